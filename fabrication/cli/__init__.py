@@ -1,0 +1,45 @@
+"""The `onestroke` command line: a thin click layer over the library.
+
+Each command lives in its own module (`vectorize_cmd.py`, `embroider_cmd.py`, ...) and is
+registered below. Library errors become a one-line message and an exit code:
+2 for bad input (`InputError`), 1 for any other failure; never a traceback.
+"""
+
+from __future__ import annotations
+
+import sys
+
+import click
+
+from onestroke.errors import OnestrokeError
+
+
+class OnestrokeGroup(click.Group):
+    """A click group that turns onestroke errors into one-line messages and exit codes."""
+
+    def invoke(self, ctx: click.Context):
+        try:
+            return super().invoke(ctx)
+        except OnestrokeError as error:
+            click.echo(f"error: {error}", err=True)
+            sys.exit(error.exit_code)
+        except KeyboardInterrupt:
+            click.echo("interrupted", err=True)
+            sys.exit(130)
+        except MemoryError:
+            click.echo("error: out of memory; try a smaller image", err=True)
+            sys.exit(1)
+
+
+@click.group(cls=OnestrokeGroup, context_settings={"help_option_names": ["-h", "--help"]})
+@click.version_option(package_name="onestroke")
+def main() -> None:
+    """Turn line drawings into embroidery files and laser G-code."""
+
+
+def _register() -> None:
+    # One import and one add_command per command module; each module owns its command.
+    pass
+
+
+_register()

@@ -1,0 +1,68 @@
+"""Placement: a `Drawing` in pixels becomes millimetres, scaled to a size and centred on (0, 0).
+
+Embroidery uses the centred frame as is (pyembroidery's +y is down, like ours); the laser
+planner moves it to the machine's origin and flips y there.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from onestroke.errors import InputError
+from vectorize.drawing import Drawing
+
+
+@dataclass(frozen=True, kw_only=True)
+class PlacementOptions:
+    """Target size of the design in mm. Give at most one of `size`, `width`, `height`.
+
+    size: longest side; width / height: that side; none: keep the drawing's own size
+    (pixels read at `dpi`). rotate: degrees, counter-clockwise as seen on screen.
+    """
+
+    size: float | None = None
+    width: float | None = None
+    height: float | None = None
+    rotate: float = 0.0
+    dpi: float = 96.0
+
+    def __post_init__(self) -> None:
+        given = [(n, v) for n, v in (("size", self.size), ("width", self.width), ("height", self.height)) if v is not None]
+        if len(given) > 1:
+            raise InputError(f"give only one of --size, --width, --height (got {', '.join(n for n, _ in given)})")
+        for name, value in given:
+            if not value > 0:
+                raise InputError(f"{name} {value:g} mm must be greater than zero")
+        if not self.dpi > 0:
+            raise InputError(f"dpi {self.dpi:g} must be greater than zero")
+
+
+def place(drawing: Drawing, options: PlacementOptions = PlacementOptions()) -> Drawing:
+    """Scale, rotate and centre `drawing` on (0, 0) in millimetres.
+
+    The returned drawing's canvas is its bounding box size; stroke width scales with it.
+    """
+    if not drawing.strokes:
+        raise InputError("the drawing has no strokes to place")
+    angle = np.radians(options.rotate)
+    # y points down, so a counter-clockwise turn on screen is a negative math angle.
+    rot = np.array([[np.cos(angle), np.sin(angle)], [-np.sin(angle), np.cos(angle)]])
+    rotated = drawing.transformed(np.hstack([rot, np.zeros((2, 1))]), width=drawing.width,
+                                  height=drawing.height, unit=drawing.unit,
+                                  stroke_width=drawing.stroke_width)
+    xmin, ymin, xmax, ymax = rotated.bounds()
+    w, h = xmax - xmin, ymax - ymin
+    if options.size is not None:
+        scale = options.size / max(w, h, 1e-12)
+    elif options.width is not None:
+        scale = options.width / max(w, 1e-12)
+    elif options.height is not None:
+        scale = options.height / max(h, 1e-12)
+    else:
+        scale = 1.0 if drawing.unit == "mm" else 25.4 / options.dpi
+    cx, cy = (xmin + xmax) / 2, (ymin + ymax) / 2
+    matrix = np.array([[scale, 0.0, -scale * cx], [0.0, scale, -scale * cy]])
+    return rotated.transformed(matrix, width=max(w * scale, 1e-9), height=max(h * scale, 1e-9),
+                               unit="mm", stroke_width=drawing.stroke_width * scale)

@@ -1,0 +1,178 @@
+"""`Stroke`: one cubic Bézier spline, the geometric type that travels through onestroke."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from functools import cached_property
+
+import numpy as np
+
+from onestroke.errors import InputError
+
+# Samples per Bézier segment of the arc-length table; the chord error this leaves in the
+# length is below 1e-5 of the segment length for the gentle segments spline fitting makes.
+_TABLE_SAMPLES = 48
+
+
+def _bezier_points(control: np.ndarray, t: np.ndarray) -> np.ndarray:
+    """Evaluate cubic segments. control (K, 4, 2), t (M,) in [0, 1] -> (K, M, 2)."""
+    t = t[None, :, None]
+    u = 1.0 - t
+    p0, p1, p2, p3 = (control[:, i, None, :] for i in range(4))
+    return u * u * u * p0 + 3 * u * u * t * p1 + 3 * u * t * t * p2 + t * t * t * p3
+
+
+@dataclass(frozen=True, eq=False)
+class Stroke:
+    """A cubic Bézier spline: `control` has shape (K, 4, 2), x right, y down.
+
+    Segment k runs from control[k, 0] to control[k, 3]; consecutive segments share end
+    points. The global parameter t in [0, 1] maps uniformly onto the K segments. Units are
+    those of the `Drawing` that holds the stroke (px before placement, mm after).
+    """
+
+    control: np.ndarray
+
+    def __post_init__(self) -> None:
+        control = np.array(self.control, dtype=float)
+        if control.ndim != 3 or control.shape[1:] != (4, 2) or len(control) == 0:
+            raise InputError(f"stroke control points must have shape (K, 4, 2), got {control.shape}")
+        if not np.all(np.isfinite(control)):
+            raise InputError("stroke control points must be finite numbers")
+        control.setflags(write=False)
+        object.__setattr__(self, "control", control)
+
+    # -- construction ------------------------------------------------------------------
+    @classmethod
+    def from_polyline(cls, points: np.ndarray) -> "Stroke":
+        """A stroke of straight cubic segments through `points` (N >= 2, 2)."""
+        points = np.asarray(points, dtype=float)
+        if points.ndim != 2 or points.shape[1] != 2 or len(points) < 2:
+            raise InputError(f"a polyline needs shape (N >= 2, 2), got {points.shape}")
+        a, b = points[:-1], points[1:]
+        return cls(np.stack([a, a + (b - a) / 3.0, a + 2.0 * (b - a) / 3.0, b], axis=1))
+
+    # -- basic properties --------------------------------------------------------------
+    @property
+    def segment_count(self) -> int:
+        return len(self.control)
+
+    @property
+    def start(self) -> np.ndarray:
+        return self.control[0, 0]
+
+    @property
+    def end(self) -> np.ndarray:
+        return self.control[-1, 3]
+
+    @property
+    def is_closed(self) -> bool:
+        """True when the end point meets the start point (within 1e-6 of the size)."""
+        scale = max(1.0, float(np.ptp(self.control.reshape(-1, 2), axis=0).max()))
+        return bool(np.linalg.norm(self.end - self.start) <= 1e-6 * scale)
+
+    @cached_property
+    def _table(self) -> tuple[np.ndarray, np.ndarray]:
+        """(t, s): global parameters and cumulative arc lengths of a dense sampling."""
+        local = np.linspace(0.0, 1.0, _TABLE_SAMPLES + 1)
+        pts = _bezier_points(self.control, local)[:, :-1].reshape(-1, 2)
+        pts = np.vstack([pts, self.end])
+        t = np.concatenate(
+            [(k + local[:-1]) / self.segment_count for k in range(self.segment_count)] + [[1.0]]
+        )
+        s = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(pts, axis=0), axis=1))])
+        return t, s
+
+    @property
+    def length(self) -> float:
+        """Arc length of the whole spline."""
+        return float(self._table[1][-1])
+
+    def bounds(self) -> tuple[float, float, float, float]:
+        """(xmin, ymin, xmax, ymax) of the curve itself (not of its control polygon)."""
+        pts = self.points_at(self._table[0])
+        return (*pts.min(axis=0), *pts.max(axis=0))
+
+    # -- evaluation --------------------------------------------------------------------
+    def _split_parameter(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        scaled = np.clip(np.asarray(t, dtype=float), 0.0, 1.0) * self.segment_count
+        index = np.minimum(scaled.astype(int), self.segment_count - 1)
+        return index, scaled - index
+
+    def points_at(self, t: np.ndarray | float) -> np.ndarray:
+        """Points at global parameters t in [0, 1]: shape (M, 2) (or (2,) for a scalar)."""
+        scalar = np.ndim(t) == 0
+        index, local = self._split_parameter(np.atleast_1d(t))
+        c = self.control[index]
+        u = (1.0 - local)[:, None]
+        v = local[:, None]
+        out = u**3 * c[:, 0] + 3 * u * u * v * c[:, 1] + 3 * u * v * v * c[:, 2] + v**3 * c[:, 3]
+        return out[0] if scalar else out
+
+    def tangents_at(self, t: np.ndarray | float) -> np.ndarray:
+        """Unit tangents (direction of travel) at global parameters t: shape (M, 2)."""
+        scalar = np.ndim(t) == 0
+        index, local = self._split_parameter(np.atleast_1d(t))
+        c = self.control[index]
+        u = (1.0 - local)[:, None]
+        v = local[:, None]
+        d = 3 * u * u * (c[:, 1] - c[:, 0]) + 6 * u * v * (c[:, 2] - c[:, 1]) + 3 * v * v * (c[:, 3] - c[:, 2])
+        # A degenerate derivative (coincident control points) falls back to the chord.
+        chord = c[:, 3] - c[:, 0]
+        small = np.linalg.norm(d, axis=1) < 1e-12
+        d[small] = chord[small]
+        norm = np.linalg.norm(d, axis=1, keepdims=True)
+        out = np.divide(d, norm, out=np.zeros_like(d), where=norm > 0)
+        return out[0] if scalar else out
+
+    def parameters_at_lengths(self, s: np.ndarray | float) -> np.ndarray:
+        """Global parameters t at arc lengths s (clipped to [0, length])."""
+        t_table, s_table = self._table
+        return np.interp(np.clip(s, 0.0, self.length), s_table, t_table)
+
+    def points_at_lengths(self, s: np.ndarray | float) -> np.ndarray:
+        """Points at arc lengths s from the start: shape (M, 2)."""
+        return self.points_at(self.parameters_at_lengths(s))
+
+    def sample_evenly(self, spacing: float) -> np.ndarray:
+        """Points every `spacing` of arc length, start and end included: shape (M, 2).
+
+        The spacing is adjusted down so that the points divide the length equally.
+        """
+        if not spacing > 0:
+            raise InputError(f"sampling spacing must be > 0, got {spacing}")
+        count = max(1, int(np.ceil(self.length / spacing - 1e-9)))
+        return self.points_at_lengths(np.linspace(0.0, self.length, count + 1))
+
+    def flatten(self, tolerance: float) -> np.ndarray:
+        """A polyline within `tolerance` of the curve: shape (N, 2), start and end included.
+
+        Each segment is cut into n equal parameter steps with n from Wang's formula,
+        n = ceil(sqrt(3/4 * M / tolerance)), M = largest second difference of its control
+        points, which bounds the chord error of every piece by `tolerance`.
+        """
+        if not tolerance > 0:
+            raise InputError(f"flattening tolerance must be > 0, got {tolerance}")
+        c = self.control
+        second = np.maximum(
+            np.linalg.norm(c[:, 0] - 2 * c[:, 1] + c[:, 2], axis=1),
+            np.linalg.norm(c[:, 1] - 2 * c[:, 2] + c[:, 3], axis=1),
+        )
+        steps = np.maximum(1, np.ceil(np.sqrt(0.75 * second / tolerance))).astype(int)
+        index = np.repeat(np.arange(len(c)), steps)
+        # local parameter j / n for j = 0..n-1 of each segment
+        offsets = np.arange(index.size) - np.repeat(np.cumsum(steps) - steps, steps)
+        local = offsets / np.repeat(steps, steps)
+        t = (index + local) / len(c)
+        pts = self.points_at(np.append(t, 1.0))
+        return pts
+
+    # -- transformations ---------------------------------------------------------------
+    def reversed(self) -> "Stroke":
+        """The same curve traversed from end to start."""
+        return Stroke(self.control[::-1, ::-1])
+
+    def transformed(self, matrix: np.ndarray) -> "Stroke":
+        """Apply a 2x3 affine matrix [[a, b, tx], [c, d, ty]] to every control point."""
+        matrix = np.asarray(matrix, dtype=float)
+        return Stroke(self.control @ matrix[:, :2].T + matrix[:, 2])

@@ -1,0 +1,91 @@
+"""SVG and JSON output of a `Drawing`: one `<path>` per stroke, in drawing order."""
+
+from __future__ import annotations
+
+import json
+import os
+
+import numpy as np
+
+from onestroke.atomic import atomic_write_text
+from vectorize.drawing import Drawing
+from vectorize.stroke import Stroke
+
+
+def _num(value: float) -> str:
+    """Compact, deterministic number: 3 decimals, no trailing zeros, no '-0'."""
+    text = f"{value:.3f}".rstrip("0").rstrip(".")
+    return "0" if text in ("-0", "") else text
+
+
+def path_data(stroke: Stroke) -> str:
+    """SVG path data "M x y C x1 y1 x2 y2 x y ..." of one stroke (Z when closed)."""
+    c = stroke.control
+    parts = [f"M{_num(c[0, 0, 0])} {_num(c[0, 0, 1])}"]
+    for seg in c:
+        parts.append("C" + " ".join(f"{_num(x)} {_num(y)}" for x, y in seg[1:]))
+    if stroke.is_closed and len(c) > 1:
+        parts.append("Z")
+    return "".join(parts)
+
+
+def drawing_to_svg(drawing: Drawing, *, color: str = "#000000") -> str:
+    """The SVG text of `drawing`: viewBox = its canvas, stroke width = its measured width."""
+    w, h = _num(drawing.width), _num(drawing.height)
+    size = f'width="{w}mm" height="{h}mm"' if drawing.unit == "mm" else f'width="{w}" height="{h}"'
+    lines = [
+        '<?xml version="1.0" encoding="UTF-8"?>',
+        f'<svg xmlns="http://www.w3.org/2000/svg" {size} viewBox="0 0 {w} {h}">',
+        f'<g fill="none" stroke="{color}" stroke-width="{_num(drawing.stroke_width)}" '
+        'stroke-linecap="round" stroke-linejoin="round">',
+    ]
+    for index, stroke in enumerate(drawing.strokes):
+        lines.append(f'<path id="stroke-{index + 1}" d="{path_data(stroke)}"/>')
+    lines += ["</g>", "</svg>", ""]
+    return "\n".join(lines)
+
+
+def drawing_to_json(drawing: Drawing) -> str:
+    """JSON with the canvas and each stroke's control points, shape (K, 4, 2)."""
+    payload = {
+        "format": "onestroke-drawing",
+        "version": 1,
+        "unit": drawing.unit,
+        "width": round(drawing.width, 6),
+        "height": round(drawing.height, 6),
+        "stroke_width": round(drawing.stroke_width, 6),
+        "strokes": [np.round(s.control, 4).tolist() for s in drawing.strokes],
+    }
+    return json.dumps(payload, separators=(",", ":")) + "\n"
+
+
+def drawing_from_json(text: str) -> Drawing:
+    """Parse what `drawing_to_json` wrote."""
+    from onestroke.errors import InputError
+
+    try:
+        payload = json.loads(text)
+        if payload.get("format") != "onestroke-drawing":
+            raise ValueError("not an onestroke drawing")
+        return Drawing(
+            strokes=tuple(Stroke(np.array(c, dtype=float)) for c in payload["strokes"]),
+            width=float(payload["width"]),
+            height=float(payload["height"]),
+            unit=payload.get("unit", "px"),
+            stroke_width=float(payload.get("stroke_width", 1.0)),
+        )
+    except (ValueError, KeyError, TypeError) as error:
+        raise InputError(f"not a valid onestroke JSON drawing: {error}") from None
+
+
+def write_drawing(drawing: Drawing, path: str | os.PathLike) -> None:
+    """Write `drawing` atomically as .svg or .json, chosen by the extension."""
+    from onestroke.errors import InputError
+
+    suffix = os.path.splitext(str(path))[1].lower()
+    if suffix == ".svg":
+        atomic_write_text(path, drawing_to_svg(drawing))
+    elif suffix == ".json":
+        atomic_write_text(path, drawing_to_json(drawing))
+    else:
+        raise InputError(f"cannot write a drawing as {suffix or 'a file without extension'!r}; use .svg or .json")
