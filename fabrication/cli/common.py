@@ -17,3 +17,15 @@ def warn(message: str) -> None:
 def done(message: str) -> None:
     """Print a one-line summary of what a command made."""
     click.echo(message)
+
+
+def read_drawing(path: str, *, multi: bool = False, threshold: float | None = None,
+                 blur: float = 0.0, classifier: str = "cnn"):
+    """Read a drawing from a raster image or SVG, printing the vectorizer's warnings."""
+    from vectorize import VectorizeOptions, vectorize_file
+
+    result = vectorize_file(path, VectorizeOptions(multi=multi, threshold=threshold, blur=blur,
+                                                   classifier=classifier))
+    for message in result.report.warnings:
+        warn(message)
+    return result.drawing

@@ -1,0 +1,129 @@
+"""The vectorizer: a raster (or SVG) line drawing in, ordered cubic Bézier strokes out.
+
+Stages (paper, Sections 3.1-3.4, and 4.5 for `multi`): load and binarize -> outline ->
+Voronoi medial axis with radii -> pruning -> simplification (degree-3 merging, Y-junctions)
+-> intersection classification -> traversal with flip-and-retry -> filtering and spline
+fitting. Each stage is a function in its own module; this one wires them together.
+"""
+
+from __future__ import annotations
+
+import os
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from onestroke.errors import InputError
+from vectorize.drawing import Drawing
+
+
+@dataclass(frozen=True, kw_only=True)
+class VectorizeOptions:
+    """Options of the vectorizer.
+
+    multi: multi-stroke mode (paper 4.5) instead of one single line.
+    threshold: gray level in [0, 1] below which a pixel is ink (None: Li's method).
+    blur: Gaussian sigma in px applied before thresholding (0: none).
+    classifier: "cnn" (shipped model) or "geometric" (tangent continuity).
+    max_size: longest side of the working image in px; larger inputs are downscaled.
+    seed: seed of every random choice (retry search ties), for reproducible output.
+    """
+
+    multi: bool = False
+    threshold: float | None = None
+    blur: float = 0.0
+    classifier: str = "cnn"
+    max_size: int = 1000
+    seed: int = 0
+    keep_stages: bool = False
+
+    def __post_init__(self) -> None:
+        if self.threshold is not None and not 0.0 < self.threshold < 1.0:
+            raise InputError(f"threshold {self.threshold!r} must lie strictly between 0 and 1")
+        if self.blur < 0:
+            raise InputError(f"blur sigma {self.blur!r} must be >= 0")
+        if self.classifier not in ("cnn", "geometric"):
+            raise InputError(f"unknown classifier {self.classifier!r}; use 'cnn' or 'geometric'")
+        if self.max_size < 64:
+            raise InputError(f"max_size {self.max_size!r} must be at least 64 px")
+
+
+@dataclass(frozen=True)
+class VectorizeReport:
+    """What happened: counts, warnings and time, for the CLI and the benchmark.
+
+    strokes: strokes produced; intersections: degree-4 nodes classified; y_junctions: sharp
+    out-and-back features kept; dropped_components: ink pieces left out (single-line mode);
+    high_degree_junctions: nodes where three or more strokes meet (not resolved);
+    scale: working px per input px (< 1 when downscaled); seconds: wall time per stage.
+    """
+
+    strokes: int = 0
+    intersections: int = 0
+    y_junctions: int = 0
+    dropped_components: int = 0
+    high_degree_junctions: int = 0
+    retries: int = 0
+    scale: float = 1.0
+    stroke_width: float = 0.0
+    warnings: tuple[str, ...] = ()
+    seconds: dict = field(default_factory=dict)
+
+    @property
+    def total_seconds(self) -> float:
+        return float(sum(self.seconds.values()))
+
+
+@dataclass(frozen=True)
+class VectorizeResult:
+    """The drawing (px, in the input image's frame) and the report; `stages` for --debug."""
+
+    drawing: Drawing
+    report: VectorizeReport
+    stages: dict | None = None
+
+
+RASTER_SUFFIXES = (".png", ".jpg", ".jpeg", ".bmp", ".gif", ".tif", ".tiff", ".webp")
+
+
+def vectorize_file(path: str | os.PathLike, options: VectorizeOptions = VectorizeOptions()) -> VectorizeResult:
+    """Vectorize a raster image or read an SVG (strokes as they are; outlines to centre lines)."""
+    path = str(path)
+    if not os.path.exists(path):
+        raise InputError(f"input file {path!r} does not exist")
+    if os.path.isdir(path):
+        raise InputError(f"input {path!r} is a directory, not an image")
+    suffix = os.path.splitext(path)[1].lower()
+    if suffix in (".svg", ".svgz"):
+        return _vectorize_svg(path, options)
+    from vectorize.image_io import load_image
+
+    image = load_image(path)
+    return vectorize_image(image, options)
+
+
+def _vectorize_svg(path: str, options: VectorizeOptions) -> VectorizeResult:
+    from vectorize.svg_read import read_svg
+
+    start = time.perf_counter()
+    content = read_svg(path)
+    if content.is_outline:
+        from vectorize.outline_svg import rasterize_rings
+
+        gray, scale, offset = rasterize_rings(content.outline_rings, content.width, content.height,
+                                              size=options.max_size)
+        result = vectorize_image(gray, options, _frame=(scale, offset, content.width, content.height))
+        return result
+    drawing = content.as_drawing()
+    report = VectorizeReport(strokes=len(drawing.strokes), stroke_width=drawing.stroke_width,
+                             seconds={"read svg": time.perf_counter() - start})
+    return VectorizeResult(drawing, report)
+
+
+def vectorize_image(image: np.ndarray, options: VectorizeOptions = VectorizeOptions(), *,
+                    _frame=None) -> VectorizeResult:
+    """Vectorize a raster image: (H, W) gray or (H, W, 3|4) colour, uint8 or float in [0, 1]."""
+    from vectorize.vectorizer import run_pipeline
+
+    return run_pipeline(image, options, frame=_frame)
