@@ -72,15 +72,30 @@ def turn_cost(directions: np.ndarray, pairing: Pairing) -> float:
 
 
 def crossing_pairing(directions: np.ndarray) -> Pairing:
-    """The pairing that goes most nearly straight through (each branch with its opposite)."""
-    return min(ALL_PAIRINGS, key=lambda p: turn_cost(directions, p))
+    """The pairing of branches that lie opposite each other in angular order around the node.
+
+    Two strokes that cross alternate around the node (A, B, A', B'); two that touch come in
+    side by side (A, A', B', B). Angular order, not tangent smoothness, tells them apart:
+    at a tangential touch both the crossing and the right touching pairing are smooth.
+    """
+    d = np.asarray(directions, dtype=float)
+    order = np.argsort(np.arctan2(d[:, 1], d[:, 0]), kind="stable")
+    a, b, c, e = (int(i) for i in order)
+    return _normal((a, c), (b, e))
 
 
 def touching_pairings(directions: np.ndarray) -> tuple[Pairing, Pairing]:
-    """The two other pairings, the smoother (smaller tangent discontinuity) first."""
-    straight = crossing_pairing(directions)
-    others = [p for p in ALL_PAIRINGS if p != straight]
-    return tuple(sorted(others, key=lambda p: turn_cost(directions, p)))  # type: ignore[return-value]
+    """The two pairings of angular neighbours, the smoother (smaller turn) first."""
+    d = np.asarray(directions, dtype=float)
+    order = np.argsort(np.arctan2(d[:, 1], d[:, 0]), kind="stable")
+    a, b, c, e = (int(i) for i in order)
+    options = [_normal((a, b), (c, e)), _normal((b, c), (e, a))]
+    return tuple(sorted(options, key=lambda p: turn_cost(d, p)))  # type: ignore[return-value]
+
+
+def _normal(first: tuple[int, int], second: tuple[int, int]) -> Pairing:
+    pair = sorted([tuple(sorted(first)), tuple(sorted(second))])
+    return (pair[0], pair[1])  # type: ignore[return-value]
 
 
 def ranked_pairings(junction: Junction, verdict: JunctionVerdict) -> tuple[Pairing, Pairing, Pairing]:
@@ -109,7 +124,8 @@ class GeometricClassifier:
         for junction in junctions:
             straight = turn_cost(junction.directions, crossing_pairing(junction.directions))
             touch = turn_cost(junction.directions, touching_pairings(junction.directions)[0])
-            # Softmax over negative costs: a crossing is likely when going straight bends less.
+            # A crossing is likely when going straight through bends less than turning;
+            # at a tangential touch both are smooth and the rule can only guess (p ~ 0.5).
             p = float(1.0 / (1.0 + np.exp(4.0 * (straight - touch))))
             verdicts.append(JunctionVerdict(p_crossing=p, confidence=max(p, 1.0 - p)))
         return verdicts

@@ -1,0 +1,37 @@
+"""Loading raster images with clear errors for files that are not usable images."""
+
+from __future__ import annotations
+
+import os
+import warnings
+
+import numpy as np
+from PIL import Image, UnidentifiedImageError
+
+from onestroke.errors import InputError
+
+# Refuse images whose decoded size would exhaust memory (e.g. a decompression bomb).
+MAX_PIXELS = 200_000_000
+
+
+def load_image(path: str | os.PathLike) -> np.ndarray:
+    """Read an image file as uint8 (H, W), (H, W, 3) or (H, W, 4) without changing its pixels."""
+    path = str(path)
+    if not os.path.isfile(path):
+        raise InputError(f"input file {path!r} does not exist")
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("error", Image.DecompressionBombWarning)
+            with Image.open(path) as image:
+                if image.width * image.height > MAX_PIXELS:
+                    raise InputError(f"image {path!r} is {image.width}x{image.height}: too large to read")
+                image.load()
+                if image.mode in ("RGBA", "LA") or (image.mode == "P" and "transparency" in image.info):
+                    image = image.convert("RGBA")
+                elif image.mode not in ("L", "RGB"):
+                    image = image.convert("RGB")
+                return np.asarray(image)
+    except UnidentifiedImageError:
+        raise InputError(f"{path!r} is not an image Pillow can read (PNG, JPEG, BMP, GIF, TIFF, WebP) or SVG") from None
+    except (OSError, SyntaxError, ValueError, Image.DecompressionBombWarning, Image.DecompressionBombError) as error:
+        raise InputError(f"cannot read image {path!r}: it is damaged or truncated ({error})") from None

@@ -1,0 +1,212 @@
+"""Medial-axis simplification (paper 3.2): merge degree-3 pairs into crossings, keep Y-junctions.
+
+Where two strokes meet, the medial axis shows two degree-3 junctions joined by a short
+branch instead of one degree-4 node. The branch between the two halves of one crossing
+runs through ink laid down twice, so its narrowest radius is the largest of the three
+(paper, Fig. 4); at shallow crossings, where all widths are alike, the two halves also
+face each other: each one's "foot" (the branch opposite its smallest angle) leads to
+the other. A degree-3 node whose foot ends in a free end is a Y-junction: a sharp
+feature drawn out and back, kept and traversed twice.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from vectorize.graph import Branch, MedialGraph
+
+Slot = tuple[int, str]  # (branch id, which end of it touches the node: "a" or "b")
+
+
+def slots(graph: MedialGraph, node: int) -> list[Slot]:
+    """The branch ends at `node`, in a fixed order (a loop contributes both of its ends)."""
+    result: list[Slot] = []
+    for bid in graph.incident[node]:
+        branch = graph.branches[bid]
+        if branch.a == branch.b:
+            result.append((bid, "b" if (bid, "a") in result else "a"))
+        else:
+            result.append((bid, "a" if branch.a == node else "b"))
+    return result
+
+
+def slot_points(graph: MedialGraph, slot: Slot) -> np.ndarray:
+    """Points of the slot's branch, starting at the node: (M, 2)."""
+    bid, end = slot
+    points = graph.branches[bid].points
+    return points if end == "a" else points[::-1]
+
+
+def slot_direction(graph: MedialGraph, slot: Slot, reach: float) -> np.ndarray:
+    """Unit tangent leaving the node along the slot: chord to the point `reach` px along it."""
+    points = slot_points(graph, slot)
+    steps = np.linalg.norm(np.diff(points, axis=0), axis=1)
+    arc = np.concatenate([[0.0], np.cumsum(steps)])
+    target = min(reach, arc[-1])
+    at = np.array([np.interp(target, arc, points[:, 0]), np.interp(target, arc, points[:, 1])])
+    chord = at - points[0]
+    norm = np.linalg.norm(chord)
+    return chord / norm if norm > 1e-9 else np.array([1.0, 0.0])
+
+
+def directions(graph: MedialGraph, node: int, reach: float) -> np.ndarray:
+    """(D, 2) unit tangents of all slots at `node`, in `slots` order."""
+    return np.array([slot_direction(graph, s, reach) for s in slots(graph, node)])
+
+
+def foot_slot(dirs: np.ndarray) -> int:
+    """Index of the foot of a degree-3 node: the slot opposite the smallest angle."""
+    best, foot = -2.0, 0
+    for i, j, k in ((0, 1, 2), (0, 2, 1), (1, 2, 0)):
+        cos = float(np.dot(dirs[i], dirs[j]))
+        if cos > best:
+            best, foot = cos, k
+    return foot
+
+
+@dataclass(frozen=True)
+class Simplified:
+    """Result of simplification: the node kinds the traversal needs.
+
+    y_feet: Y-junction node -> slot index of its foot; y_tips: the free ends of those feet;
+    crossings: degree-4 nodes; merged: pairs merged; unresolved: nodes where three or more
+    strokes seem to meet (degree >= 5, or degree 3 that is neither Y, end nor crossing half).
+    """
+
+    y_feet: dict
+    y_tips: frozenset
+    crossings: tuple
+    merged: int
+    unresolved: tuple
+    t_ends: tuple
+
+
+def _min_radius(branch: Branch) -> float:
+    inner = branch.radii[1:-1]
+    return float(inner.min()) if inner.size else float(branch.radii.min())
+
+
+def _merge(graph: MedialGraph, a: int, b: int, bid: int) -> int:
+    """Replace nodes a, b and their joining branch by one node at the branch's middle."""
+    join = graph.remove_branch(bid).oriented_from(a)
+    arc = np.concatenate([[0.0], np.cumsum(join.edge_lengths)])
+    mid = int(np.searchsorted(arc, arc[-1] / 2.0))
+    mid = min(max(mid, 0), len(arc) - 1)
+    node = graph.add_node(join.points[mid], float(join.radii.max()))
+    # Each remaining branch keeps its geometry: it now starts at the middle node and runs
+    # along the half of the joining branch that leads to its old junction.
+    for old, half_points, half_radii, half_sins in (
+        (a, join.points[: mid + 1][::-1], join.radii[: mid + 1][::-1], join.sins[:mid][::-1]),
+        (b, join.points[mid:], join.radii[mid:], join.sins[mid:]),
+    ):
+        for other in list(graph.incident[old]):
+            branch = graph.remove_branch(other)
+            if branch.a == branch.b:
+                # A loop at the old junction: both of its ends move to the new node.
+                pts = np.vstack([half_points, branch.points[1:], half_points[::-1][1:]])
+                rad = np.concatenate([half_radii, branch.radii[1:], half_radii[::-1][1:]])
+                sn = np.concatenate([half_sins, branch.sins, half_sins[::-1]])
+                graph.add_branch(Branch(node, node, pts, rad, sn))
+                continue
+            out = branch.oriented_from(old)
+            graph.add_branch(Branch(node, out.b, np.vstack([half_points, out.points[1:]]),
+                                    np.concatenate([half_radii, out.radii[1:]]),
+                                    np.concatenate([half_sins, out.sins])))
+        del graph.incident[old], graph.positions[old], graph.radii[old]
+    return node
+
+
+def simplify(graph: MedialGraph, *, stroke_width: float, multi: bool) -> Simplified:
+    """Merge crossing halves into degree-4 nodes in place and classify the other nodes."""
+    reach = 2.5 * stroke_width
+    merged = 0
+
+    def is_y(node: int) -> bool:
+        if graph.degree(node) != 3:
+            return False
+        node_slots = slots(graph, node)
+        foot = node_slots[foot_slot(directions(graph, node, reach))]
+        far = graph.branches[foot[0]].other(node)
+        return graph.degree(far) == 1
+
+    def candidates() -> list[int]:
+        return sorted(n for n in graph.nodes_of_degree(3) if not is_y(n))
+
+    def joining(node: int, other_ok) -> dict[str, int | None]:
+        """This node's picks: by widest narrowest radius (paper) and by foot."""
+        node_slots = slots(graph, node)
+        options = [(bid, graph.branches[bid].other(node)) for bid, _ in node_slots
+                   if graph.branches[bid].a != graph.branches[bid].b]
+        options = [(bid, far) for bid, far in options if other_ok(far)
+                   and graph.branches[bid].length < 14.0 * stroke_width]
+        widest = max(options, key=lambda o: _min_radius(graph.branches[o[0]]), default=None)
+        foot_bid = node_slots[foot_slot(directions(graph, node, reach))][0]
+        foot = next((o for o in options if o[0] == foot_bid), None)
+        return {"widest": widest, "foot": foot}
+
+    # Rounds: mutual widest picks, then mutual feet; each round recomputes the picks.
+    for rule in ("widest", "foot"):
+        while True:
+            pool = set(candidates())
+            picks = {n: joining(n, lambda far: far in pool)[rule] for n in pool}
+            pairs = sorted({tuple(sorted((n, p[1]))) + (p[0],) for n, p in picks.items()
+                            if p is not None and picks.get(p[1]) is not None and picks[p[1]][0] == p[0]})
+            if not pairs:
+                break
+            done: set[int] = set()
+            for a, b, bid in pairs:
+                if a in done or b in done or bid not in graph.branches:
+                    continue
+                _merge(graph, a, b, bid)
+                done |= {a, b}
+                merged += 1
+    # Remaining non-mutual picks over short branches (the paper's second pass).
+    while True:
+        pool = set(candidates())
+        progress = False
+        for node in sorted(pool):
+            if node not in graph.incident or graph.degree(node) != 3:
+                continue
+            pick = joining(node, lambda far: far in pool and far in graph.incident and graph.degree(far) == 3)["widest"]
+            if pick is None or graph.branches[pick[0]].length > 2.0 * stroke_width:
+                continue
+            _merge(graph, node, pick[1], pick[0])
+            pool -= {node, pick[1]}
+            merged += 1
+            progress = True
+        if not progress:
+            break
+
+    y_feet, y_tips, t_ends, unresolved = {}, set(), [], []
+    for node in sorted(graph.incident):
+        degree = graph.degree(node)
+        if degree == 3:
+            node_slots = slots(graph, node)
+            dirs = directions(graph, node, reach)
+            foot = foot_slot(dirs)
+            far = graph.branches[node_slots[foot][0]].other(node)
+            if graph.degree(far) == 1:
+                y_feet[node] = foot
+                y_tips.add(far)
+            elif _is_t_shape(dirs):
+                # A stroke ending on another line: an end of the drawing (paper 3.3, 4.5).
+                t_ends.append(node)
+            else:
+                # Three strokes seem to meet, or a crossing lost its other half. In
+                # single-line mode it still counts as an end (paper 3.3); report it.
+                unresolved.append(node)
+                if not multi:
+                    t_ends.append(node)
+        elif degree >= 5:
+            unresolved.append(node)
+    crossings = tuple(sorted(graph.nodes_of_degree(4)))
+    return Simplified(y_feet, frozenset(y_tips), crossings, merged, tuple(unresolved), tuple(t_ends))
+
+
+def _is_t_shape(dirs: np.ndarray) -> bool:
+    """Largest angle between branches near 180 degrees and the other two alike (paper 4.5)."""
+    pairs = [(0, 1), (0, 2), (1, 2)]
+    angles = sorted(float(np.degrees(np.arccos(np.clip(np.dot(dirs[i], dirs[j]), -1, 1)))) for i, j in pairs)
+    return angles[2] > 150.0 and abs(angles[1] - angles[0]) < 40.0

@@ -1,0 +1,181 @@
+"""The raster pipeline, stage by stage (paper 3.1-3.4 and 4.5)."""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+
+from vectorize.binarize import binarize
+from vectorize.drawing import Drawing
+from vectorize.fitting import TracedPoint, fit_stroke
+from vectorize.graph import MedialGraph
+from vectorize.intersections import Junction, JunctionVerdict, make_classifier, ranked_pairings
+from vectorize.medial_axis import medial_axis
+from vectorize.outline import outline_rings
+from vectorize.pipeline import VectorizeOptions, VectorizeReport, VectorizeResult
+from vectorize.pruning import prune
+from vectorize.simplify import Simplified, directions, simplify, slots
+from vectorize.stroke import Stroke
+from vectorize.traversal import Ordering, order_strokes
+
+# Vanishing-angle thresholds (notes: 0.95 single-line, 0.90 multi-line).
+PRUNE_SINGLE, PRUNE_MULTI = 0.95, 0.90
+# Share of plausibility of the smoother touching pairing when the classifier says "touch".
+SMOOTHER_TOUCH = 0.85
+
+
+class _Clock:
+    def __init__(self) -> None:
+        self.seconds: dict[str, float] = {}
+        self._last = time.perf_counter()
+
+    def lap(self, stage: str) -> None:
+        now = time.perf_counter()
+        self.seconds[stage] = self.seconds.get(stage, 0.0) + now - self._last
+        self._last = now
+
+
+def _junctions(graph: MedialGraph, nodes, stroke_width: float) -> list[Junction]:
+    result = []
+    for node in nodes:
+        dirs = directions(graph, node, 2.5 * stroke_width)
+        radii = []
+        for bid, end in slots(graph, node):
+            branch = graph.branches[bid]
+            r = branch.radii if end == "a" else branch.radii[::-1]
+            pts = branch.points if end == "a" else branch.points[::-1]
+            dist = np.linalg.norm(pts - pts[0], axis=1)
+            band = r[(dist > 1.5 * stroke_width) & (dist < 3.5 * stroke_width)]
+            radii.extend(band.tolist())
+        width = 2.0 * float(np.median(radii)) if radii else stroke_width
+        result.append(Junction(center=graph.positions[node].copy(), directions=dirs, width=width))
+    return result
+
+
+def _pairing_costs(verdict: JunctionVerdict) -> tuple[float, float, float]:
+    """-log plausibility of the three ranked pairings, relative to the first."""
+    p = float(np.clip(verdict.p_crossing, 0.02, 0.98))
+    straight, touch_a, touch_b = p, (1 - p) * SMOOTHER_TOUCH, (1 - p) * (1 - SMOOTHER_TOUCH)
+    ranked = [straight, touch_a, touch_b] if verdict.is_crossing else [touch_a, straight, touch_b]
+    return tuple(float(np.log(ranked[0]) - np.log(x)) for x in ranked)  # type: ignore[return-value]
+
+
+def _trace(graph: MedialGraph, simple: Simplified, ordering: Ordering, junctions: dict,
+           verdicts: dict, stroke_width: float) -> list[tuple[list[TracedPoint], bool]]:
+    """Turn branch passes into point lists flagged for filtering (paper 3.4)."""
+    foot_branches = {slots(graph, n)[f][0] for n, f in simple.y_feet.items()}
+    crossing_of = dict(zip(simple.crossings, ordering.choice))
+    # Uncertain zone around each degree-4 node: where the two strokes' inks still overlap.
+    zones = []
+    for node in simple.crossings:
+        junction = junctions[node]
+        d = junction.directions
+        cos = max(-float(np.dot(d[a], d[b])) for a, b in crossing_of[node])
+        half_angle = np.arccos(np.clip(cos, -1.0, 1.0)) / 2.0
+        angle = np.pi / 2 - half_angle  # half the angle between the two crossing lines
+        reach = stroke_width / (2.0 * max(np.sin(max(angle, 1e-3)), 1e-3))
+        reach = float(np.clip(reach, graph.radii[node], 6.0 * stroke_width))
+        zones.append((graph.positions[node], reach, verdicts[node].is_crossing))
+    result = []
+    for passes, closed in zip(ordering.strokes, ordering.closed):
+        traced: list[TracedPoint] = []
+        for index, step in enumerate(passes):
+            branch = graph.branches[step.branch].oriented_from(
+                graph.branches[step.branch].a if step.start == "a" else graph.branches[step.branch].b)
+            points = branch.points if index == 0 else branch.points[1:]
+            on_foot = step.branch in foot_branches
+            for k, xy in enumerate(points):
+                last = k == len(points) - 1
+                tip = on_foot and last and branch.b in simple.y_tips
+                keep = (not on_foot) or tip
+                traced.append(TracedPoint(xy, keep, tip))
+        xy = np.array([t.xy for t in traced])
+        for center, reach, crossing in zones:
+            dist = np.linalg.norm(xy - center, axis=1)
+            for i in np.flatnonzero(dist < reach):
+                at_node = dist[i] < 1e-6
+                traced[i] = TracedPoint(traced[i].xy, crossing and at_node and traced[i].keep, traced[i].split)
+        result.append((traced, closed))
+    return result
+
+
+def _orient(stroke: Stroke, closed: bool) -> Stroke:
+    """Deterministic direction: open strokes start at the end nearer the top-left corner."""
+    if not closed and stroke.end.sum() < stroke.start.sum():
+        return stroke.reversed()
+    return stroke
+
+
+def run_pipeline(image: np.ndarray, options: VectorizeOptions, *, frame=None) -> VectorizeResult:
+    """Vectorize `image`; `frame` = (scale, offset, width, height) maps working px to an SVG frame."""
+    clock = _Clock()
+    ink = binarize(image, max_size=options.max_size, blur=options.blur,
+                   threshold=options.threshold, multi=options.multi)
+    clock.lap("binarize")
+    w = ink.stroke_width
+    spacing = float(np.clip(w / 8.0, 0.3, 1.0))
+    rings = outline_rings(ink.gray, ink.threshold, spacing)
+    clock.lap("outline")
+    graph = medial_axis(rings, ink.gray, ink.threshold)
+    clock.lap("medial axis")
+    prune(graph, threshold=PRUNE_MULTI if options.multi else PRUNE_SINGLE, stroke_width=w)
+    clock.lap("pruning")
+    stages = {"ink": ink, "rings": rings, "pruned": graph.copy()} if options.keep_stages else None
+    simple = simplify(graph, stroke_width=w, multi=options.multi)
+    clock.lap("simplification")
+
+    junction_list = _junctions(graph, simple.crossings, w)
+    junctions = dict(zip(simple.crossings, junction_list))
+    if junction_list:
+        classifier = make_classifier(options.classifier)
+        verdict_list = classifier.classify(ink.gray, junction_list, w)
+    else:
+        verdict_list = []
+    verdicts = dict(zip(simple.crossings, verdict_list))
+    clock.lap("classification")
+
+    ranked = {n: ranked_pairings(junctions[n], verdicts[n]) for n in simple.crossings}
+    costs = {n: _pairing_costs(verdicts[n]) for n in simple.crossings}
+    ordering, tried = order_strokes(graph, simple, ranked, costs, stroke_width=w, search=not options.multi)
+    clock.lap("traversal")
+
+    sigma = float(np.clip(0.06 * w, 0.15, 0.6))
+    strokes = []
+    for traced, closed in _trace(graph, simple, ordering, junctions, verdicts, w):
+        if len(traced) < 2:
+            continue
+        strokes.append(_orient(fit_stroke(traced, closed=closed, sigma=sigma), closed))
+    strokes = [s for s in strokes if s.length > 0.5 * w or len(strokes) == 1]
+    strokes.sort(key=lambda s: (round(float(s.start.sum()) / (4 * w)), float(s.start[0])))
+    clock.lap("fitting")
+
+    # Back to the input's frame: original image pixels, or the SVG's user units.
+    if frame is None:
+        scale, offset = ink.scale, np.zeros(2)
+        height, width = (np.asarray(image).shape[0], np.asarray(image).shape[1])
+    else:
+        scale, offset, width, height = frame
+    matrix = np.array([[1 / scale, 0, offset[0]], [0, 1 / scale, offset[1]]])
+    drawing = Drawing(tuple(s.transformed(matrix) for s in strokes), float(width), float(height), "px", w / scale)
+
+    warnings = []
+    if ink.scale < 1.0 and frame is None:
+        h0, w0 = np.asarray(image).shape[:2]
+        warnings.append(f"image is {w0}x{h0} px: downscaled to {ink.gray.shape[1]}x{ink.gray.shape[0]} to vectorize")
+    if ink.dropped:
+        warnings.append(f"{ink.dropped} separate ink piece(s) dropped: a single-line drawing keeps only the largest"
+                        " (use --multi to keep them all)")
+    if simple.unresolved:
+        warnings.append(f"{len(simple.unresolved)} junction(s) where three or more strokes seem to meet:"
+                        " they are not resolved and the order there may be wrong")
+    if not options.multi and len(strokes) > 1:
+        warnings.append(f"the line could not be followed in one stroke: {len(strokes)} strokes")
+    report = VectorizeReport(
+        strokes=len(strokes), intersections=len(simple.crossings), y_junctions=len(simple.y_feet),
+        dropped_components=ink.dropped, high_degree_junctions=len(simple.unresolved), retries=tried - 1,
+        scale=ink.scale, stroke_width=w / scale, warnings=tuple(warnings), seconds=clock.seconds)
+    if stages is not None:
+        stages.update(simplified=graph, simple=simple, junctions=junctions, verdicts=verdicts,
+                      ordering=ordering, working_strokes=strokes)
+    return VectorizeResult(drawing, report, stages)
