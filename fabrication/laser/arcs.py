@@ -1,0 +1,127 @@
+"""G2/G3 arcs fitted to a dense polyline within a tolerance, to cut the G-code line count.
+
+Greedy and deterministic: from each vertex take the longest run of following vertices that
+one straight line or one circular arc passes within `tolerance` of, found by exponential
+then binary search on the run length. Arc centres are rounded the way they will be written
+(I, J to 0.001 mm from the start point) before the fit is checked, so the check holds for
+the arc GRBL will actually cut.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+LINE, CW, CCW = 1, 2, 3
+# Arcs flatter than this are written as lines: the line already fits, and huge I/J words
+# would waste characters and GRBL's arc radius check precision.
+MAX_RADIUS = 2000.0
+# Stay clear of full circles: GRBL reads an arc whose end meets its start as a full turn.
+MAX_SWEEP = 1.5 * np.pi
+# GRBL rejects arcs whose start and end radii differ by more than 0.005 mm (error:33).
+_RADIUS_MISMATCH = 0.002
+
+
+def _line_fits(p: np.ndarray, tolerance: float) -> bool:
+    a, b = p[0], p[-1]
+    d = b - a
+    length2 = float(d @ d)
+    if length2 == 0.0:
+        return False
+    t = np.clip(((p - a) @ d) / length2, 0.0, 1.0)
+    err = np.linalg.norm(p - (a + t[:, None] * d), axis=1)
+    return bool(err.max() <= tolerance)
+
+
+def _arc_fits(p: np.ndarray, tolerance: float, quantum: float) -> tuple[np.ndarray, int] | None:
+    """Centre (2,) and direction (CW/CCW) of an arc through p[0], p[-1] within tolerance."""
+    a, m, b = p[0], p[len(p) // 2], p[-1]
+    ab, am = b - a, m - a
+    cross = ab[0] * am[1] - ab[1] * am[0]
+    if abs(cross) < 1e-12:
+        return None
+    # circumcentre of a, m, b
+    bb, mm = ab @ ab, am @ am
+    ux = (am[1] * bb - ab[1] * mm) / (2 * cross)
+    uy = (ab[0] * mm - am[0] * bb) / (2 * cross)
+    offset = np.round(np.array([ux, uy]) / quantum) * quantum
+    centre = a + offset
+    radius = float(np.hypot(*offset))
+    if radius > MAX_RADIUS or radius == 0.0:
+        return None
+    if abs(float(np.hypot(*(b - centre))) - radius) > _RADIUS_MISMATCH:
+        return None
+    rel = p - centre
+    if np.abs(np.hypot(rel[:, 0], rel[:, 1]) - radius).max() > tolerance:
+        return None
+    angles = np.unwrap(np.arctan2(rel[:, 1], rel[:, 0]))
+    steps = np.diff(angles)
+    # the points must advance monotonically around the centre, all one way
+    direction = CCW if cross < 0 else CW
+    sign = 1.0 if direction == CCW else -1.0
+    if np.any(steps * sign <= 0) or abs(angles[-1] - angles[0]) > MAX_SWEEP:
+        return None
+    # chords between consecutive points may cut inside the circle: bound their sagitta
+    chord = np.hypot(*np.diff(p, axis=0).T).max()
+    if chord * chord / (8 * radius) + np.abs(np.hypot(rel[:, 0], rel[:, 1]) - radius).max() > tolerance:
+        return None
+    return centre, direction
+
+
+def fit_arcs(points: np.ndarray, tolerance: float, *, quantum: float = 0.001
+             ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Lines and arcs through a subset of `points` that pass within `tolerance` of all.
+
+    points: (N, 2) dense polyline, mm, machine frame (+y up, so G2 = clockwise).
+    Returns vertices (M, 2) (a subset of points, first and last kept), kinds (M-1,) int8
+    (1 line, 2 clockwise arc, 3 counter-clockwise arc) and centres (M-1, 2) (NaN for lines).
+    """
+    p = np.asarray(points, dtype=float)
+    n = len(p)
+    keep = [0]
+    kinds: list[int] = []
+    centres: list[tuple[float, float]] = []
+
+    def fit(i: int, j: int):
+        if j - i == 1:
+            return LINE, None
+        run = p[i:j + 1]
+        if _line_fits(run, tolerance):
+            return LINE, None
+        arc = _arc_fits(run, tolerance, quantum)
+        if arc is None:
+            return None
+        return arc[1], arc[0]
+
+    i = 0
+    while i < n - 1:
+        good_j, good = i + 1, fit(i, i + 1)
+        step = 2
+        bad_j = None
+        while True:
+            j = i + step
+            if j >= n - 1:
+                j = n - 1
+            result = fit(i, j) if j > good_j else None
+            if result is None:
+                bad_j = j if j > good_j else None
+                break
+            good_j, good = j, result
+            if j == n - 1:
+                break
+            step *= 2
+        if bad_j is not None:
+            lo, hi = good_j, bad_j
+            while hi - lo > 1:
+                mid = (lo + hi) // 2
+                result = fit(i, mid)
+                if result is None:
+                    hi = mid
+                else:
+                    lo, good = mid, result
+            good_j = lo
+        kind, centre = good
+        keep.append(good_j)
+        kinds.append(kind)
+        centres.append((np.nan, np.nan) if centre is None else (float(centre[0]), float(centre[1])))
+        i = good_j
+    return p[keep], np.array(kinds, dtype=np.int8), np.array(centres, dtype=float).reshape(-1, 2)

@@ -1,0 +1,121 @@
+"""G-code for GRBL 1.1 in laser mode, written from a planned `Toolpath`.
+
+Program shape (see docs/laser.md): comment lines, `G21`, `G90`, `M4S0` once (dynamic power:
+the beam scales with speed and is off when still), `M8` if air assist; per stroke a `G0` to
+its start, then `G1`/`G2`/`G3` moves with `S` and `F` on the first; `M5`, `M9` at the end,
+then an optional `G0X0Y0`. No M3/M4/M5/M8 between strokes: each of them makes GRBL drain
+its planner to a full stop. Numbers carry at most 3 decimals without trailing zeros, words
+are not separated by spaces (they waste GRBL's 128-byte receive buffer), lines end in `\\n`.
+"""
+
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass
+
+import numpy as np
+
+from fabrication.laser.arcs import LINE
+from fabrication.laser.toolpath import BurnPath, Toolpath
+from machines.laser_profile import LaserProfile
+from onestroke.atomic import atomic_write_text
+from onestroke.errors import InputError
+
+MAX_LINE = 80  # GRBL's line buffer; longer lines get error:11
+
+
+@dataclass(frozen=True, kw_only=True)
+class GcodeOptions:
+    """feed: burn speed, mm/min. power: fraction (0..1] of the profile's max S ($30).
+    passes: times the job is burned; even passes run the job backwards so each pass starts
+    where the last ended. return_home: end with G0X0Y0. air_assist: None uses the
+    profile's setting. dynamic: M4 (True, even burn through corners) or M3 constant power.
+    """
+
+    feed: float = 1500.0
+    power: float = 0.6
+    passes: int = 1
+    return_home: bool = False
+    air_assist: bool | None = None
+    dynamic: bool = True
+
+    def __post_init__(self) -> None:
+        if not (isinstance(self.feed, (int, float)) and self.feed > 0 and np.isfinite(self.feed)):
+            raise InputError(f"feed {self.feed!r} mm/min must be greater than 0")
+        if not (0.0 < self.power <= 1.0):
+            raise InputError(f"power {self.power * 100:g}% must be above 0% and at most 100%")
+        if isinstance(self.passes, bool) or not isinstance(self.passes, int) or self.passes < 1:
+            raise InputError(f"passes {self.passes!r} must be a whole number >= 1")
+
+
+def fmt(value: float) -> str:
+    """A compact G-code number: 3 decimals at most, no trailing zeros, no '-0'."""
+    text = ("%.3f" % value).rstrip("0").rstrip(".")
+    return "0" if text == "-0" else text
+
+
+def _fmt_many(values: np.ndarray) -> list[str]:
+    out = [("%.3f" % v).rstrip("0").rstrip(".") for v in values.tolist()]
+    return ["0" if s == "-0" else s for s in out] if "-0" in out else out
+
+
+def _path_lines(path: BurnPath, position: tuple[str, str], first_words: str) -> tuple[list[str], tuple[str, str]]:
+    """Lines that move from `position` (formatted x, y) to the path and burn it."""
+    xs, ys = _fmt_many(path.points[:, 0]), _fmt_many(path.points[:, 1])
+    lines = []
+    px, py = position
+    if (xs[0], ys[0]) != (px, py):
+        lines.append("G0" + ("X" + xs[0] if xs[0] != px else "") + ("Y" + ys[0] if ys[0] != py else ""))
+    arc = path.kinds != LINE
+    if arc.any():
+        offsets = path.centres - path.points[:-1]
+        i_words, j_words = _fmt_many(np.nan_to_num(offsets[:, 0])), _fmt_many(np.nan_to_num(offsets[:, 1]))
+    kinds = path.kinds.tolist()
+    for k in range(len(kinds)):
+        x, y, kind = xs[k + 1], ys[k + 1], kinds[k]
+        words = "G%d" % kind
+        # an axis word is left out when its value does not change (GRBL keeps it modal)
+        if x != xs[k]:
+            words += "X" + x
+        if y != ys[k]:
+            words += "Y" + y
+        if kind != LINE:
+            # GRBL needs at least one of I, J; zero offsets are left out
+            words += ("I" + i_words[k] if i_words[k] != "0" else "") + ("J" + j_words[k] if j_words[k] != "0" or i_words[k] == "0" else "")
+        if k == 0:
+            words += first_words
+        lines.append(words)
+    return lines, (xs[-1], ys[-1])
+
+
+def gcode_lines(toolpath: Toolpath, profile: LaserProfile, options: GcodeOptions = GcodeOptions(), *,
+                comments: tuple[str, ...] = ()) -> list[str]:
+    """The whole program as lines without line endings (each <= 80 characters)."""
+    air = profile.air_assist if options.air_assist is None else options.air_assist
+    s_value = fmt(options.power * profile.max_power)
+    first_words = f"S{s_value}F{fmt(options.feed)}"
+    lines = ["; " + c[:MAX_LINE - 2].rstrip() for c in comments]
+    lines += ["G21", "G90", "M4S0" if options.dynamic else "M3S0"]
+    if air:
+        lines.append("M8")
+    position = ("0", "0")  # GRBL's position is unknown here; a G0 to the start always follows
+    position = ("", "")
+    for index in range(options.passes):
+        paths = toolpath.paths if index % 2 == 0 else tuple(p.reversed() for p in toolpath.paths[::-1])
+        for path in paths:
+            more, position = _path_lines(path, position, first_words)
+            lines.extend(more)
+    lines += ["M5", "M9"]
+    if options.return_home and position != ("0", "0"):
+        lines.append("G0X0Y0")
+    return lines
+
+
+def gcode_text(lines: list[str]) -> str:
+    """Lines joined with `\\n` endings (never `\\r\\n`: GRBL would answer twice)."""
+    return "\n".join(lines) + "\n"
+
+
+def write_gcode(path: str | os.PathLike, lines: list[str]) -> None:
+    """Write the program atomically."""
+    atomic_write_text(path, gcode_text(lines))

@@ -1,0 +1,172 @@
+"""Laser machine profiles: GRBL 1.1 settings as TOML data with unit strings.
+
+A profile holds what the planner, the G-code writer and the time estimate need to know
+about one machine: bed size, max S (`$30`), laser mode (`$32`), per-axis max rates and
+accelerations (`$110/$111/$120/$121`), junction deviation (`$11`), arc tolerance (`$12`),
+steps per mm (`$100/$101`), the serial RX buffer and the planner's block count. The
+format is documented in docs/laser.md; `profiles/laser-default.toml` is the default.
+"""
+
+from __future__ import annotations
+
+import os
+import re
+import tomllib
+from dataclasses import dataclass
+from pathlib import Path
+
+from onestroke.errors import InputError
+from onestroke.units import parse_length, parse_positive_length, parse_size_pair, parse_speed
+
+DEFAULT_PROFILE_PATH = Path(__file__).with_name("profiles") / "laser-default.toml"
+
+_ACCEL = re.compile(r"^\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*(?:(mm|in|m)\s*/\s*(s|sec|min)\s*(?:\^?\s*2|²))?\s*$")
+
+
+@dataclass(frozen=True, kw_only=True)
+class LaserProfile:
+    """One GRBL laser machine. Lengths in mm, rates in mm/min, accelerations in mm/s².
+
+    The bed spans [0, bed_width] x [0, bed_height] in machine coordinates (+y up).
+    """
+
+    name: str = "GRBL laser"
+    bed_width: float = 400.0
+    bed_height: float = 400.0
+    max_power: float = 1000.0
+    laser_mode: bool = True
+    air_assist: bool = False
+    max_rate_x: float = 6000.0
+    max_rate_y: float = 6000.0
+    acceleration_x: float = 500.0
+    acceleration_y: float = 500.0
+    junction_deviation: float = 0.01
+    arc_tolerance: float = 0.002
+    steps_per_mm_x: float = 80.0
+    steps_per_mm_y: float = 80.0
+    rx_buffer: int = 128
+    planner_blocks: int = 15
+
+    def __post_init__(self) -> None:
+        for name in ("bed_width", "bed_height", "max_power", "max_rate_x", "max_rate_y",
+                     "acceleration_x", "acceleration_y", "junction_deviation", "arc_tolerance",
+                     "steps_per_mm_x", "steps_per_mm_y"):
+            value = getattr(self, name)
+            if not (isinstance(value, (int, float)) and value > 0 and value < float("inf")):
+                raise InputError(f"laser profile {self.name!r}: {name} {value!r} must be a positive number")
+        if not (isinstance(self.rx_buffer, int) and self.rx_buffer >= 16):
+            raise InputError(f"laser profile {self.name!r}: rx_buffer {self.rx_buffer!r} must be an integer >= 16")
+        if not (isinstance(self.planner_blocks, int) and 2 <= self.planner_blocks <= 1000):
+            raise InputError(f"laser profile {self.name!r}: planner_blocks {self.planner_blocks!r} "
+                             "must be an integer in 2..1000")
+
+    @property
+    def rapid_rate(self) -> float:
+        """The slower axis' max rate, mm/min (a safe single figure for travel speed)."""
+        return min(self.max_rate_x, self.max_rate_y)
+
+
+def parse_acceleration(text: str | float, *, what: str = "acceleration") -> float:
+    """Return mm/s² from "500mm/s^2", "500 mm/s²", "1800000mm/min^2" or a bare number (mm/s²)."""
+    if isinstance(text, (int, float)) and not isinstance(text, bool):
+        return float(text)
+    match = _ACCEL.match(str(text))
+    if not match:
+        raise InputError(f"{what} {text!r} is not an acceleration; use e.g. '500mm/s^2'")
+    value = float(match.group(1))
+    unit = {"mm": 1.0, "in": 25.4, "m": 1000.0}[match.group(2) or "mm"]
+    per = match.group(3) or "s"
+    return value * unit / (3600.0 if per == "min" else 1.0)
+
+
+def _number(value, what: str) -> float:
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        raise InputError(f"{what} {value!r} must be a number")
+    return float(value)
+
+
+def _flag(value, what: str) -> bool:
+    if not isinstance(value, bool):
+        raise InputError(f"{what} {value!r} must be true or false")
+    return value
+
+
+def _integer(value, what: str) -> int:
+    if isinstance(value, bool) or not isinstance(value, int):
+        raise InputError(f"{what} {value!r} must be a whole number")
+    return value
+
+
+# key in the TOML table -> (profile field, converter)
+_FIELDS = {
+    "laser": {
+        "max_power": ("max_power", _number),
+        "laser_mode": ("laser_mode", _flag),
+        "air_assist": ("air_assist", _flag),
+    },
+    "motion": {
+        "max_rate_x": ("max_rate_x", lambda v, w: parse_speed(v, what=w)),
+        "max_rate_y": ("max_rate_y", lambda v, w: parse_speed(v, what=w)),
+        "acceleration_x": ("acceleration_x", lambda v, w: parse_acceleration(v, what=w)),
+        "acceleration_y": ("acceleration_y", lambda v, w: parse_acceleration(v, what=w)),
+        "junction_deviation": ("junction_deviation", lambda v, w: parse_positive_length(v, what=w)),
+        "arc_tolerance": ("arc_tolerance", lambda v, w: parse_positive_length(v, what=w)),
+        "steps_per_mm_x": ("steps_per_mm_x", _number),
+        "steps_per_mm_y": ("steps_per_mm_y", _number),
+    },
+    "controller": {
+        "rx_buffer": ("rx_buffer", _integer),
+        "planner_blocks": ("planner_blocks", _integer),
+    },
+}
+
+
+def laser_profile_from_dict(data: dict, *, source: str = "profile") -> LaserProfile:
+    """Build a `LaserProfile` from the parsed TOML tables (see docs/laser.md)."""
+    known_tables = {"name", "bed", *_FIELDS}
+    unknown = sorted(set(data) - known_tables)
+    if unknown:
+        raise InputError(f"{source}: unknown key(s) {', '.join(unknown)}; "
+                         f"use name, bed, laser, motion, controller")
+    values: dict = {}
+    if "name" in data:
+        values["name"] = str(data["name"])
+    bed = data.get("bed", {})
+    if not isinstance(bed, dict):
+        raise InputError(f"{source}: [bed] must be a table")
+    for key in bed:
+        if key not in ("size", "width", "height"):
+            raise InputError(f"{source}: unknown key bed.{key}; use size, or width and height")
+    if "size" in bed:
+        values["bed_width"], values["bed_height"] = parse_size_pair(str(bed["size"]), what=f"{source}: bed.size")
+    if "width" in bed:
+        values["bed_width"] = parse_positive_length(bed["width"], what=f"{source}: bed.width")
+    if "height" in bed:
+        values["bed_height"] = parse_positive_length(bed["height"], what=f"{source}: bed.height")
+    for table, fields in _FIELDS.items():
+        section = data.get(table, {})
+        if not isinstance(section, dict):
+            raise InputError(f"{source}: [{table}] must be a table")
+        for key, value in section.items():
+            if key not in fields:
+                raise InputError(f"{source}: unknown key {table}.{key}; use {', '.join(fields)}")
+            field_name, convert = fields[key]
+            values[field_name] = convert(value, f"{source}: {table}.{key}")
+    return LaserProfile(**values)
+
+
+def load_laser_profile(path: str | os.PathLike | None = None) -> LaserProfile:
+    """Read a laser profile TOML file; `None` gives the shipped default profile."""
+    path = Path(path) if path is not None else DEFAULT_PROFILE_PATH
+    try:
+        with open(path, "rb") as handle:
+            data = tomllib.load(handle)
+    except FileNotFoundError:
+        raise InputError(f"laser profile {str(path)!r} does not exist") from None
+    except IsADirectoryError:
+        raise InputError(f"laser profile {str(path)!r} is a directory, not a TOML file") from None
+    except tomllib.TOMLDecodeError as error:
+        raise InputError(f"laser profile {str(path)!r} is not valid TOML: {error}") from None
+    except (OSError, UnicodeDecodeError) as error:
+        raise InputError(f"cannot read laser profile {str(path)!r}: {error}") from None
+    return laser_profile_from_dict(data, source=f"laser profile {path.name!r}")
