@@ -39,7 +39,9 @@ def main() -> None:
 
 def _register() -> None:
     # One import and one add_command per command module; each module owns its command.
-    pass
+    from fabrication.cli.vectorize_cmd import vectorize
+
+    main.add_command(vectorize)
 
 
 _register()
