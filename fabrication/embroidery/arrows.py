@@ -1,0 +1,106 @@
+"""Arrow motifs along the curve (paper Fig. 13 right): chevrons pointing the way it is drawn.
+
+A centre walk (running stitch) carries the thread along the curve; at every `spacing` of
+arc length it stops on a tip and sews a chevron: out to the left arm, back to the tip,
+out to the right arm, back to the tip, then walks on. Tips sit on a grid of arc length
+counted over the whole drawing (`offset`), so the motifs never start over at a stroke
+boundary. Motifs shrink where the curve under them is tight, and shrink or drop out
+before a corner or the start of a stroke instead of reaching across it.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from fabrication.embroidery.needles import BODY, MOTIF, NeedlePoints
+from fabrication.embroidery.running import (DENSE_TOLERANCE, RunningOptions, refine_to_tolerance,
+                                            stitch_lengths_along)
+from fabrication.embroidery.needles import SNAP_ALLOWANCE
+from fabrication.embroidery.sampling import dense_curve
+from onestroke.errors import InputError
+from vectorize.stroke import Stroke
+
+
+@dataclass(frozen=True, kw_only=True)
+class ArrowOptions:
+    """size: arm length along the curve, mm; width: tip-to-tip spread of the arms, mm;
+    spacing: arc length between tips, mm; stitch_length / tolerance / corner_angle: the
+    centre walk; min_scale: smallest motif (fraction of full size) before one is dropped;
+    tight_radius: motifs shrink where the curve radius under them is below
+    tight_radius x size."""
+
+    size: float = 2.0
+    width: float = 2.5
+    spacing: float = 5.0
+    stitch_length: float = 2.5
+    tolerance: float = 0.2
+    corner_angle: float = 45.0
+    min_scale: float = 0.4
+    tight_radius: float = 1.5
+
+    def __post_init__(self) -> None:
+        for name in ("size", "width", "spacing"):
+            if not getattr(self, name) > 0:
+                raise InputError(f"arrow {name} {getattr(self, name):g} mm must be greater than zero")
+        if not self.spacing > self.size:
+            raise InputError(f"arrow spacing {self.spacing:g} mm must exceed the arrow size "
+                             f"{self.size:g} mm, or the motifs overlap")
+        if not 0 < self.min_scale <= 1:
+            raise InputError(f"arrow min_scale {self.min_scale:g} must lie in (0, 1]")
+        self.running  # validates the centre walk
+
+    @property
+    def running(self) -> RunningOptions:
+        return RunningOptions(stitch_length=self.stitch_length, tolerance=self.tolerance,
+                              corner_angle=self.corner_angle)
+
+
+def arrow_stitch(stroke: Stroke, options: ArrowOptions = ArrowOptions(), *,
+                 offset: float = 0.0) -> NeedlePoints:
+    """Chevrons along `stroke` (mm). `offset`: arc length of the drawing sewn before this
+    stroke, which keeps the motif rhythm continuous from stroke to stroke."""
+    curve = dense_curve(stroke, DENSE_TOLERANCE)
+    length = curve.length
+    # Tips on the global grid size + k * spacing, in this stroke's arc length.
+    first = options.size - offset
+    k0 = int(np.ceil((0.0 - first) / options.spacing - 1e-9))
+    tips = first + options.spacing * np.arange(k0, k0 + int(length // options.spacing) + 2)
+    tips = tips[(tips > 0) & (tips <= length)]
+    # Tight curves: the smallest radius over each motif's reach scales it down.
+    corner = np.abs(curve.turns) > np.radians(options.corner_angle)
+    radius = 1.0 / np.maximum(np.abs(curve.curvature), 1e-12)
+    reach_lo = np.searchsorted(curve.s, tips - options.size)
+    reach_hi = np.searchsorted(curve.s, tips, side="right")
+    scale = np.ones(len(tips))
+    barrier = np.concatenate([[0.0], curve.s[corner]])  # stroke start and corners
+    for i, (lo, hi) in enumerate(zip(reach_lo, reach_hi)):
+        # Python loop over motifs only (one per `spacing`, a few hundred at most per stroke).
+        r = radius[lo:hi][~corner[lo:hi]].min(initial=np.inf)
+        scale[i] = min(1.0, r / (options.tight_radius * options.size))
+        before = barrier[barrier < tips[i] - 1e-9]
+        room = (tips[i] - before.max()) / options.size if len(before) else np.inf
+        scale[i] = min(scale[i], room)
+    ok = scale >= options.min_scale
+    tips, scale = tips[ok], scale[ok]
+
+    s = stitch_lengths_along(curve, options.running, breaks=tips)
+    s, t = refine_to_tolerance(stroke, curve, s, options.tolerance - SNAP_ALLOWANCE)
+    walk = NeedlePoints.of(stroke.points_at(t), t, BODY)
+    if not len(tips):
+        return walk
+    tip_index = np.searchsorted(s, tips - 1e-9)
+    base_t = curve.t_at(tips - options.size * scale)
+    tip_t = curve.t_at(tips)
+    base = stroke.points_at(base_t)
+    tangent = stroke.tangents_at(base_t)
+    normal = np.column_stack([-tangent[:, 1], tangent[:, 0]])
+    half = (options.width / 2.0 * scale)[:, None]
+    tip = walk.points[tip_index]
+    motif = np.stack([base + normal * half, tip, base - normal * half, tip], axis=1)
+    motif_t = np.stack([base_t, tip_t, base_t, tip_t], axis=1)
+    where = np.repeat(tip_index + 1, 4)
+    return NeedlePoints(np.insert(walk.points, where, motif.reshape(-1, 2), axis=0),
+                        np.insert(walk.t, where, motif_t.ravel()),
+                        np.insert(walk.roles, where, np.full(where.size, MOTIF, dtype=np.uint8)))

@@ -1,0 +1,63 @@
+"""Tack and lock stitches: a few tiny stitches back and forth over the thread just sewn.
+
+A lock walks back along the needle path from its end by fractions of a lock length and
+returns (Ink/Stitch's "half stitch": 0.5, 1, 0.5, 0 of min(path, 1.5 mm)); a tack is the
+same figure at the start, sewn forward along the path before the path itself. We make
+them ourselves: pyembroidery's `tie_off` emits zero-length stitches and nothing useful.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from onestroke.errors import InputError
+
+# Positions of the lock's needle points, as fractions of the lock length back from the
+# end of the path. Consecutive entries differ, so no lock stitch has zero length.
+LOCK_FORMS: dict[str, tuple[float, ...]] = {
+    "half": (0.5, 1.0, 0.5, 0.0),
+    "back_forth": (1.0, 0.0, 1.0, 0.0),
+}
+
+
+@dataclass(frozen=True, kw_only=True)
+class LockOptions:
+    """form: a key of LOCK_FORMS; length: how far back along the path a lock reaches, mm."""
+
+    form: str = "half"
+    length: float = 1.5
+
+    def __post_init__(self) -> None:
+        if self.form not in LOCK_FORMS:
+            raise InputError(f"unknown lock form {self.form!r}; use one of {', '.join(LOCK_FORMS)}")
+        if not self.length > 0:
+            raise InputError(f"lock length {self.length:g} mm must be greater than zero")
+
+
+def walk_back(path: np.ndarray, distances: np.ndarray) -> np.ndarray:
+    """Points at arc `distances` (m,) mm back from the last point of polyline `path` (N, 2)."""
+    rev = path[::-1]
+    cum = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(rev, axis=0), axis=1))])
+    d = np.clip(distances, 0.0, cum[-1])
+    return np.column_stack([np.interp(d, cum, rev[:, 0]), np.interp(d, cum, rev[:, 1])])
+
+
+def _lock_length(path: np.ndarray, options: LockOptions) -> float:
+    total = float(np.linalg.norm(np.diff(path, axis=0), axis=1).sum())
+    return min(options.length, total)
+
+
+def lock_points(path: np.ndarray, options: LockOptions = LockOptions()) -> np.ndarray:
+    """Needle points (4, 2) to sew after `path` (N, 2) ends; the last one is its end."""
+    length = _lock_length(path, options)
+    return walk_back(path, length * np.asarray(LOCK_FORMS[options.form]))
+
+
+def tack_points(path: np.ndarray, options: LockOptions = LockOptions()) -> np.ndarray:
+    """Needle points (4, 2) to sew before `path` (N, 2) begins: its start, then the lock
+    figure forward along it; the path then continues from its own start."""
+    length = _lock_length(path, options)
+    form = np.asarray(LOCK_FORMS[options.form])
+    return np.vstack([path[:1], walk_back(path[::-1], length * form[:-1])])

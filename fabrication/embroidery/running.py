@@ -1,0 +1,109 @@
+"""Running stitch: needle points along the curve, within a chord tolerance, on every corner.
+
+Ink/Stitch's rules: target stitch length (2.5 mm), no stitch chord leaves a band of
+`tolerance` (0.2 mm) around the curve (tight curves get shorter stitches, never looser
+ones), a needle point on every turn sharper than `corner_angle`, and equal stitches
+within each piece between corners.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from fabrication.embroidery.needles import BODY, SNAP_ALLOWANCE, NeedlePoints
+from fabrication.embroidery.sampling import DenseCurve, dense_curve
+from onestroke.errors import InputError
+from vectorize.stroke import Stroke
+
+# Dense sampling tolerance (mm): small against every stitch tolerance we accept.
+DENSE_TOLERANCE = 0.004
+
+
+@dataclass(frozen=True, kw_only=True)
+class RunningOptions:
+    """stitch_length: target stitch in mm; tolerance: largest chord-to-curve distance in mm;
+    corner_angle: turns sharper than this (degrees) always get a needle point."""
+
+    stitch_length: float = 2.5
+    tolerance: float = 0.2
+    corner_angle: float = 45.0
+
+    def __post_init__(self) -> None:
+        if not self.stitch_length > 0:
+            raise InputError(f"stitch length {self.stitch_length:g} mm must be greater than zero")
+        if not self.tolerance >= 0.1:
+            raise InputError(f"chord tolerance {self.tolerance:g} mm must be at least 0.1 mm "
+                             "(the files store 0.1 mm steps)")
+        if not 0 < self.corner_angle < 180:
+            raise InputError(f"corner angle {self.corner_angle:g} must lie between 0 and 180 degrees")
+
+
+def chord_deviation(curve: DenseCurve, s_stitch: np.ndarray, points: np.ndarray) -> np.ndarray:
+    """Largest distance (mm) from the curve to each stitch chord: (n - 1,) for n needle
+    points at arc lengths `s_stitch` (increasing) with positions `points` (n, 2)."""
+    n = len(s_stitch)
+    dev = np.zeros(max(n - 1, 0))
+    if n < 2:
+        return dev
+    k = np.clip(np.searchsorted(s_stitch, curve.s, side="right") - 1, 0, n - 2)
+    a, b = points[k], points[k + 1]
+    ab = b - a
+    ap = curve.points - a
+    denom = np.einsum("ij,ij->i", ab, ab)
+    u = np.clip(np.divide(np.einsum("ij,ij->i", ap, ab), denom, out=np.zeros(len(k)), where=denom > 0), 0, 1)
+    d = np.linalg.norm(ap - u[:, None] * ab, axis=1)
+    np.maximum.at(dev, k, d)
+    return dev
+
+
+def stitch_lengths_along(curve: DenseCurve, options: RunningOptions, *,
+                         breaks: np.ndarray | None = None) -> np.ndarray:
+    """Arc lengths (n,) of the needle points of a running stitch on `curve`, start and end
+    included. `breaks` (arc lengths) are extra points every stitch must meet, like corners."""
+    s = curve.s
+    tol = options.tolerance - SNAP_ALLOWANCE
+    corner = np.abs(curve.turns) > np.radians(options.corner_angle)
+    kappa = np.abs(curve.curvature)
+    kappa[corner] = 0.0  # a corner is a kink, not a tight curve: it gets its own point
+    # A chord c on radius R strays c^2 / (8 R) from the arc: the longest allowed chord.
+    allowed = np.minimum(options.stitch_length, np.sqrt(8.0 * tol / np.maximum(kappa, 1e-12)))
+    per_piece = np.minimum(allowed[:-1], allowed[1:])
+    # u counts stitches: equal steps in u are equal stitches where the curvature is even.
+    u = np.concatenate([[0.0], np.cumsum(np.diff(s) / per_piece)])
+    cuts = [[0.0, curve.length], s[corner]]
+    if breaks is not None and len(breaks):
+        cuts.append(np.clip(np.asarray(breaks, dtype=float), 0.0, curve.length))
+    cut_s = np.unique(np.concatenate(cuts))
+    cut_u = np.interp(cut_s, s, u)
+    du = np.diff(cut_u)
+    n = np.maximum(1, np.ceil(du - 1e-9)).astype(int)
+    piece = np.repeat(np.arange(len(n)), n)
+    k = np.arange(n.sum()) - np.repeat(np.cumsum(n) - n, n)
+    s_out = np.interp(cut_u[piece] + du[piece] * k / n[piece], u, s)
+    s_out[k == 0] = cut_s[:-1]  # exact corners and breaks, not a round trip through u
+    return np.append(s_out, curve.length)
+
+
+def refine_to_tolerance(stroke: Stroke, curve: DenseCurve, s_points: np.ndarray,
+                        tolerance: float, *, rounds: int = 12) -> tuple[np.ndarray, np.ndarray]:
+    """Split every stitch whose chord strays more than `tolerance` from the curve (measured).
+    Returns (s (n,), t (n,))."""
+    for _ in range(rounds):
+        t = curve.t_at(s_points)
+        dev = chord_deviation(curve, s_points, stroke.points_at(t))
+        bad = dev > tolerance
+        if not bad.any():
+            return s_points, t
+        s_points = np.sort(np.concatenate([s_points, 0.5 * (s_points[:-1][bad] + s_points[1:][bad])]))
+    return s_points, curve.t_at(s_points)
+
+
+def running_stitch(stroke: Stroke, options: RunningOptions = RunningOptions(), *,
+                   curve: DenseCurve | None = None, breaks: np.ndarray | None = None) -> NeedlePoints:
+    """Running stitch along `stroke` (mm). Returns needle points, start and end included."""
+    curve = curve if curve is not None else dense_curve(stroke, DENSE_TOLERANCE)
+    s = stitch_lengths_along(curve, options, breaks=breaks)
+    s, t = refine_to_tolerance(stroke, curve, s, options.tolerance - SNAP_ALLOWANCE)
+    return NeedlePoints.of(stroke.points_at(t), t, BODY)

@@ -1,0 +1,156 @@
+"""Zigzag across the curve (paper Fig. 13 middle): needle points alternate side to side.
+
+Centre points every spacing/2 along the curve (an even number of them), each pushed
+perpendicular to the local direction by width/2 + pull_compensation/2, alternating sides.
+On tight inner curves the inside points crowd: every other inner point is inset
+(Ink/Stitch's short stitches), the inside reach is capped below the curve radius, and a
+rail point still closer than `min_gap` to the previous one on its rail is dropped (the
+outside fans round a shared inner point). Wide zigzags get a centre-walk underlay sewn
+there and back first, and zigs longer than `max_stitch` are split at staggered points.
+"""
+
+from __future__ import annotations
+
+import heapq
+from dataclasses import dataclass
+
+import numpy as np
+
+from fabrication.embroidery.needles import BODY, SNAP_ALLOWANCE, UNDERLAY, NeedlePoints
+from fabrication.embroidery.running import DENSE_TOLERANCE, RunningOptions, running_stitch
+from fabrication.embroidery.sampling import dense_curve
+from onestroke.errors import InputError
+from vectorize.stroke import Stroke
+
+# The inside reach stays below this fraction of the curve radius, so inner points never
+# pass the centre of curvature (they would sew loops and run backwards).
+MAX_INNER_REACH = 0.75
+
+
+@dataclass(frozen=True, kw_only=True)
+class ZigzagOptions:
+    """width: rail to rail in mm; spacing: peak to peak along the curve in mm;
+    pull_compensation: mm added to the width (half per side) since the thread pulls the
+    fabric in; underlay: None = centre walk when width > underlay_min_width;
+    short_stitch_distance / short_stitch_inset: inset every other inner point by this
+    fraction of the reach where inner points come closer than that distance; min_gap: the
+    closest two needle points may come on one rail (0.25 mm keeps them >= 0.1 mm apart
+    after snapping to the files' 0.1 mm grid); max_stitch: longer zigs are split."""
+
+    width: float = 2.0
+    spacing: float = 0.4
+    pull_compensation: float = 0.2
+    underlay: bool | None = None
+    underlay_min_width: float = 1.5
+    underlay_stitch_length: float = 2.0
+    short_stitch_distance: float = 0.25
+    short_stitch_inset: float = 0.15
+    min_gap: float = 0.25
+    max_stitch: float = 12.1
+    tolerance: float = 0.2
+
+    def __post_init__(self) -> None:
+        if not self.width > 0:
+            raise InputError(f"zigzag width {self.width:g} mm must be greater than zero")
+        if not self.spacing >= 0.1:
+            raise InputError(f"zigzag spacing {self.spacing:g} mm must be at least 0.1 mm")
+        if not self.pull_compensation >= 0:
+            raise InputError(f"pull compensation {self.pull_compensation:g} mm must be >= 0")
+        if not 0 <= self.short_stitch_inset < 1:
+            raise InputError(f"short-stitch inset {self.short_stitch_inset:g} must lie in [0, 1)")
+        if not self.max_stitch > 1.0:
+            raise InputError(f"max stitch {self.max_stitch:g} mm must be over 1 mm")
+        RunningOptions(stitch_length=self.underlay_stitch_length, tolerance=self.tolerance)
+
+    @property
+    def reach(self) -> float:
+        """Offset of each needle point from the centre line, mm."""
+        return (self.width + self.pull_compensation) / 2.0
+
+    @property
+    def has_underlay(self) -> bool:
+        return self.width > self.underlay_min_width if self.underlay is None else bool(self.underlay)
+
+
+def _drop_crowded(points: np.ndarray, min_gap: float) -> np.ndarray:
+    """Mask of points to keep so that no point comes within `min_gap` of the previous kept
+    point on its rail (rails alternate: even and odd indices). Only crowded points and the
+    ones after a dropped point are visited one by one."""
+    keep = np.ones(len(points), dtype=bool)
+    gaps = np.full(len(points), np.inf)
+    gaps[2:] = np.linalg.norm(points[2:] - points[:-2], axis=1)
+    work = sorted(np.flatnonzero(gaps < min_gap).tolist())
+    queued = set(work)
+    while work:
+        i = heapq.heappop(work)
+        if i == len(points) - 1:
+            continue  # the end point anchors the lock
+        k = i - 2
+        while k >= 0 and not keep[k]:
+            k -= 2
+        if k >= 0 and np.hypot(*(points[i] - points[k])) < min_gap:
+            keep[i] = False
+            if i + 2 < len(points) and i + 2 not in queued:
+                queued.add(i + 2)
+                heapq.heappush(work, i + 2)
+    return keep
+
+
+def _split_long(points: np.ndarray, t: np.ndarray, max_length: float) -> tuple[np.ndarray, np.ndarray]:
+    """Split stitches longer than `max_length` into real stitches at staggered fractions so
+    that the split points of neighbouring zigs do not line up into a ridge."""
+    seg = np.diff(points, axis=0)
+    length = np.linalg.norm(seg, axis=1)
+    # Staggers up to 1/3 of a piece make the longest piece (1 + 1/3) / n of the stitch.
+    n = np.maximum(1, np.ceil(length * (4.0 / 3.0) / max_length)).astype(int)
+    n[length <= max_length] = 1
+    if n.max() == 1:
+        return points, t
+    stagger = np.array([0.0, 1.0 / 3.0, -1.0 / 3.0])[np.arange(len(n)) % 3]
+    extra = n - 1
+    owner = np.repeat(np.arange(len(n)), extra)
+    k = np.arange(extra.sum()) - np.repeat(np.cumsum(extra) - extra, extra) + 1
+    frac = (k - stagger[owner]) / n[owner]
+    new_pts = points[owner] + seg[owner] * frac[:, None]
+    new_t = t[owner] + (t[owner + 1] - t[owner]) * frac
+    # Insert after the start of each owning stitch, keeping the order along each stitch.
+    order = np.argsort(np.concatenate([np.arange(len(points)) * 1.0, owner + frac * 0.999]), kind="stable")
+    return np.concatenate([points, new_pts])[order], np.concatenate([t, new_t])[order]
+
+
+def zigzag_stitch(stroke: Stroke, options: ZigzagOptions = ZigzagOptions()) -> NeedlePoints:
+    """Zigzag along `stroke` (mm), preceded by a there-and-back centre walk when wide."""
+    curve = dense_curve(stroke, DENSE_TOLERANCE)
+    length = curve.length
+    steps = max(1, int(round(2.0 * length / options.spacing)))
+    if steps % 2 == 0:
+        steps += 1  # an even number of points: the zigzag ends on the other rail
+    s = np.linspace(0.0, length, steps + 1)
+    t = curve.t_at(s)
+    centre = stroke.points_at(t)
+    tangent = stroke.tangents_at(t)
+    normal = np.column_stack([-tangent[:, 1], tangent[:, 0]])
+    theta = np.unwrap(np.arctan2(tangent[:, 1], tangent[:, 0]))
+    kappa = np.gradient(theta, s) if len(s) > 2 else np.zeros(len(s))
+    side = np.where(np.arange(len(s)) % 2 == 0, 1.0, -1.0)
+    reach = np.full(len(s), options.reach)
+    inner = side * kappa > 0
+    radius = 1.0 / np.maximum(np.abs(kappa), 1e-12)
+    reach[inner] = np.minimum(reach[inner], MAX_INNER_REACH * radius[inner])
+    # Same-rail spacing on the inside shrinks by (1 - reach / radius).
+    rail_gap = 2.0 * (length / steps) * (1.0 - reach * np.abs(kappa))
+    short = inner & (rail_gap < options.short_stitch_distance) & ((np.arange(len(s)) // 2) % 2 == 1)
+    reach[short] *= 1.0 - options.short_stitch_inset
+    points = centre + normal * (side * reach)[:, None]
+    keep = _drop_crowded(points, options.min_gap)
+    points, t = points[keep], t[keep]
+    points, t = _split_long(points, t, options.max_stitch - 2 * SNAP_ALLOWANCE)
+    zig = NeedlePoints.of(points, t, BODY)
+    if not options.has_underlay:
+        return zig
+    walk = running_stitch(stroke, RunningOptions(stitch_length=options.underlay_stitch_length,
+                                                 tolerance=options.tolerance), curve=curve)
+    back = walk.take(np.arange(len(walk) - 2, -1, -1))
+    under = NeedlePoints.of(np.concatenate([walk.points, back.points]),
+                            np.concatenate([walk.t, back.t]), UNDERLAY)
+    return NeedlePoints.concat([under, zig])
