@@ -42,6 +42,9 @@ def _register() -> None:
     from fabrication.cli.vectorize_cmd import vectorize
 
     main.add_command(vectorize)
+    from fabrication.cli.laser_cmd import laser
+
+    main.add_command(laser)
 
 
 _register()

@@ -19,7 +19,7 @@ import numpy as np
 import shapely
 
 from fabrication.laser.arcs import CCW, CW, LINE, fit_arcs
-from fabrication.laser.travel_order import order_strokes
+from fabrication.laser.travel_order import order_strokes, travel_length
 from fabrication.placement import PlacementOptions, place
 from machines.laser_profile import LaserProfile
 from onestroke.errors import InputError
@@ -88,6 +88,18 @@ class BurnPath:
     @property
     def length(self) -> float:
         return float(self.segment_lengths().sum())
+
+    @property
+    def is_closed(self) -> bool:
+        return len(self.points) > 2 and bool(np.all(self.points[0] == self.points[-1]))
+
+    def rotated(self, start: int) -> "BurnPath":
+        """A closed path started at vertex `start` (same loop, same direction)."""
+        if not self.is_closed or start % self.segment_count == 0:
+            return self
+        k = start % self.segment_count
+        points = np.vstack([self.points[k:-1], self.points[:k + 1]])
+        return BurnPath(points, np.roll(self.kinds, -k), np.roll(self.centres, -k, axis=0))
 
     def reversed(self) -> "BurnPath":
         """The same path burned from its end to its start."""
@@ -209,14 +221,21 @@ def plan_toolpath(drawing: Drawing, profile: LaserProfile,
         order, flipped = result.order, result.flipped
         before, greedy, after = result.before, result.greedy, result.after
     else:
-        from fabrication.laser.travel_order import travel_length
-
         order, flipped = np.arange(len(planned)), np.zeros(len(planned), dtype=bool)
         before = greedy = after = travel_length(starts, ends, np.zeros(2))
     paths, curves = [], []
+    position = np.zeros(2)
     for index, flip in zip(order.tolist(), flipped.tolist()):
         path, stroke = planned[index]
-        paths.append(path.reversed() if flip else path)
+        path = path.reversed() if flip else path
+        if options.optimize and path.is_closed:
+            # a closed loop may start at any vertex: take the one nearest the head
+            path = path.rotated(int(np.argmin(np.hypot(*(path.points - position).T))))
+        paths.append(path)
         curves.append(stroke.reversed() if flip else stroke)
+        position = path.points[-1]
+    if options.optimize:
+        after = travel_length(np.array([p.points[0] for p in paths]), np.array([p.points[-1] for p in paths]),
+                              np.zeros(2))
     return Toolpath(tuple(paths), tuple(curves), bounds, (profile.bed_width, profile.bed_height),
                     options.tolerance, before, greedy, after, dropped)
