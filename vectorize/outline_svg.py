@@ -19,7 +19,7 @@ def rasterize_rings(rings, width: float, height: float, *, size: int) -> tuple[n
     """Fill closed rings (list of (N, 2) in SVG units) even-odd into a gray image.
 
     Returns (gray (H, W) float32, 1 = paper; scale = working px per SVG unit; offset (2,)
-    = SVG position of working pixel (0, 0)). The image covers the rings' bounds plus a
+    = SVG position of the corner of working pixel (0, 0)). The image covers the rings' bounds plus a
     margin, with its longest side `size` px.
     """
     everything = np.vstack(rings)
@@ -32,7 +32,8 @@ def rasterize_rings(rings, width: float, height: float, *, size: int) -> tuple[n
     big = (shape[0] * SUPERSAMPLE, shape[1] * SUPERSAMPLE)
     ink = np.zeros(big, dtype=bool)
     for ring in rings:
-        xy = (ring - lo) * scale * SUPERSAMPLE + (SUPERSAMPLE - 1) / 2.0
+        # Big pixel p covers [p, p + 1) of the supersampled frame; its centre decides.
+        xy = (ring - lo) * scale * SUPERSAMPLE - 0.5
         rr, cc = fill_polygon(xy[:, 1], xy[:, 0], shape=big)
         ink[rr, cc] ^= True
     gray = 1.0 - downscale_local_mean(ink.astype(np.float32), (SUPERSAMPLE, SUPERSAMPLE))

@@ -9,6 +9,8 @@ because removing spurs turns junctions into degree-2 points and exposes new leav
 
 from __future__ import annotations
 
+import numpy as np
+
 from vectorize.graph import MedialGraph
 
 
@@ -57,3 +59,36 @@ def prune(graph: MedialGraph, *, threshold: float, stroke_width: float) -> int:
                 graph.remove_node(branch.b)
                 removed += 1
     return removed
+
+
+def trim_free_ends(graph: MedialGraph, *, stroke_width: float) -> None:
+    """Pull each free end back to its cap centre, in place.
+
+    The medial axis of a round stroke end ends at the centre of the cap; sampled outlines
+    let it run on towards the tip with shrinking radius, which would make the stroke
+    longer than the line drawn. Cut the end where the radius falls below 85 % of the
+    radius one stroke width further in.
+    """
+    from vectorize.graph import Branch
+
+    for node in [n for n, inc in graph.incident.items() if len(inc) == 1]:
+        bid = graph.incident[node][0]
+        branch = graph.branches[bid]
+        if branch.a == branch.b:
+            continue
+        out = branch.oriented_from(node)
+        arc = np.concatenate([[0.0], np.cumsum(out.edge_lengths)])
+        # The radius one stroke width in: past the cap, before any widening further on
+        # (a spike's two sides merge into wider ink towards its junction).
+        band = out.radii[(arc >= 0.6 * stroke_width) & (arc <= 1.4 * stroke_width)]
+        if band.size < 3:
+            continue
+        full = 0.85 * float(np.median(band))
+        first = int(np.argmax(out.radii >= full))
+        if first == 0 or arc[first] > stroke_width or first >= len(out.points) - 2:
+            continue
+        graph.remove_branch(bid)
+        graph.positions[node] = out.points[first].copy()
+        graph.radii[node] = float(out.radii[first])
+        trimmed = Branch(node, out.b, out.points[first:], out.radii[first:], out.sins[first:])
+        graph.add_branch(trimmed)

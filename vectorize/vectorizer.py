@@ -14,7 +14,7 @@ from vectorize.intersections import Junction, JunctionVerdict, make_classifier, 
 from vectorize.medial_axis import medial_axis
 from vectorize.outline import outline_rings
 from vectorize.pipeline import VectorizeOptions, VectorizeReport, VectorizeResult
-from vectorize.pruning import prune
+from vectorize.pruning import prune, trim_free_ends
 from vectorize.simplify import Simplified, directions, simplify, slots
 from vectorize.stroke import Stroke
 from vectorize.traversal import Ordering, order_strokes
@@ -81,13 +81,15 @@ def _trace(graph: MedialGraph, simple: Simplified, ordering: Ordering, junctions
     for passes, closed in zip(ordering.strokes, ordering.closed):
         traced: list[TracedPoint] = []
         for index, step in enumerate(passes):
-            branch = graph.branches[step.branch].oriented_from(
-                graph.branches[step.branch].a if step.start == "a" else graph.branches[step.branch].b)
-            points = branch.points if index == 0 else branch.points[1:]
+            branch = graph.branches[step.branch]
+            # By end, not by node: a loop starts and ends at the same node.
+            points = branch.points if step.start == "a" else branch.points[::-1]
+            far_node = branch.b if step.start == "a" else branch.a
+            points = points if index == 0 else points[1:]
             on_foot = step.branch in foot_branches
             for k, xy in enumerate(points):
                 last = k == len(points) - 1
-                tip = on_foot and last and branch.b in simple.y_tips
+                tip = on_foot and last and far_node in simple.y_tips
                 keep = (not on_foot) or tip
                 traced.append(TracedPoint(xy, keep, tip))
         xy = np.array([t.xy for t in traced])
@@ -120,6 +122,7 @@ def run_pipeline(image: np.ndarray, options: VectorizeOptions, *, frame=None) ->
     graph = medial_axis(rings, ink.gray, ink.threshold)
     clock.lap("medial axis")
     prune(graph, threshold=PRUNE_MULTI if options.multi else PRUNE_SINGLE, stroke_width=w)
+    trim_free_ends(graph, stroke_width=w)
     clock.lap("pruning")
     stages = {"ink": ink, "rings": rings, "pruned": graph.copy()} if options.keep_stages else None
     simple = simplify(graph, stroke_width=w, multi=options.multi)
@@ -140,7 +143,7 @@ def run_pipeline(image: np.ndarray, options: VectorizeOptions, *, frame=None) ->
     ordering, tried = order_strokes(graph, simple, ranked, costs, stroke_width=w, search=not options.multi)
     clock.lap("traversal")
 
-    sigma = float(np.clip(0.06 * w, 0.15, 0.6))
+    sigma = float(np.clip(0.04 * w, 0.1, 0.4))
     strokes = []
     for traced, closed in _trace(graph, simple, ordering, junctions, verdicts, w):
         if len(traced) < 2:
@@ -156,7 +159,9 @@ def run_pipeline(image: np.ndarray, options: VectorizeOptions, *, frame=None) ->
         height, width = (np.asarray(image).shape[0], np.asarray(image).shape[1])
     else:
         scale, offset, width, height = frame
-    matrix = np.array([[1 / scale, 0, offset[0]], [0, 1 / scale, offset[1]]])
+    # Working pixel centres sit at integers (scikit-image); in SVG and in the input's pixel
+    # frame pixel i covers [i, i + 1), so its centre is at i + 0.5.
+    matrix = np.array([[1 / scale, 0, offset[0] + 0.5 / scale], [0, 1 / scale, offset[1] + 0.5 / scale]])
     drawing = Drawing(tuple(s.transformed(matrix) for s in strokes), float(width), float(height), "px", w / scale)
 
     warnings = []
