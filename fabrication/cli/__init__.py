@@ -45,6 +45,12 @@ def _register() -> None:
     from fabrication.cli.laser_cmd import laser
 
     main.add_command(laser)
+    from fabrication.cli.stream_cmd import stream
+
+    main.add_command(stream)
+    from fabrication.cli.ports_cmd import ports
+
+    main.add_command(ports)
 
 
 _register()

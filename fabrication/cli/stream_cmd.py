@@ -1,0 +1,214 @@
+"""`onestroke stream FILE.gcode --port PORT`: send a G-code job to a GRBL laser, safely.
+
+Also `run_stream`, the same thing as a function, for `onestroke laser ... --port`.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import os
+import select
+import sys
+import threading
+import time
+from pathlib import Path
+
+import click
+import numpy as np
+from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
+
+from fabrication.cli.common import console, done, warn
+from machines.gcode_program import Program, analyze_program, load_program, program_from_text
+from machines.job_check import check_job
+from machines.ports import open_port
+from machines.streamer import GrblStreamer, MachineInfo, StreamProgress
+from onestroke.errors import InputError, MachineError
+
+BAUD_RATES = (9600, 19200, 38400, 57600, 115200, 230400, 250000, 500000, 1000000)
+FRAME_FEED = 3000.0  # mm/min: slow enough to follow by eye
+
+
+def _format_seconds(seconds: float) -> str:
+    seconds = max(0.0, float(seconds))
+    if seconds < 60:
+        return f"{seconds:.1f} s"
+    whole = int(round(seconds))
+    hours, rest = divmod(whole, 3600)
+    minutes, secs = divmod(rest, 60)
+    return f"{hours}:{minutes:02d}:{secs:02d}" if hours else f"{minutes}:{secs:02d}"
+
+
+def _line_seconds(path: Path, program: Program, info: MachineInfo, fallback: np.ndarray) -> np.ndarray:
+    """Cumulative planner-model seconds at the end of each program line, from the laser
+    helper's estimator when available (the same one `onestroke laser` prints), else from
+    `machines.planner_model` (what `fallback` holds)."""
+    try:
+        from fabrication.laser.job_time import estimate_gcode_time
+        from machines.laser_profile import LaserProfile
+
+        s = info.settings
+        default = LaserProfile()
+
+        def pick(number: int, value: float) -> float:
+            got = s.get(number)
+            return float(got) if got and got > 0 else value
+
+        profile = LaserProfile(
+            name="connected machine", bed_width=pick(130, default.bed_width), bed_height=pick(131, default.bed_height),
+            max_power=pick(30, default.max_power), laser_mode=bool(s.get(32, 1)),
+            max_rate_x=pick(110, default.max_rate_x), max_rate_y=pick(111, default.max_rate_y),
+            acceleration_x=pick(120, default.acceleration_x), acceleration_y=pick(121, default.acceleration_y),
+            junction_deviation=pick(11, default.junction_deviation), arc_tolerance=pick(12, default.arc_tolerance),
+            steps_per_mm_x=pick(100, default.steps_per_mm_x), steps_per_mm_y=pick(101, default.steps_per_mm_y),
+            rx_buffer=max(16, info.rx_buffer), planner_blocks=max(2, info.planner_blocks))
+        raw = path.read_text(encoding="utf-8").splitlines()
+        per_file_line = np.asarray(estimate_gcode_time(raw, profile).line_seconds, dtype=float)
+        index = np.array([number - 1 for number, _ in program.lines], dtype=int)
+        if len(per_file_line) >= len(raw) and len(index):
+            return per_file_line[index]
+    except Exception:  # noqa: BLE001 - the estimate is a nicety; never fail a job over it
+        pass
+    return fallback
+
+
+def _frame_program(stats, info: MachineInfo) -> Program:
+    """Trace the job's bounding box in machine coordinates with the beam off (M5), then go back."""
+    box = stats.burn_extent or stats.extent
+    if box is None:
+        raise InputError("the job does not move; nothing to frame")
+    (x0, y0), (x1, y1) = box
+    feed = min(FRAME_FEED, info.settings.get(110, FRAME_FEED), info.settings.get(111, FRAME_FEED))
+    px, py = info.position[0], info.position[1]
+    corners = [(x0, y0), (x1, y0), (x1, y1), (x0, y1), (x0, y0)]
+    lines = ["M5", "G21", f"G53G0X{x0:.3f}Y{y0:.3f}"]
+    lines += [f"G53G1X{x:.3f}Y{y:.3f}F{feed:.0f}" for x, y in corners[1:]]
+    lines.append(f"G53G0X{px:.3f}Y{py:.3f}")
+    return program_from_text("\n".join(lines), source="frame")
+
+
+@contextlib.contextmanager
+def _key_controls(streamer: GrblStreamer, enabled: bool):
+    """Keys while streaming on a terminal: space/p pause, r resume, +/- feed, >/< power, q abort."""
+    if not enabled:
+        yield
+        return
+    import termios
+    import tty
+
+    fd = sys.stdin.fileno()
+    saved = termios.tcgetattr(fd)
+    stop = threading.Event()
+
+    def loop() -> None:
+        actions = {" ": streamer.pause, "p": streamer.pause, "r": streamer.resume, "q": streamer.abort,
+                   "+": lambda: streamer.feed_override(10), "-": lambda: streamer.feed_override(-10),
+                   ">": lambda: streamer.power_override(10), "<": lambda: streamer.power_override(-10)}
+        while not stop.is_set():
+            ready, _, _ = select.select([fd], [], [], 0.2)
+            if ready:
+                key = os.read(fd, 1).decode("latin-1").lower()
+                if key in actions:
+                    with contextlib.suppress(MachineError):
+                        actions[key]()
+
+    tty.setcbreak(fd)  # keeps ISIG: Ctrl-C still interrupts
+    thread = threading.Thread(target=loop, name="stream-keys", daemon=True)
+    thread.start()
+    try:
+        yield
+    finally:
+        stop.set()
+        thread.join(timeout=1.0)
+        termios.tcsetattr(fd, termios.TCSADRAIN, saved)
+
+
+def run_stream(gcode_path, *, port: str, baud: int = 115200, check: bool = False, frame: bool = False,
+               profile: str | os.PathLike | None = None) -> None:
+    """Connect to `port`, check the job against the machine, stream it with a progress bar
+    and print a summary. `check` streams in GRBL's check mode ($C, nothing moves); `frame`
+    only traces the job's bounding box with the beam off. `profile`: a laser profile TOML
+    to compare with the machine's settings. Raises OnestrokeError on any failure."""
+    path = Path(gcode_path)
+    program = load_program(path)
+    if baud not in BAUD_RATES:
+        raise InputError(f"--baud {baud} is not a serial rate GRBL uses; use one of "
+                         f"{', '.join(map(str, BAUD_RATES))} (GRBL 1.1 default: 115200)")
+    laser_profile = None
+    if profile is not None:
+        from machines.laser_profile import load_laser_profile
+
+        laser_profile = load_laser_profile(profile)
+    handle = open_port(port, baud=baud)
+    time_scale = float(getattr(handle, "time_scale", 1.0))
+    with GrblStreamer(handle, name=port) as streamer:
+        console.print(f"connecting to {port} at {baud} baud ...")
+        info = streamer.connect()
+        if info.alarm:
+            raise MachineError(f"{port} is locked in ALARM (it booted or was left in alarm): home it with $H, or "
+                               "unlock it with $X if it has no homing switches, then run again")
+        stats = analyze_program(program, settings=info.settings, start=info.position, offsets=info.offsets,
+                                planner_blocks=info.planner_blocks)
+        for problem in check_job(stats, info.settings, profile=laser_profile):
+            if problem.fatal:
+                raise InputError(f"{path.name}: {problem.message}")
+            warn(problem.message)
+        if frame:
+            box = stats.burn_extent or stats.extent
+            result = streamer.stream(_frame_program(stats, info))
+            (x0, y0), (x1, y1) = box
+            done(f"framed {x1 - x0:.1f} x {y1 - y0:.1f} mm at X{x0:.1f} Y{y0:.1f} (machine) with the beam off "
+                 f"in {_format_seconds(result.elapsed)}")
+            return
+        line_seconds = _line_seconds(path, program, info, stats.line_seconds)
+        total = float(line_seconds[-1]) if len(line_seconds) else 0.0
+        sim = f" (simulated, {time_scale:g}x faster)" if time_scale != 1.0 else ""
+        console.print(f"GRBL {info.version}: RX {info.rx_buffer} B, planner {info.planner_blocks} blocks; "
+                      f"{len(program)} lines, estimated {_format_seconds(total)} of machine time{sim}"
+                      + (" - check mode, nothing moves" if check else ""))
+        columns = (TextColumn("[bold]{task.description}"), BarColumn(),
+                   TextColumn("{task.completed}/{task.total} lines"), TimeElapsedColumn(),
+                   TextColumn("ETA {task.fields[eta]}"), TextColumn("{task.fields[state]}"))
+        interactive = sys.stdin.isatty() and console.is_terminal
+        with Progress(*columns, console=console, transient=False, disable=not console.is_terminal) as bar:
+            task = bar.add_task("check" if check else "stream", total=len(program), eta="-", state="")
+            last = [0.0]
+
+            def on_progress(p: StreamProgress) -> None:
+                now = time.monotonic()
+                if now - last[0] < 0.1 and p.acked < p.total:
+                    return
+                last[0] = now
+                remaining = (total - float(line_seconds[p.acked - 1])) / time_scale if p.acked else total
+                bar.update(task, completed=p.acked, eta="-" if check else _format_seconds(remaining),
+                           state=p.state or "")
+
+            if interactive:
+                console.print("keys: space pause, r resume, +/- feed, </> power, q or Ctrl-C abort")
+            with _key_controls(streamer, interactive):
+                result = streamer.stream(program, check=check, on_progress=on_progress)
+        for message in result.warnings:
+            warn(message)
+        if check:
+            if result.check_errors:
+                line, text = result.check_errors[0]
+                more = f" (and {len(result.check_errors) - 1} more)" if len(result.check_errors) > 1 else ""
+                raise InputError(f"{path.name}: check mode: line {line} refused: {text}{more}")
+            done(f"check passed: GRBL accepted all {len(program)} lines of {path.name} (nothing moved)")
+            return
+        machine = result.elapsed * time_scale
+        extra = f"; {_format_seconds(machine)} of machine time" if time_scale != 1.0 else ""
+        done(f"streamed {len(program)} lines of {path.name} to {port} in {_format_seconds(result.elapsed)} "
+             f"(estimate {_format_seconds(total)}{extra}); machine Idle, beam off")
+
+
+@click.command("stream")
+@click.argument("gcode", type=click.Path(dir_okay=True, path_type=Path))
+@click.option("--port", required=True, help="Serial port (/dev/ttyUSB0, COM3) or sim:// for a dry run on an emulator.")
+@click.option("--baud", type=int, default=115200, show_default=True, help="Serial baud rate.")
+@click.option("--check", is_flag=True, help="Dry run in GRBL's check mode ($C): parse everything, move nothing.")
+@click.option("--frame", is_flag=True, help="Only trace the job's bounding box with the beam off.")
+@click.option("--profile", type=click.Path(path_type=Path), default=None,
+              help="Laser profile TOML to compare with the machine's settings.")
+def stream(gcode: Path, port: str, baud: int, check: bool, frame: bool, profile: Path | None) -> None:
+    """Stream GCODE to a GRBL laser over USB serial (pause, resume and abort leave the beam off)."""
+    run_stream(gcode, port=port, baud=baud, check=check, frame=frame, profile=profile)
