@@ -43,7 +43,8 @@ class Hoop:
 
 @dataclass(frozen=True, kw_only=True)
 class EmbroideryFormat:
-    """What one file format can hold. Lengths in mm (per axis, per record)."""
+    """What one file format can hold. Lengths in mm (per axis, per record); full_jump: an
+    explicit jump record lands on the first needle point of every run."""
 
     extension: str
     name: str
@@ -51,6 +52,7 @@ class EmbroideryFormat:
     max_jump: float
     trims: str
     max_colors: int
+    full_jump: bool = False
     settings: dict = field(default_factory=dict, compare=False)
 
 
@@ -109,6 +111,7 @@ def _load(path: Path) -> EmbroideryProfile:
                          max_stitch=parse_positive_length(spec["max_stitch"], what=f"{ext} max_stitch"),
                          max_jump=parse_positive_length(spec["max_jump"], what=f"{ext} max_jump"),
                          trims=spec["trims"], max_colors=int(spec["max_colors"]),
+                         full_jump=bool(spec.get("full_jump", False)),
                          settings=dict(spec.get("settings", {})))
         for ext, spec in data.get("formats", {}).items()
     )

@@ -15,9 +15,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from fabrication.embroidery.needles import BODY, MOTIF, NeedlePoints
-from fabrication.embroidery.running import (DENSE_TOLERANCE, RunningOptions, refine_to_tolerance,
-                                            stitch_lengths_along)
-from fabrication.embroidery.needles import SNAP_ALLOWANCE
+from fabrication.embroidery.running import (DENSE_TOLERANCE, TOLERANCE_RESERVE, RunningOptions,
+                                            refine_to_tolerance, stitch_lengths_along)
 from fabrication.embroidery.sampling import dense_curve
 from onestroke.errors import InputError
 from vectorize.stroke import Stroke
@@ -86,7 +85,7 @@ def arrow_stitch(stroke: Stroke, options: ArrowOptions = ArrowOptions(), *,
     tips, scale = tips[ok], scale[ok]
 
     s = stitch_lengths_along(curve, options.running, breaks=tips)
-    s, t = refine_to_tolerance(stroke, curve, s, options.tolerance - SNAP_ALLOWANCE)
+    s, t = refine_to_tolerance(stroke, curve, s, options.tolerance - TOLERANCE_RESERVE)
     walk = NeedlePoints.of(stroke.points_at(t), t, BODY)
     if not len(tips):
         return walk

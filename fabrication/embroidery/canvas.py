@@ -1,0 +1,226 @@
+"""A small 2-D canvas in millimetres that saves as PNG (Pillow) or SVG, for previews.
+
+Items are collected in mm (x right, y down) and drawn in order. PNG is drawn at twice the
+size and downsampled for smooth lines. Files are written atomically.
+"""
+
+from __future__ import annotations
+
+import io
+import os
+from dataclasses import dataclass, field
+
+import numpy as np
+from PIL import Image, ImageDraw, ImageFont
+
+from onestroke.atomic import atomic_write_bytes, atomic_write_text
+from onestroke.errors import InputError
+
+PREVIEW_SUFFIXES = (".png", ".svg")
+
+# Anchors of the start-to-end gradient (blue, cyan, green, yellow, red, like the paper's
+# figures): order along the curve reads as colour.
+_ANCHORS = np.array([[48, 18, 160], [30, 120, 230], [20, 185, 140], [120, 205, 40],
+                     [245, 190, 20], [235, 95, 20], [190, 20, 40]], dtype=float)
+_SUPERSAMPLE = 2
+
+
+def gradient(u: np.ndarray) -> np.ndarray:
+    """Colours (N, 3) uint8 for positions u (N,) in [0, 1] along the start-to-end gradient."""
+    u = np.clip(np.nan_to_num(np.asarray(u, dtype=float)), 0.0, 1.0) * (len(_ANCHORS) - 1)
+    i = np.minimum(u.astype(int), len(_ANCHORS) - 2)
+    f = (u - i)[:, None]
+    return np.rint(_ANCHORS[i] * (1 - f) + _ANCHORS[i + 1] * f).astype(np.uint8)
+
+
+def check_preview_path(path: str | os.PathLike) -> str:
+    """The lower-case suffix of a preview path, or `InputError` if it is not .png / .svg."""
+    suffix = os.path.splitext(str(path))[1].lower()
+    if suffix not in PREVIEW_SUFFIXES:
+        shown = f"'{suffix}'" if suffix else "no extension"
+        raise InputError(f"cannot write a preview as {shown} ({str(path)!r}); use .png or .svg")
+    return suffix
+
+
+def _hex(rgb) -> str:
+    return "#{:02x}{:02x}{:02x}".format(*(int(c) for c in rgb))
+
+
+@dataclass
+class Canvas:
+    """A `width` x `height` px picture of the mm box `view` = (xmin, ymin, xmax, ymax)."""
+
+    width: int
+    height: int
+    view: tuple[float, float, float, float]
+    background: tuple[int, int, int] = (250, 248, 243)
+    items: list = field(default_factory=list)
+
+    @classmethod
+    def fitting(cls, view: tuple[float, float, float, float], width: int, **kw) -> "Canvas":
+        """A canvas `width` px wide whose height keeps the aspect ratio of `view`."""
+        w = max(view[2] - view[0], 1e-9)
+        h = max(view[3] - view[1], 1e-9)
+        return cls(width=int(width), height=max(1, int(round(width * h / w))), view=view, **kw)
+
+    @property
+    def scale(self) -> float:
+        """Pixels per mm."""
+        return self.width / max(self.view[2] - self.view[0], 1e-9)
+
+    def px(self, points: np.ndarray) -> np.ndarray:
+        """mm (..., 2) to px (..., 2)."""
+        return (np.asarray(points, dtype=float) - np.array(self.view[:2])) * self.scale
+
+    # -- items (all coordinates in mm, widths in mm unless said) --------------------
+    def segments(self, a: np.ndarray, b: np.ndarray, colors: np.ndarray, width: float,
+                 *, min_px: float = 1.0) -> None:
+        """Line segments a[i] -> b[i] (S, 2) with colours (S, 3)."""
+        self.items.append(("segments", self.px(a), self.px(b), np.asarray(colors, np.uint8),
+                           max(width * self.scale, min_px), None))
+
+    def dashed(self, a: np.ndarray, b: np.ndarray, color, width: float, dash: float) -> None:
+        """Dashed segments with dashes and gaps `dash` mm long."""
+        self.items.append(("segments", self.px(a), self.px(b),
+                           np.tile(np.asarray(color, np.uint8), (len(a), 1)),
+                           max(width * self.scale, 1.0), max(dash * self.scale, 2.0)))
+
+    def dots(self, points: np.ndarray, color, radius: float, *, min_px: float = 0.8) -> None:
+        self.items.append(("dots", self.px(points), tuple(color), max(radius * self.scale, min_px)))
+
+    def crosses(self, points: np.ndarray, color, size_px: float) -> None:
+        self.items.append(("crosses", self.px(points), tuple(color), size_px))
+
+    def rectangle(self, box: tuple[float, float, float, float], color, width_px: float) -> None:
+        lo, hi = self.px(np.array(box[:2])), self.px(np.array(box[2:]))
+        self.items.append(("rect", lo, hi, tuple(color), width_px))
+
+    def text_box(self, lines: list[str], *, swatch=None, corner: str = "top-left") -> None:
+        """Lines of text in a light box in a corner; `swatch` an RGB shown beside it."""
+        self.items.append(("text", list(lines), swatch, corner))
+
+    # -- output ---------------------------------------------------------------------
+    def save(self, path: str | os.PathLike) -> None:
+        """Write PNG or SVG by the extension of `path`, atomically."""
+        suffix = check_preview_path(path)
+        if suffix == ".png":
+            buffer = io.BytesIO()
+            self.to_image().save(buffer, format="PNG", optimize=False)
+            atomic_write_bytes(path, buffer.getvalue())
+        else:
+            atomic_write_text(path, self.to_svg())
+
+    def _font_size(self) -> int:
+        return max(11, min(22, int(self.width / 60)))
+
+    def to_image(self) -> Image.Image:
+        k = _SUPERSAMPLE
+        image = Image.new("RGB", (self.width * k, self.height * k), self.background)
+        draw = ImageDraw.Draw(image)
+        for item in self.items:
+            kind = item[0]
+            if kind == "segments":
+                _, a, b, colors, width, dash = item
+                w = max(1, int(round(width * k)))
+                if dash is not None:
+                    a, b, colors = _dash_pieces(a, b, colors, dash)
+                for (x0, y0), (x1, y1), c in zip((a * k).tolist(), (b * k).tolist(), colors.tolist()):
+                    draw.line((x0, y0, x1, y1), fill=tuple(c), width=w)
+            elif kind == "dots":
+                _, p, color, r = item
+                r *= k
+                for x, y in (p * k).tolist():
+                    draw.ellipse((x - r, y - r, x + r, y + r), fill=color)
+            elif kind == "crosses":
+                _, p, color, size = item
+                s = size * k / 2
+                for x, y in (p * k).tolist():
+                    draw.line((x - s, y - s, x + s, y + s), fill=color, width=2 * k)
+                    draw.line((x - s, y + s, x + s, y - s), fill=color, width=2 * k)
+            elif kind == "rect":
+                _, lo, hi, color, width = item
+                draw.rectangle((*(lo * k), *(hi * k)), outline=color, width=max(1, int(width * k)))
+            elif kind == "text":
+                _, lines, swatch, _corner = item
+                font = ImageFont.load_default(size=self._font_size() * k)
+                pad = 6 * k
+                boxes = [draw.textbbox((0, 0), line, font=font) for line in lines]
+                line_h = max(b[3] - b[1] for b in boxes) + 4 * k
+                text_w = max(b[2] - b[0] for b in boxes)
+                sw = line_h if swatch is not None else 0
+                draw.rectangle((pad, pad, 3 * pad + text_w + sw, 3 * pad + line_h * len(lines)),
+                               fill=(255, 255, 255), outline=(150, 150, 150), width=k)
+                for j, line in enumerate(lines):
+                    draw.text((2 * pad, 2 * pad + j * line_h), line, fill=(20, 20, 20), font=font)
+                if swatch is not None:
+                    x = 2 * pad + text_w + pad
+                    draw.rectangle((x, 2 * pad, x + sw - pad, 2 * pad + sw - pad), fill=tuple(swatch),
+                                   outline=(60, 60, 60), width=k)
+        return image.resize((self.width, self.height), Image.LANCZOS)
+
+    def to_svg(self) -> str:
+        out = [f'<svg xmlns="http://www.w3.org/2000/svg" width="{self.width}" height="{self.height}" '
+               f'viewBox="0 0 {self.width} {self.height}">',
+               f'<rect width="100%" height="100%" fill="{_hex(self.background)}"/>']
+        for item in self.items:
+            kind = item[0]
+            if kind == "segments":
+                _, a, b, colors, width, dash = item
+                dash_attr = f' stroke-dasharray="{dash:.1f} {dash:.1f}"' if dash is not None else ""
+                # One path per distinct colour keeps the file small.
+                keys = colors[:, 0].astype(np.int64) << 16 | colors[:, 1].astype(np.int64) << 8 | colors[:, 2]
+                for key in np.unique(keys):
+                    sel = keys == key
+                    d = " ".join(f"M{x0:.2f} {y0:.2f}L{x1:.2f} {y1:.2f}"
+                                 for (x0, y0), (x1, y1) in zip(a[sel].tolist(), b[sel].tolist()))
+                    out.append(f'<path d="{d}" fill="none" stroke="#{int(key):06x}" '
+                               f'stroke-width="{width:.2f}" stroke-linecap="round"{dash_attr}/>')
+            elif kind == "dots":
+                _, p, color, r = item
+                d = " ".join(f"M{x:.2f} {y:.2f}h0" for x, y in p.tolist())
+                out.append(f'<path d="{d}" stroke="{_hex(color)}" stroke-width="{2 * r:.2f}" '
+                           'stroke-linecap="round"/>')
+            elif kind == "crosses":
+                _, p, color, size = item
+                s = size / 2
+                d = " ".join(f"M{x - s:.1f} {y - s:.1f}L{x + s:.1f} {y + s:.1f}M{x - s:.1f} {y + s:.1f}"
+                             f"L{x + s:.1f} {y - s:.1f}" for x, y in p.tolist())
+                out.append(f'<path d="{d}" stroke="{_hex(color)}" stroke-width="2"/>')
+            elif kind == "rect":
+                _, lo, hi, color, width = item
+                out.append(f'<rect x="{lo[0]:.2f}" y="{lo[1]:.2f}" width="{hi[0] - lo[0]:.2f}" '
+                           f'height="{hi[1] - lo[1]:.2f}" fill="none" stroke="{_hex(color)}" '
+                           f'stroke-width="{width:.1f}"/>')
+            elif kind == "text":
+                _, lines, swatch, _corner = item
+                size = self._font_size()
+                line_h = size + 4
+                w = max(len(s) for s in lines) * size * 0.62 + 24 + (line_h if swatch is not None else 0)
+                out.append(f'<rect x="6" y="6" width="{w:.0f}" height="{line_h * len(lines) + 12}" '
+                           'fill="white" stroke="#969696"/>')
+                for j, line in enumerate(lines):
+                    text = line.replace("&", "&amp;").replace("<", "&lt;")
+                    out.append(f'<text x="12" y="{12 + size + j * line_h}" font-family="monospace" '
+                               f'font-size="{size}" xml:space="preserve">{text}</text>')
+                if swatch is not None:
+                    out.append(f'<rect x="{w - line_h:.0f}" y="12" width="{line_h - 6}" '
+                               f'height="{line_h - 6}" fill="{_hex(swatch)}" stroke="#3c3c3c"/>')
+        out.append("</svg>")
+        return "\n".join(out) + "\n"
+
+
+def _dash_pieces(a: np.ndarray, b: np.ndarray, colors: np.ndarray, dash: float):
+    """Cut each segment into dashes `dash` px long separated by equal gaps."""
+    pieces_a, pieces_b, pieces_c = [], [], []
+    for p, q, c in zip(a, b, colors):
+        length = float(np.hypot(*(q - p)))
+        n = max(1, int(length // (2 * dash)) + 1)
+        starts = np.arange(n) * 2 * dash
+        ends = np.minimum(starts + dash, length)
+        u0, u1 = starts / max(length, 1e-9), ends / max(length, 1e-9)
+        pieces_a.append(p + (q - p) * u0[:, None])
+        pieces_b.append(p + (q - p) * u1[:, None])
+        pieces_c.append(np.tile(c, (n, 1)))
+    if not pieces_a:
+        return a, b, colors
+    return np.concatenate(pieces_a), np.concatenate(pieces_b), np.concatenate(pieces_c)

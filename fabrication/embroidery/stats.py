@@ -1,0 +1,87 @@
+"""Stats of a stitch plan: counts, thread, size, sewing time and a density check."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.spatial import cKDTree
+
+from fabrication.embroidery.plan import JUMP, STITCH, TRIM, StitchPlan
+
+
+@dataclass(frozen=True, kw_only=True)
+class EmbroideryStats:
+    """stitches: needle penetrations; jumps: needle-up moves (a split jump counts once,
+    the lead-in to the first point not at all); trims; color_changes; thread_length: sum
+    of needle-down stitch lengths, mm; width / height: extent of the needle points, mm;
+    seconds: estimated sewing time; max_density: most needle points within
+    `density_radius` of one needle point (itself included); dense_points: needle points
+    with `density_limit` or more."""
+
+    stitches: int
+    jumps: int
+    trims: int
+    color_changes: int
+    thread_length: float
+    width: float
+    height: float
+    seconds: float
+    stitches_per_minute: float
+    max_density: int
+    dense_points: int
+    density_radius: float
+    density_limit: int
+
+    @property
+    def too_dense(self) -> bool:
+        return self.dense_points > 0
+
+    @property
+    def warnings(self) -> tuple[str, ...]:
+        if not self.too_dense:
+            return ()
+        return (f"{self.dense_points} needle points have {self.density_limit} or more needle points "
+                f"within {self.density_radius:g} mm (up to {self.max_density}): too dense, the thread "
+                "may pile up or break; use a longer stitch or a wider spacing",)
+
+    def lines(self) -> list[str]:
+        """Human-readable lines (for the CLI and the preview's corner)."""
+        minutes, seconds = divmod(int(round(self.seconds)), 60)
+        return [
+            f"stitches  {self.stitches:,}",
+            f"jumps     {self.jumps}   trims {self.trims}",
+            f"thread    {self.thread_length / 1000:.2f} m",
+            f"size      {self.width:.1f} x {self.height:.1f} mm",
+            f"time      {minutes} min {seconds:02d} s at {self.stitches_per_minute:g} spm",
+            f"density   max {self.max_density} within {self.density_radius:g} mm"
+            + ("  TOO DENSE" if self.too_dense else ""),
+        ]
+
+
+def embroidery_stats(plan: StitchPlan, *, stitches_per_minute: float = 600.0,
+                     trim_seconds: float = 10.0, color_changes: int = 0,
+                     density_radius: float = 0.5, density_limit: int = 6) -> EmbroideryStats:
+    """Measure `plan`. Time = stitches / stitches_per_minute + (trims + colour changes) x trim_seconds."""
+    needles = plan.points[plan.kinds == STITCH]
+    a, b = plan.stitches()
+    thread = float(np.linalg.norm(b - a, axis=1).sum()) if len(a) else 0.0
+    kinds = plan.kinds
+    is_jump = kinds == JUMP
+    run_start = is_jump & np.concatenate([[True], ~is_jump[:-1]])
+    first_needle = int(np.argmax(kinds == STITCH)) if len(needles) else len(kinds)
+    jumps = int(run_start[first_needle:].sum())
+    trims = int((kinds == TRIM).sum())
+    if len(needles):
+        counts = cKDTree(needles).query_ball_point(needles, density_radius, return_length=True)
+        max_density, dense = int(counts.max()), int((counts >= density_limit).sum())
+        lo, hi = needles.min(axis=0), needles.max(axis=0)
+    else:
+        max_density, dense, lo, hi = 0, 0, np.zeros(2), np.zeros(2)
+    seconds = len(needles) / stitches_per_minute * 60.0 + (trims + color_changes) * trim_seconds
+    return EmbroideryStats(stitches=int(len(needles)), jumps=jumps, trims=trims,
+                           color_changes=int(color_changes), thread_length=thread,
+                           width=float(hi[0] - lo[0]), height=float(hi[1] - lo[1]),
+                           seconds=float(seconds), stitches_per_minute=float(stitches_per_minute),
+                           max_density=max_density, dense_points=dense,
+                           density_radius=density_radius, density_limit=density_limit)
