@@ -51,6 +51,12 @@ def _register() -> None:
     from fabrication.cli.ports_cmd import ports
 
     main.add_command(ports)
+    from fabrication.cli.embroider_cmd import embroider
+
+    main.add_command(embroider)
+    from fabrication.cli.preview_cmd import preview
+
+    main.add_command(preview)
 
 
 _register()

@@ -1,0 +1,162 @@
+"""`onestroke embroider`: a drawing (PNG/JPG/SVG/JSON) to an embroidery file sewn along the curve."""
+
+from __future__ import annotations
+
+import os
+import time
+
+import click
+
+from fabrication.cli.common import console, done, warn
+from onestroke.atomic import check_writable
+from onestroke.errors import InputError
+
+# CLI option -> field name in the style options; which styles use it (for warnings).
+_STYLE_FIELDS = {
+    "stitch_length": ("stitch_length", "--stitch-length"),
+    "tolerance": ("tolerance", "--tolerance"),
+    "stitch_width": ("width", "--stitch-width"),
+    "spacing": ("spacing", "--spacing"),
+    "pull_comp": ("pull_compensation", "--pull-comp"),
+    "repeats": ("repeats", "--repeats"),
+    "arrow_size": ("size", "--arrow-size"),
+}
+
+
+@click.command()
+@click.argument("source", type=click.Path(path_type=str))
+@click.option("-o", "--output", required=True, type=click.Path(path_type=str),
+              help="Embroidery file to write: .pes, .dst, .jef, .exp or .vp3.")
+@click.option("--style", default="running", show_default=True,
+              help="Stitch style: running, triple, zigzag or arrows.")
+@click.option("--size", default=None, help="Longest side of the design, e.g. 90mm, 3.5in [default: 90mm].")
+@click.option("--width", default=None, help="Width of the design instead of --size.")
+@click.option("--height", default=None, help="Height of the design instead of --size.")
+@click.option("--rotate", type=float, default=0.0, show_default=True, help="Degrees, counter-clockwise.")
+@click.option("--hoop", default="100x100", show_default=True,
+              help="Hoop: 100x100 (4x4), 130x180 (5x7), 150x250, 160x260 (6x10), 200x200, or WxH in mm.")
+@click.option("--fit", is_flag=True, help="Scale the design down to fit the hoop instead of refusing it.")
+@click.option("--stitch-length", default=None,
+              help="Running/triple stitch and the arrows' centre walk [default: 2.5mm].")
+@click.option("--tolerance", default=None, help="Largest chord-to-curve distance [default: 0.2mm].")
+@click.option("--stitch-width", "--zigzag-width", "stitch_width", default=None,
+              help="Zigzag width rail to rail [2mm] or arrow spread [2.5mm].")
+@click.option("--spacing", default=None, help="Zigzag peak-to-peak spacing [0.4mm] or arrow spacing [5mm].")
+@click.option("--pull-comp", default=None, help="Zigzag pull compensation added to the width [default: 0.2mm].")
+@click.option("--repeats", type=int, default=None, help="Triple stitch: back-and-forth passes [default: 1].")
+@click.option("--arrow-size", default=None, help="Arrows: arm length along the curve [default: 2mm].")
+@click.option("--min-stitch", default="0.3mm", show_default=True,
+              help="Shorter stitches are merged away (locks excepted).")
+@click.option("--max-stitch", default="12.1mm", show_default=True,
+              help="Longest needle-down stitch per axis (never above the format's limit).")
+@click.option("--trim-distance", default="3mm", show_default=True,
+              help="Strokes further apart are joined by lock, trim and jump.")
+@click.option("--lock", "lock_form", default="half", show_default=True, help="Lock/tack form: half or back_forth.")
+@click.option("--color", "--colour", "color", default="#000000", show_default=True,
+              help="Thread colour: #rrggbb or a name.")
+@click.option("--pes-version", type=int, default=None,
+              help="PES version: 6 (default; keeps RGB colours) or 1 (Brother's 64-colour palette).")
+@click.option("--spm", type=float, default=None, help="Machine speed in stitches per minute [default: 600].")
+@click.option("--preview", "preview_path", default=None, type=click.Path(path_type=str),
+              help="Also write a preview image (.png or .svg).")
+@click.option("--preview-width", type=int, default=1000, show_default=True, help="Preview width in px.")
+@click.option("--multi", is_flag=True, help="Raster input: multi-stroke vectorization.")
+@click.option("--threshold", type=float, default=None, help="Raster input: ink threshold in (0, 1).")
+def embroider(source: str, output: str, style: str, size: str | None, width: str | None, height: str | None,
+              rotate: float, hoop: str, fit: bool, stitch_length: str | None, tolerance: str | None,
+              stitch_width: str | None, spacing: str | None, pull_comp: str | None, repeats: int | None,
+              arrow_size: str | None, min_stitch: str, max_stitch: str, trim_distance: str, lock_form: str,
+              color: str, pes_version: int | None, spm: float | None, preview_path: str | None,
+              preview_width: int, multi: bool, threshold: float | None) -> None:
+    """Sew SOURCE (PNG/JPG/SVG/JSON drawing) along its curve into an embroidery file."""
+    from fabrication.embroidery.canvas import check_preview_path
+    from fabrication.embroidery.export import PES_VERSIONS, write_embroidery
+    from fabrication.embroidery.hooping import check_plan_in_hoop, fit_to_hoop
+    from fabrication.embroidery.locks import LockOptions
+    from fabrication.embroidery.plan import PlanOptions, plan_embroidery, style_options, style_reach
+    from fabrication.embroidery.preview import PreviewOptions, render_stitch_preview
+    from fabrication.embroidery.stats import embroidery_stats
+    from fabrication.embroidery.thread import parse_color
+    from fabrication.placement import PlacementOptions, place
+    from machines.hoops import load_embroidery_profile
+    from onestroke.units import parse_length, parse_positive_length
+
+    started = time.perf_counter()
+    # Every option is checked before anything is read or written.
+    profile = load_embroidery_profile()
+    fmt = profile.format_for(output)
+    check_writable(output)
+    if pes_version is not None:
+        if fmt.extension != "pes":
+            raise InputError(f"--pes-version applies to .pes output only, not .{fmt.extension}")
+        if pes_version not in PES_VERSIONS:
+            raise InputError(f"--pes-version {pes_version} is not supported; use 1 or 6")
+    if preview_path is not None:
+        check_preview_path(preview_path)
+        check_writable(preview_path)
+        preview_options = PreviewOptions(width=preview_width)
+    if not os.path.isfile(source):
+        raise InputError(f"input file {source!r} does not exist")
+
+    lengths = {name: parse_positive_length(value, what=flag)
+               for name, value, flag in (("stitch_length", stitch_length, "--stitch-length"),
+                                         ("tolerance", tolerance, "--tolerance"),
+                                         ("stitch_width", stitch_width, "--stitch-width"),
+                                         ("spacing", spacing, "--spacing"),
+                                         ("arrow_size", arrow_size, "--arrow-size")) if value is not None}
+    if pull_comp is not None:
+        lengths["pull_comp"] = parse_length(pull_comp, what="--pull-comp")
+    if repeats is not None:
+        lengths["repeats"] = repeats
+    style_values = {_STYLE_FIELDS[k][0]: v for k, v in lengths.items()}
+    stitch_options = style_options(style, **style_values)
+    unused = [_STYLE_FIELDS[k][1] for k in lengths
+              if _STYLE_FIELDS[k][0] not in type(stitch_options).__dataclass_fields__]
+    if not any(v is not None for v in (size, width, height)):
+        size = "90mm"
+    placement = PlacementOptions(
+        size=parse_positive_length(size, what="--size") if size is not None else None,
+        width=parse_positive_length(width, what="--width") if width is not None else None,
+        height=parse_positive_length(height, what="--height") if height is not None else None,
+        rotate=rotate)
+    the_hoop = profile.hoop(hoop)
+    limit = min(parse_positive_length(max_stitch, what="--max-stitch"), fmt.max_stitch, profile.max_stitch)
+    plan_options = PlanOptions(style=stitch_options, lock=LockOptions(form=lock_form),
+                               min_stitch=parse_positive_length(min_stitch, what="--min-stitch"),
+                               max_stitch=limit,
+                               trim_distance=parse_length(trim_distance, what="--trim-distance"),
+                               color=parse_color(color))
+    if spm is not None and not spm > 0:
+        raise InputError(f"--spm {spm:g} must be greater than zero")
+    for flag in unused:
+        warn(f"{flag} has no effect with --style {style}")
+
+    if source.lower().endswith(".json"):
+        from vectorize.svg_write import drawing_from_json
+
+        with open(source, encoding="utf-8") as handle:
+            drawing = drawing_from_json(handle.read())
+    else:
+        from fabrication.cli.common import read_drawing
+
+        drawing = read_drawing(source, multi=multi, threshold=threshold)
+    placed = fit_to_hoop(place(drawing, placement), the_hoop, reach=style_reach(stitch_options), fit=fit)
+    plan = plan_embroidery(placed, plan_options)
+    check_plan_in_hoop(plan, the_hoop)
+    stats = embroidery_stats(plan, stitches_per_minute=spm or profile.stitches_per_minute,
+                             trim_seconds=profile.trim_seconds)
+    write_embroidery(plan, output, pes_version=pes_version)
+    if preview_path is not None:
+        render_stitch_preview(plan, preview_path, hoop=the_hoop, stats=stats, options=preview_options)
+
+    if plan.skipped:
+        warn(f"{plan.skipped} stroke(s) shorter than the minimum stitch were left out")
+    for message in stats.warnings:
+        warn(message)
+    for line in stats.lines():
+        console.print(line)
+    extra = f" and {preview_path}" if preview_path else ""
+    done(f"wrote {output}{extra}: {stats.stitches} stitches, {stats.trims} trims, "
+         f"{stats.thread_length / 1000:.2f} m thread, {stats.width:.1f} x {stats.height:.1f} mm "
+         f"in hoop {the_hoop.name}, about {stats.seconds / 60:.1f} min "
+         f"({time.perf_counter() - started:.1f} s)")

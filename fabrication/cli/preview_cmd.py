@@ -1,0 +1,90 @@
+"""`onestroke preview`: a picture of an embroidery file, a G-code file or a drawing.
+
+Dispatch by the input's extension: G-code goes to the laser preview, .svg/.json drawings
+to the drawing preview, and anything pyembroidery reads to the stitch preview.
+"""
+
+from __future__ import annotations
+
+import os
+
+import click
+
+from fabrication.cli.common import console, done, warn
+from onestroke.atomic import check_writable
+from onestroke.errors import InputError
+
+GCODE_SUFFIXES = (".gcode", ".nc", ".gc", ".ngc")
+DRAWING_SUFFIXES = (".svg", ".json")
+
+
+@click.command()
+@click.argument("source", type=click.Path(path_type=str))
+@click.option("-o", "--output", required=True, type=click.Path(path_type=str),
+              help="Preview image to write (.png or .svg).")
+@click.option("--width", "width_px", type=int, default=1000, show_default=True,
+              help="Image width in px (embroidery and drawings).")
+@click.option("--hoop", default=None, help="Embroidery: draw this hoop, e.g. 100x100 or 5x7.")
+@click.option("--spm", type=float, default=None, help="Embroidery: stitches per minute for the time [600].")
+def preview(source: str, output: str, width_px: int, hoop: str | None, spm: float | None) -> None:
+    """Draw SOURCE (.pes/.dst/.jef/.exp/.vp3/... , .gcode/.nc, or an .svg/.json drawing) as OUTPUT."""
+    from fabrication.embroidery.canvas import check_preview_path
+    from fabrication.embroidery.read import readable_extensions
+
+    suffix = os.path.splitext(source)[1].lower()
+    accepted = readable_extensions() + GCODE_SUFFIXES + DRAWING_SUFFIXES
+    if suffix not in accepted:
+        raise InputError(f"cannot preview {source!r}; use an embroidery file "
+                         f"({', '.join(readable_extensions()[:8])}, ...), G-code "
+                         f"({', '.join(GCODE_SUFFIXES)}) or a drawing (.svg, .json)")
+    if not os.path.isfile(source):
+        raise InputError(f"input file {source!r} does not exist")
+
+    if suffix in GCODE_SUFFIXES:
+        from fabrication.laser.preview import render_gcode_preview
+
+        job = render_gcode_preview(source, output)
+        minutes, seconds = divmod(int(round(job.total_seconds)), 60)
+        done(f"wrote {output}: laser job about {minutes} min {seconds:02d} s")
+        return
+
+    check_preview_path(output)
+    check_writable(output)
+    from fabrication.embroidery.preview import PreviewOptions
+
+    options = PreviewOptions(width=width_px)
+    if suffix in DRAWING_SUFFIXES:
+        from fabrication.embroidery.preview import render_drawing_preview
+
+        if suffix == ".json":
+            from vectorize.svg_write import drawing_from_json
+
+            with open(source, encoding="utf-8") as handle:
+                drawing = drawing_from_json(handle.read())
+        else:
+            from fabrication.cli.common import read_drawing
+
+            drawing = read_drawing(source)
+        render_drawing_preview(drawing, output, options)
+        done(f"wrote {output}: {len(drawing.strokes)} stroke(s), length {drawing.length:.1f} {drawing.unit}")
+        return
+
+    from fabrication.embroidery.preview import render_stitch_preview
+    from fabrication.embroidery.read import read_embroidery
+    from fabrication.embroidery.stats import embroidery_stats
+    from machines.hoops import load_embroidery_profile
+
+    profile = load_embroidery_profile()
+    the_hoop = profile.hoop(hoop) if hoop is not None else None
+    if spm is not None and not spm > 0:
+        raise InputError(f"--spm {spm:g} must be greater than zero")
+    read = read_embroidery(source)
+    stats = embroidery_stats(read.plan, stitches_per_minute=spm or profile.stitches_per_minute,
+                             trim_seconds=profile.trim_seconds, color_changes=read.color_changes)
+    render_stitch_preview(read.plan, output, hoop=the_hoop, stats=stats, options=options)
+    for message in stats.warnings:
+        warn(message)
+    for line in stats.lines():
+        console.print(line)
+    done(f"wrote {output}: {stats.stitches} stitches, {stats.trims} trims, "
+         f"{stats.width:.1f} x {stats.height:.1f} mm")
