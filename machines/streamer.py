@@ -251,7 +251,8 @@ class GrblStreamer:
         if welcome is None:
             raise MachineError(
                 f"no answer from {self.name} within {self.options.connect_timeout:g} s: not a GRBL board, "
-                "wrong baud rate (--baud), or still booting; check the cable and 'onestroke ports'")
+                "wrong baud rate (--baud), or still booting; check the cable and 'onestroke ports'; "
+                "nothing was sent, no line was acknowledged")
         time.sleep(0.05)  # the ALARM-lock message follows the welcome at once
         options = self._collect("$I")
         for reply in options:
