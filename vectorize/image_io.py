@@ -14,8 +14,14 @@ from onestroke.errors import InputError
 MAX_PIXELS = 200_000_000
 
 
-def load_image(path: str | os.PathLike) -> np.ndarray:
-    """Read an image file as uint8 (H, W), (H, W, 3) or (H, W, 4) without changing its pixels."""
+def load_image(path: str | os.PathLike, *, max_size: int | None = None):
+    """Read an image file as uint8 (H, W), (H, W, 3) or (H, W, 4), and its `InputFrame`.
+
+    An image much larger than `max_size` is first shrunk by an integer factor (box average,
+    done by Pillow on 8-bit data) so that a huge scan never needs gigabytes as floats.
+    """
+    from vectorize.pipeline import InputFrame
+
     path = str(path)
     if not os.path.isfile(path):
         raise InputError(f"input file {path!r} does not exist")
@@ -26,11 +32,21 @@ def load_image(path: str | os.PathLike) -> np.ndarray:
                 if image.width * image.height > MAX_PIXELS:
                     raise InputError(f"image {path!r} is {image.width}x{image.height}: too large to read")
                 image.load()
+                original = (image.width, image.height)
+                factor = max(1, int(max(original) // (2 * max_size))) if max_size else 1
+                if factor > 1:
+                    image = image.reduce(factor) if image.mode in ("L", "RGB", "RGBA") else image
                 if image.mode in ("RGBA", "LA") or (image.mode == "P" and "transparency" in image.info):
                     image = image.convert("RGBA")
                 elif image.mode not in ("L", "RGB"):
                     image = image.convert("RGB")
-                return np.asarray(image)
+                if factor > 1 and image.mode not in ("L", "RGB", "RGBA"):
+                    image = image.reduce(factor)
+                array = np.asarray(image)
+                scale = 1.0 / factor
+                frame = InputFrame(scale, (0.0, 0.0), float(original[0]), float(original[1]),
+                                   original if factor > 1 else None)
+                return array, frame
     except UnidentifiedImageError:
         raise InputError(f"{path!r} is not an image Pillow can read (PNG, JPEG, BMP, GIF, TIFF, WebP) or SVG") from None
     except (OSError, SyntaxError, ValueError, Image.DecompressionBombWarning, Image.DecompressionBombError) as error:

@@ -15,7 +15,7 @@ from skimage.transform import downscale_local_mean
 SUPERSAMPLE = 3
 
 
-def rasterize_rings(rings, width: float, height: float, *, size: int) -> tuple[np.ndarray, float, np.ndarray]:
+def rasterize_rings(rings, *, size: int) -> tuple[np.ndarray, float, np.ndarray]:
     """Fill closed rings (list of (N, 2) in SVG units) even-odd into a gray image.
 
     Returns (gray (H, W) float32, 1 = paper; scale = working px per SVG unit; offset (2,)

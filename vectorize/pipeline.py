@@ -84,7 +84,20 @@ class VectorizeResult:
     stages: dict | None = None
 
 
-RASTER_SUFFIXES = (".png", ".jpg", ".jpeg", ".bmp", ".gif", ".tif", ".tiff", ".webp")
+@dataclass(frozen=True)
+class InputFrame:
+    """How the pipeline's input image sits in the frame the output is written in.
+
+    scale: image px per output unit; offset: (2,) output position of the image's corner;
+    width/height: the output canvas; reduced_from: (W, H) of an original image that was
+    shrunk before the pipeline saw it (for the "downscaled" message), else None.
+    """
+
+    scale: float
+    offset: tuple[float, float]
+    width: float
+    height: float
+    reduced_from: tuple[int, int] | None = None
 
 
 def vectorize_file(path: str | os.PathLike, options: VectorizeOptions = VectorizeOptions()) -> VectorizeResult:
@@ -99,8 +112,8 @@ def vectorize_file(path: str | os.PathLike, options: VectorizeOptions = Vectoriz
         return _vectorize_svg(path, options)
     from vectorize.image_io import load_image
 
-    image = load_image(path)
-    return vectorize_image(image, options)
+    image, frame = load_image(path, max_size=options.max_size)
+    return vectorize_image(image, options, frame=frame)
 
 
 def _vectorize_svg(path: str, options: VectorizeOptions) -> VectorizeResult:
@@ -111,10 +124,9 @@ def _vectorize_svg(path: str, options: VectorizeOptions) -> VectorizeResult:
     if content.is_outline:
         from vectorize.outline_svg import rasterize_rings
 
-        gray, scale, offset = rasterize_rings(content.outline_rings, content.width, content.height,
-                                              size=options.max_size)
-        result = vectorize_image(gray, options, _frame=(scale, offset, content.width, content.height))
-        return result
+        gray, scale, offset = rasterize_rings(content.outline_rings, size=options.max_size)
+        frame = InputFrame(scale, (float(offset[0]), float(offset[1])), content.width, content.height)
+        return vectorize_image(gray, options, frame=frame)
     drawing = content.as_drawing()
     report = VectorizeReport(strokes=len(drawing.strokes), stroke_width=drawing.stroke_width,
                              seconds={"read svg": time.perf_counter() - start})
@@ -122,8 +134,11 @@ def _vectorize_svg(path: str, options: VectorizeOptions) -> VectorizeResult:
 
 
 def vectorize_image(image: np.ndarray, options: VectorizeOptions = VectorizeOptions(), *,
-                    _frame=None) -> VectorizeResult:
-    """Vectorize a raster image: (H, W) gray or (H, W, 3|4) colour, uint8 or float in [0, 1]."""
+                    frame: InputFrame | None = None) -> VectorizeResult:
+    """Vectorize a raster image: (H, W) gray or (H, W, 3|4) colour, uint8 or float in [0, 1].
+
+    The drawing comes out in the image's pixels (pixel i covers [i, i + 1)), or in `frame`.
+    """
     from vectorize.vectorizer import run_pipeline
 
-    return run_pipeline(image, options, frame=_frame)
+    return run_pipeline(image, options, frame=frame)

@@ -51,9 +51,9 @@ def drawing_to_json(drawing: Drawing) -> str:
         "format": "onestroke-drawing",
         "version": 1,
         "unit": drawing.unit,
-        "width": round(drawing.width, 6),
-        "height": round(drawing.height, 6),
-        "stroke_width": round(drawing.stroke_width, 6),
+        "width": round(float(drawing.width), 6),
+        "height": round(float(drawing.height), 6),
+        "stroke_width": round(float(drawing.stroke_width), 6),
         "strokes": [np.round(s.control, 4).tolist() for s in drawing.strokes],
     }
     return json.dumps(payload, separators=(",", ":")) + "\n"

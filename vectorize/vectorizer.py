@@ -13,7 +13,7 @@ from vectorize.graph import MedialGraph
 from vectorize.intersections import Junction, JunctionVerdict, make_classifier, ranked_pairings
 from vectorize.medial_axis import medial_axis
 from vectorize.outline import outline_rings
-from vectorize.pipeline import VectorizeOptions, VectorizeReport, VectorizeResult
+from vectorize.pipeline import InputFrame, VectorizeOptions, VectorizeReport, VectorizeResult
 from vectorize.pruning import prune, trim_free_ends
 from vectorize.simplify import Simplified, directions, simplify, slots
 from vectorize.stroke import Stroke
@@ -109,8 +109,9 @@ def _orient(stroke: Stroke, closed: bool) -> Stroke:
     return stroke
 
 
-def run_pipeline(image: np.ndarray, options: VectorizeOptions, *, frame=None) -> VectorizeResult:
-    """Vectorize `image`; `frame` = (scale, offset, width, height) maps working px to an SVG frame."""
+def run_pipeline(image: np.ndarray, options: VectorizeOptions, *,
+                 frame: InputFrame | None = None) -> VectorizeResult:
+    """Vectorize `image`; the drawing comes out in `frame` (default: the image's pixels)."""
     clock = _Clock()
     ink = binarize(image, max_size=options.max_size, blur=options.blur,
                    threshold=options.threshold, multi=options.multi)
@@ -154,19 +155,19 @@ def run_pipeline(image: np.ndarray, options: VectorizeOptions, *, frame=None) ->
     clock.lap("fitting")
 
     # Back to the input's frame: original image pixels, or the SVG's user units.
+    shape = np.asarray(image).shape
     if frame is None:
-        scale, offset = ink.scale, np.zeros(2)
-        height, width = (np.asarray(image).shape[0], np.asarray(image).shape[1])
-    else:
-        scale, offset, width, height = frame
+        frame = InputFrame(1.0, (0.0, 0.0), float(shape[1]), float(shape[0]))
+    scale = ink.scale * frame.scale  # working px per output unit
     # Working pixel centres sit at integers (scikit-image); in SVG and in the input's pixel
     # frame pixel i covers [i, i + 1), so its centre is at i + 0.5.
-    matrix = np.array([[1 / scale, 0, offset[0] + 0.5 / scale], [0, 1 / scale, offset[1] + 0.5 / scale]])
-    drawing = Drawing(tuple(s.transformed(matrix) for s in strokes), float(width), float(height), "px", w / scale)
+    matrix = np.array([[1 / scale, 0, frame.offset[0] + 0.5 / scale],
+                       [0, 1 / scale, frame.offset[1] + 0.5 / scale]])
+    drawing = Drawing(tuple(s.transformed(matrix) for s in strokes), frame.width, frame.height, "px", w / scale)
 
     warnings = []
-    if ink.scale < 1.0 and frame is None:
-        h0, w0 = np.asarray(image).shape[:2]
+    if ink.scale < 1.0 or frame.reduced_from is not None:
+        w0, h0 = frame.reduced_from or (shape[1], shape[0])
         warnings.append(f"image is {w0}x{h0} px: downscaled to {ink.gray.shape[1]}x{ink.gray.shape[0]} to vectorize")
     if ink.dropped:
         warnings.append(f"{ink.dropped} separate ink piece(s) dropped: a single-line drawing keeps only the largest"
@@ -179,7 +180,7 @@ def run_pipeline(image: np.ndarray, options: VectorizeOptions, *, frame=None) ->
     report = VectorizeReport(
         strokes=len(strokes), intersections=len(simple.crossings), y_junctions=len(simple.y_feet),
         dropped_components=ink.dropped, high_degree_junctions=len(simple.unresolved), retries=tried - 1,
-        scale=ink.scale, stroke_width=w / scale, warnings=tuple(warnings), seconds=clock.seconds)
+        scale=scale, stroke_width=w / scale, warnings=tuple(warnings), seconds=clock.seconds)
     if stages is not None:
         stages.update(simplified=graph, simple=simple, junctions=junctions, verdicts=verdicts,
                       ordering=ordering, working_strokes=strokes)
