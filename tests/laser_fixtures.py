@@ -77,3 +77,17 @@ def spiral_points(segment: float = 0.05, turns: float = 8.0, r0: float = 2.0, pi
         pts.append((centre[0] + r * np.cos(theta), centre[1] + r * np.sin(theta)))
         theta += segment / np.hypot(r, b)
     return np.array(pts)
+
+
+def trefoil_png(path, size: int = 500, width: int = 7):
+    """A raster single-line drawing with three self-crossings (trefoil), for the vectorizer."""
+    from PIL import Image, ImageDraw
+
+    t = np.linspace(0, 2 * np.pi, 2000)
+    x = np.sin(t) + 2 * np.sin(2 * t)
+    y = np.cos(t) - 2 * np.cos(2 * t)
+    pts = np.c_[size / 2 + 0.14 * size * x, size / 2 + 0.14 * size * y]
+    image = Image.new("L", (size, size), 255)
+    ImageDraw.Draw(image).line([tuple(p) for p in pts.tolist()], fill=0, width=width, joint="curve")
+    image.save(path)
+    return path

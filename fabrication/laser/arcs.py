@@ -32,7 +32,24 @@ def _line_fits(p: np.ndarray, tolerance: float) -> bool:
     return bool(err.max() <= tolerance)
 
 
-def _arc_fits(p: np.ndarray, tolerance: float, quantum: float) -> tuple[np.ndarray, int] | None:
+def _leaves_box(centre, radius, start_angle, sweep, box) -> bool:
+    """True when the arc sticks out of box (xmin, ymin, xmax, ymax). Its end points lie
+    inside, so it can only leave at one of its axis-extreme points within the sweep."""
+    if box is None:
+        return False
+    lo, hi = (start_angle, start_angle + sweep) if sweep > 0 else (start_angle + sweep, start_angle)
+    for k, (dx, dy) in enumerate(((1, 0), (0, 1), (-1, 0), (0, -1))):
+        angle = k * np.pi / 2
+        # is this axis direction inside the swept interval (mod 2 pi)?
+        turns = np.ceil((lo - angle) / (2 * np.pi))
+        if angle + turns * 2 * np.pi <= hi:
+            x, y = centre[0] + dx * radius, centre[1] + dy * radius
+            if x < box[0] or y < box[1] or x > box[2] or y > box[3]:
+                return True
+    return False
+
+
+def _arc_fits(p: np.ndarray, tolerance: float, quantum: float, box=None) -> tuple[np.ndarray, int] | None:
     """Centre (2,) and direction (CW/CCW) of an arc through p[0], p[-1] within tolerance."""
     a, m, b = p[0], p[len(p) // 2], p[-1]
     ab, am = b - a, m - a
@@ -64,10 +81,13 @@ def _arc_fits(p: np.ndarray, tolerance: float, quantum: float) -> tuple[np.ndarr
     chord = np.hypot(*np.diff(p, axis=0).T).max()
     if chord * chord / (8 * radius) + np.abs(np.hypot(rel[:, 0], rel[:, 1]) - radius).max() > tolerance:
         return None
+    # reversed (later passes), the arc is written from its other end: allow for that radius
+    if _leaves_box(centre, radius + _RADIUS_MISMATCH, angles[0], angles[-1] - angles[0], box):
+        return None
     return centre, direction
 
 
-def fit_arcs(points: np.ndarray, tolerance: float, *, quantum: float = 0.001
+def fit_arcs(points: np.ndarray, tolerance: float, *, quantum: float = 0.001, box=None
              ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Lines and arcs through a subset of `points` that pass within `tolerance` of all.
 
@@ -87,7 +107,7 @@ def fit_arcs(points: np.ndarray, tolerance: float, *, quantum: float = 0.001
         run = p[i:j + 1]
         if _line_fits(run, tolerance):
             return LINE, None
-        arc = _arc_fits(run, tolerance, quantum)
+        arc = _arc_fits(run, tolerance, quantum, box)
         if arc is None:
             return None
         return arc[1], arc[0]

@@ -177,13 +177,13 @@ def _quantize(points: np.ndarray) -> np.ndarray:
     return np.round(points / QUANTUM) * QUANTUM + 0.0
 
 
-def _plan_stroke(stroke: Stroke, tolerance: float, arcs: bool) -> BurnPath | None:
+def _plan_stroke(stroke: Stroke, tolerance: float, arcs: bool, box) -> BurnPath | None:
     dense = _dedupe(_quantize(stroke.flatten(tolerance / 4)))
     if len(dense) < 2:
         return None
     fit_tolerance = 0.75 * tolerance - _ROUNDING_BUDGET
     if arcs:
-        points, kinds, centres = fit_arcs(dense, fit_tolerance, quantum=QUANTUM)
+        points, kinds, centres = fit_arcs(dense, fit_tolerance, quantum=QUANTUM, box=box)
         return BurnPath(points, kinds, centres)
     simple = shapely.get_coordinates(
         shapely.simplify(shapely.linestrings(dense), fit_tolerance, preserve_topology=False))
@@ -200,10 +200,11 @@ def plan_toolpath(drawing: Drawing, profile: LaserProfile,
     if not drawing.strokes:
         raise InputError("the drawing has no strokes to engrave")
     machine = _to_machine(drawing, profile, options)
+    box = (0.0, 0.0, profile.bed_width, profile.bed_height)  # no arc may bulge out of the bed
     planned: list[tuple[BurnPath, Stroke]] = []
     dropped = 0
     for stroke in machine.strokes:
-        path = _plan_stroke(stroke, options.tolerance, options.arcs)
+        path = _plan_stroke(stroke, options.tolerance, options.arcs, box)
         if path is None:
             dropped += 1
         else:
