@@ -317,15 +317,20 @@ class GrblEmulator:
                 wait = max(0.0003, min(wire_t + byte_time * min(len(pending), 16) - now, 0.05))
             else:
                 wait = 0.05
+            fd = self._fd
+            if fd is None:
+                return
             try:
-                ready, _, _ = select.select([self._fd], [], [], wait)
-            except (OSError, ValueError):
+                ready, _, _ = select.select([fd], [], [], wait)
+            except (OSError, ValueError, TypeError):
                 return
             if ready:
                 try:
-                    data = os.read(self._fd, 4096)
+                    data = os.read(fd, 4096)
                 except BlockingIOError:
                     data = b""
+                except (TypeError, ValueError):
+                    return
                 except OSError as error:
                     if error.errno == errno.EIO:  # no host has the port open
                         time.sleep(0.01)
@@ -809,6 +814,8 @@ class GrblEmulator:
                     # The protocol thread holds a parsed block waiting for this free slot; on
                     # GRBL it would join the look-ahead while this block runs.
                     self._cond.wait_for(lambda: not self._adding or self._reset_pending, timeout=0.005)
+                    if self._reset_pending or not self.planner or self.hold or self.stalled or self.critical:
+                        continue  # things changed while the lock was released
                 planned = self.planner[0]
                 window = [p.block for p in self.planner]
                 fo, ro = self.feed_ov / 100.0, self.rapid_ov / 100.0

@@ -1,0 +1,260 @@
+"""Streaming to the emulator on a real pty: completeness, flow control, speed, pause/resume,
+and every fault path through the `onestroke stream` command (beam off, one line, exit code)."""
+
+import math
+import os
+import re
+import signal
+import subprocess
+import sys
+import threading
+import time
+
+import pytest
+from click.testing import CliRunner
+
+from fabrication.cli import main
+from machines.emulator import EmulatorOptions, Faults, GrblEmulator
+from machines.gcode_program import program_from_text
+from machines.ports import open_port
+from machines.streamer import DRAIN_LINE, GrblStreamer, StreamOptions
+
+
+def job_text(n, *, step=0.5, feed=3000, seed=0):
+    """A curvy single-stroke job of n G1 lines (no blank lines: file line k = program line k)."""
+    lines = ["G21", "G90", "M4 S600", "G0 X100 Y100", f"F{feed}"]
+    x = y = 100.0
+    for i in range(n):
+        t = 0.004 * i + seed
+        x += step * math.cos(3 * math.sin(t * 2.0) + t)
+        y += step * math.sin(3 * math.sin(t * 2.0) + t)
+        lines.append(f"G1X{x:.3f}Y{y:.3f}")
+    lines += ["M5", "G0X0Y0"]
+    return "\n".join(lines) + "\n"
+
+
+@pytest.fixture
+def emulator():
+    made = []
+
+    def make(**options):
+        options.setdefault("time_scale", 40.0)
+        emu = GrblEmulator(EmulatorOptions(**options))
+        emu.start_pty()
+        made.append(emu)
+        return emu
+
+    yield make
+    for emu in made:
+        emu.stop()
+
+
+def cleaned(text):
+    return [line for _, line in program_from_text(text).lines]
+
+
+def stream(emu, text, **options):
+    port = open_port(emu.device)
+    streamer = GrblStreamer(port, options=StreamOptions(**options))
+    try:
+        streamer.connect()
+        return streamer.stream(program_from_text(text))
+    finally:
+        streamer.close()
+
+
+def test_job_runs_every_line_once_in_order_without_overflow_near_planner_time(emulator):
+    scale = 8.0
+    emu = emulator(time_scale=scale)
+    text = job_text(2500, step=0.4)
+    result = stream(emu, text)
+    stats = emu.stats()
+    assert emu.executed == cleaned(text) + [DRAIN_LINE]
+    assert stats.rx_overflow_bytes == 0 and stats.max_rx_used <= 128
+    ratio = result.elapsed * scale / stats.planner_limited_time
+    print(f"\ncharacter counting: {result.elapsed * scale:.2f} s machine, planner-limited "
+          f"{stats.planner_limited_time:.2f} s, ratio {ratio:.3f}")
+    assert ratio <= 1.05
+    assert not emu.beam_on and stats.state == "Idle"
+
+
+def test_send_response_is_slower_on_dense_work(emulator):
+    scale = 4.0
+    text = job_text(600, step=0.15, feed=3600)
+    times = {}
+    for mode in (False, True):
+        emu = emulator(time_scale=scale)
+        result = stream(emu, text, send_response=mode)
+        assert emu.executed == cleaned(text) + [DRAIN_LINE]
+        times[mode] = result.elapsed * scale / emu.stats().planner_limited_time
+    print(f"\nratio to planner-limited time: character counting {times[False]:.3f}, "
+          f"send-response {times[True]:.3f}")
+    assert times[True] > times[False] * 1.05
+
+
+def test_pause_and_resume_lose_and_repeat_nothing(emulator):
+    emu = emulator(time_scale=10.0)
+    text = job_text(800)
+    port = open_port(emu.device)
+    streamer = GrblStreamer(port)
+    streamer.connect()
+    done = {}
+    thread = threading.Thread(target=lambda: done.setdefault("result", streamer.stream(program_from_text(text))))
+    thread.start()
+    while len(emu.executed) < 300:
+        time.sleep(0.01)
+    streamer.pause()
+    assert streamer.wait_status(lambda s: s.full_state == "Hold:0", 3.0) is not None
+    moved = emu.stats().blocks_executed
+    time.sleep(0.3)  # GRBL keeps parsing into the planner during a hold until it is full
+    held = len(emu.executed)
+    time.sleep(0.3)
+    assert len(emu.executed) == held and emu.stats().blocks_executed == moved  # nothing moves in Hold:0
+    assert not emu.beam_on or not emu._motion_busy
+    streamer.resume()
+    thread.join(30)
+    streamer.close()
+    assert "result" in done
+    assert emu.executed == cleaned(text) + [DRAIN_LINE]
+    assert emu.position[:2] == pytest.approx((0.0, 0.0))  # the last move (G0X0Y0) completed
+
+
+# ---------------------------------------------------------------- faults, through the CLI
+
+def run_cli(tmp_path, emu, text, *extra):
+    path = tmp_path / "job.gcode"
+    path.write_text(text)
+    result = CliRunner().invoke(main, ["stream", str(path), "--port", emu.device, *extra])
+    errors = [line for line in result.stderr.splitlines() if line.startswith("error:")]
+    return result, errors
+
+
+def assert_beam_off_after(emu):
+    assert not emu.beam_on
+    assert emu.resets >= 2 or emu.spindle_history[-1][0] == "M5" or emu.disconnected
+
+
+def last_acked(message):
+    match = re.search(r"last acknowledged line (\d+)", message)
+    assert match, message
+    return int(match.group(1))
+
+
+def test_error_mid_job(tmp_path, emulator):
+    emu = emulator(faults=Faults(error_at=400))
+    result, errors = run_cli(tmp_path, emu, job_text(1000))
+    assert result.exit_code == 1 and len(errors) == 1
+    assert "line 400" in errors[0] and "error:20" in errors[0]
+    assert last_acked(errors[0]) == 399
+    assert_beam_off_after(emu)
+    assert 3 not in emu.alarms  # reset after the hold: no ALARM:3
+
+
+def test_alarm_mid_job(tmp_path, emulator):
+    emu = emulator(faults=Faults(alarm_at=500))
+    result, errors = run_cli(tmp_path, emu, job_text(1000))
+    assert result.exit_code == 1 and len(errors) == 1
+    assert "ALARM:1" in errors[0] and "Hard limit" in errors[0] and "$H" in errors[0]
+    assert last_acked(errors[0]) == 499
+    assert_beam_off_after(emu)
+
+
+def test_port_closed_mid_job(tmp_path, emulator):
+    emu = emulator(faults=Faults(disconnect_at=300))
+    result, errors = run_cli(tmp_path, emu, job_text(1000))
+    assert result.exit_code == 1 and len(errors) == 1
+    assert "lost the connection" in errors[0]
+    assert 290 <= last_acked(errors[0]) <= 300
+    assert_beam_off_after(emu)
+
+
+def test_garbage_bytes_on_the_line(tmp_path, emulator):
+    emu = emulator(faults=Faults(garbage_at=250))
+    result, errors = run_cli(tmp_path, emu, job_text(1000))
+    assert result.exit_code == 1 and len(errors) == 1
+    assert "unreadable bytes" in errors[0]
+    assert 250 <= last_acked(errors[0]) <= 260
+    assert_beam_off_after(emu)
+
+
+def test_no_answer_at_connect(tmp_path, emulator):
+    emu = emulator(faults=Faults(silent=True))
+    result, errors = run_cli(tmp_path, emu, job_text(10))
+    assert result.exit_code == 1 and len(errors) == 1
+    assert "no answer" in errors[0] and "no line was acknowledged" in errors[0]
+    assert emu.executed == [] and not emu.beam_on
+
+
+def test_lost_ok(tmp_path, emulator):
+    emu = emulator(faults=Faults(drop_ok_at=200))
+    result, errors = run_cli(tmp_path, emu, job_text(400))
+    assert result.exit_code == 1 and len(errors) == 1
+    assert "'ok' was lost" in errors[0]
+    assert last_acked(errors[0]) >= 200  # later answers are attributed one line early
+    assert_beam_off_after(emu)
+
+
+def test_idle_stall_with_queued_blocks_is_recovered(tmp_path, emulator):
+    emu = emulator(faults=Faults(stall_at=300))
+    text = job_text(600)
+    result, errors = run_cli(tmp_path, emu, text)
+    assert result.exit_code == 0, result.output
+    assert "stalled Idle" in result.stderr and errors == []
+    assert emu.executed == cleaned(text) + [DRAIN_LINE]
+
+
+def test_ctrl_c_halts_safely(tmp_path, emulator):
+    emu = emulator(time_scale=5.0)
+    path = tmp_path / "job.gcode"
+    path.write_text(job_text(3000))
+    env = {**os.environ, "PYTHONUNBUFFERED": "1"}
+    process = subprocess.Popen([sys.executable, "-c", "from fabrication.cli import main; main()", "stream",
+                                str(path), "--port", emu.device], stderr=subprocess.PIPE, text=True, env=env)
+    deadline = time.monotonic() + 30
+    while len(emu.executed) < 400 and time.monotonic() < deadline:
+        time.sleep(0.02)
+    assert emu.beam_on  # burning when interrupted
+    process.send_signal(signal.SIGINT)
+    _, stderr = process.communicate(timeout=30)
+    errors = [line for line in stderr.splitlines() if line.startswith("error:")]
+    assert process.returncode == 130 and len(errors) == 1
+    assert "Ctrl-C" in errors[0] and last_acked(errors[0]) >= 400
+    assert_beam_off_after(emu)
+    assert 3 not in emu.alarms and emu.stats().state == "Idle"
+
+
+def test_alarm_at_boot_is_reported_with_the_unlock_hint(tmp_path, emulator):
+    emu = emulator(boot_alarm=True)
+    result, errors = run_cli(tmp_path, emu, job_text(10))
+    assert result.exit_code == 1 and len(errors) == 1 and "$X" in errors[0] and "$H" in errors[0]
+    assert emu.executed == []
+
+
+def test_cli_check_mode_and_preflight_table(tmp_path, emulator):
+    emu = emulator()
+    result, errors = run_cli(tmp_path, emu, job_text(50), "--check")
+    assert result.exit_code == 0 and "check passed" in result.stdout
+    assert emu.stats().blocks_executed == 0
+    emu = emulator(settings={30: 255})
+    result, errors = run_cli(tmp_path, emu, job_text(50))
+    assert result.exit_code == 2 and "$30=255" in errors[0] and emu.executed == []
+    emu = emulator()
+    result, errors = run_cli(tmp_path, emu, "G21\nG5 X1\n")
+    assert result.exit_code == 2 and "line 2" in errors[0] and "error:20" in errors[0]
+    result = CliRunner().invoke(main, ["stream", str(tmp_path / "nope.gcode"), "--port", "sim://"])
+    assert result.exit_code == 2
+    result = CliRunner().invoke(main, ["stream", str(tmp_path / "job.gcode"), "--port", "/dev/does-not-exist"])
+    assert result.exit_code == 1 and "does not exist" in result.stderr
+    result = CliRunner().invoke(main, ["stream", str(tmp_path / "job.gcode"), "--port", "sim://", "--baud", "7"])
+    assert result.exit_code == 2 and "--baud 7" in result.stderr
+
+
+def test_cli_sim_dry_run_and_frame(tmp_path):
+    path = tmp_path / "job.gcode"
+    path.write_text(job_text(200))
+    result = CliRunner().invoke(main, ["stream", str(path), "--port", "sim://?speed=50"])
+    assert result.exit_code == 0 and "streamed 207 lines" in result.stdout
+    result = CliRunner().invoke(main, ["stream", str(path), "--port", "sim://?speed=50", "--frame"])
+    assert result.exit_code == 0 and "framed" in result.stdout and "beam off" in result.stdout
+    result = CliRunner().invoke(main, ["ports", "--no-probe"])
+    assert result.exit_code == 0 and "serial port" in result.stdout
