@@ -62,12 +62,16 @@ _STYLE_FIELDS = {
 @click.option("--preview-width", type=int, default=1000, show_default=True, help="Preview width in px.")
 @click.option("--multi", is_flag=True, help="Raster input: multi-stroke vectorization.")
 @click.option("--threshold", type=float, default=None, help="Raster input: ink threshold in (0, 1).")
+@click.option("--blur", type=float, default=0.0, show_default=True, help="Raster input: Gaussian blur sigma in px.")
+@click.option("--classifier", default="cnn", show_default=True,
+              help="Raster input: crossing classifier, cnn or geometric.")
 def embroider(source: str, output: str, style: str, size: str | None, width: str | None, height: str | None,
               rotate: float, hoop: str, fit: bool, stitch_length: str | None, tolerance: str | None,
               stitch_width: str | None, spacing: str | None, pull_comp: str | None, repeats: int | None,
               arrow_size: str | None, min_stitch: str, max_stitch: str, trim_distance: str, lock_form: str,
               color: str, pes_version: int | None, spm: float | None, preview_path: str | None,
-              preview_width: int, multi: bool, threshold: float | None) -> None:
+              preview_width: int, multi: bool, threshold: float | None, blur: float,
+              classifier: str) -> None:
     """Sew SOURCE (PNG/JPG/SVG/JSON drawing) along its curve into an embroidery file."""
     from fabrication.embroidery.canvas import check_preview_path
     from fabrication.embroidery.export import PES_VERSIONS, write_embroidery
@@ -139,7 +143,7 @@ def embroider(source: str, output: str, style: str, size: str | None, width: str
     else:
         from fabrication.cli.common import read_drawing
 
-        drawing = read_drawing(source, multi=multi, threshold=threshold)
+        drawing = read_drawing(source, multi=multi, threshold=threshold, blur=blur, classifier=classifier)
     placed = fit_to_hoop(place(drawing, placement), the_hoop, reach=style_reach(stitch_options), fit=fit)
     plan = plan_embroidery(placed, plan_options)
     check_plan_in_hoop(plan, the_hoop)

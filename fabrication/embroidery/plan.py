@@ -110,12 +110,14 @@ class StitchPlan:
     """Rows in sewing order. points (N, 2) mm on the 0.1 mm grid; kinds (N,) STITCH (needle
     down here), JUMP (move here needle up) or TRIM (cut at the current point); roles (N,)
     needle roles (BODY, TACK, LOCK, ...); params (N,): stroke index + curve parameter t
-    (NaN on jumps and trims); color: thread RGB; skipped: strokes too short to sew."""
+    (NaN on jumps and trims); strokes (N,): index of the drawing's stroke each row sews
+    (-1 on trims and jumps); color: thread RGB; skipped: strokes too short to sew."""
 
     points: np.ndarray
     kinds: np.ndarray
     roles: np.ndarray
     params: np.ndarray
+    strokes: np.ndarray
     color: tuple[int, int, int] = (0, 0, 0)
     skipped: int = 0
 
@@ -151,12 +153,13 @@ class StitchPlan:
 def _assemble(drawing: Drawing, options: PlanOptions):
     """Rows before cleanup: float points, kinds, roles, params; and the skipped count."""
     generate = _GENERATORS[type(options.style)]
-    pts, kinds, roles, params = [], [], [], []
+    pts, kinds, roles, params, owners = [], [], [], [], []
     current: np.ndarray | None = None
     offset, skipped = 0.0, 0
 
-    def add(p, kind, role, param):
+    def add(p, kind, role, param, owner):
         p = np.atleast_2d(p)
+        owners.append(np.full(len(p), owner, dtype=np.int64))
         pts.append(p)
         kinds.append(np.full(len(p), kind, dtype=np.uint8))
         roles.append(np.broadcast_to(np.asarray(role, dtype=np.uint8), (len(p),)))
@@ -174,22 +177,22 @@ def _assemble(drawing: Drawing, options: PlanOptions):
         connect = TACK
         if current is not None:
             if np.linalg.norm(path[0] - current) > options.trim_distance:
-                add(current, TRIM, TRAVEL, np.nan)
-                add(path[0], JUMP, TRAVEL, np.nan)
+                add(current, TRIM, TRAVEL, np.nan, -1)
+                add(path[0], JUMP, TRAVEL, np.nan, -1)
             else:
                 connect = TRAVEL  # a short stitch from the last stroke's end
         tack = tack_points(path, options.lock)
-        add(tack, STITCH, [connect, TACK, TACK, TACK], index + body.t[0])
+        add(tack, STITCH, [connect, TACK, TACK, TACK], index + body.t[0], index)
         body_roles = body.roles.copy()
         body_roles[0] = TACK  # the stitch into the start closes the tack
-        add(path, STITCH, body_roles, index + body.t)
-        add(lock_points(path, options.lock), STITCH, LOCK, index + body.t[-1])
+        add(path, STITCH, body_roles, index + body.t, index)
+        add(lock_points(path, options.lock), STITCH, LOCK, index + body.t[-1], index)
         current = path[-1]
     if not pts:
         raise InputError("no stroke is long enough to stitch "
                          f"(all shorter than the minimum stitch {options.min_stitch:g} mm)")
     return (np.concatenate(pts), np.concatenate(kinds), np.concatenate(roles),
-            np.concatenate(params), skipped)
+            np.concatenate(params), np.concatenate(owners), skipped)
 
 
 def _merge_short(units: np.ndarray, kinds: np.ndarray, roles: np.ndarray, min_units: float) -> np.ndarray:
@@ -236,7 +239,7 @@ def _merge_short(units: np.ndarray, kinds: np.ndarray, roles: np.ndarray, min_un
     return keep
 
 
-def _split_long(units, kinds, roles, params, max_units: int):
+def _split_long(units, kinds, roles, params, owners, max_units: int):
     """Split needle-down moves longer than `max_units` per axis into real stitches, on the grid."""
     sewn = np.zeros(len(units), dtype=bool)
     sewn[1:] = (kinds[1:] == STITCH) & (kinds[:-1] == STITCH)
@@ -245,7 +248,7 @@ def _split_long(units, kinds, roles, params, max_units: int):
     pieces = np.where(sewn, -(-step // max_units), 1)
     pieces = np.maximum(pieces, 1)
     if pieces.max() == 1:
-        return units, kinds, roles, params
+        return units, kinds, roles, params, owners
     # Row i becomes pieces[i] rows: intermediate points on the way from row i - 1.
     owner = np.repeat(np.arange(len(units)), pieces)
     k = np.arange(owner.size) - np.repeat(np.cumsum(pieces) - pieces, pieces) + 1
@@ -255,7 +258,7 @@ def _split_long(units, kinds, roles, params, max_units: int):
     new_units = prev + np.floor((units[owner] - prev) * frac[:, None] + 0.5).astype(np.int64)
     prev_param = params[np.maximum(owner - 1, 0)]
     new_params = prev_param + (params[owner] - prev_param) * frac
-    return new_units, kinds[owner], roles[owner], new_params
+    return new_units, kinds[owner], roles[owner], new_params, owners[owner]
 
 
 def plan_embroidery(drawing: Drawing, options: PlanOptions = PlanOptions()) -> StitchPlan:
@@ -264,13 +267,13 @@ def plan_embroidery(drawing: Drawing, options: PlanOptions = PlanOptions()) -> S
         raise InputError(f"place the drawing in mm before stitching (it is in {drawing.unit})")
     if not drawing.strokes:
         raise InputError("the drawing has no strokes to stitch")
-    points, kinds, roles, params, skipped = _assemble(drawing, options)
+    points, kinds, roles, params, owners, skipped = _assemble(drawing, options)
     units = np.rint(points / options.grid).astype(np.int64)
     keep = _merge_short(units, kinds, roles, options.min_stitch / options.grid - 1e-9)
-    units, kinds, roles, params = units[keep], kinds[keep], roles[keep], params[keep]
+    units, kinds, roles, params, owners = units[keep], kinds[keep], roles[keep], params[keep], owners[keep]
     max_units = int(np.floor(options.max_stitch / options.grid + 1e-9))
-    units, kinds, roles, params = _split_long(units, kinds, roles, params, max_units)
+    units, kinds, roles, params, owners = _split_long(units, kinds, roles, params, owners, max_units)
     if not np.any(kinds == STITCH):
         raise FabricationError("no needle points left after merging short stitches")
     return StitchPlan(points=units * options.grid, kinds=kinds, roles=roles, params=params,
-                      color=tuple(int(c) for c in options.color), skipped=skipped)
+                      strokes=owners, color=tuple(int(c) for c in options.color), skipped=skipped)

@@ -60,5 +60,5 @@ def read_embroidery(path: str | os.PathLike) -> EmbroideryFile:
     threads = tuple(tuple(int(v) for v in (t.get_red(), t.get_green(), t.get_blue()))
                     for t in pattern.threadlist) or ((0, 0, 0),)
     plan = StitchPlan(points=points, kinds=kinds, roles=np.full(len(points), BODY, dtype=np.uint8),
-                      params=params, color=threads[0])
+                      params=params, strokes=np.where(kinds == STITCH, 0, -1), color=threads[0])
     return EmbroideryFile(plan=plan, threads=threads, color_changes=changes)

@@ -6,7 +6,8 @@ On tight inner curves the inside points crowd: every other inner point is inset
 (Ink/Stitch's short stitches), the inside reach is capped below the curve radius, and a
 rail point still closer than `min_gap` to the previous one on its rail is dropped (the
 outside fans round a shared inner point). Wide zigzags get a centre-walk underlay sewn
-there and back first, and zigs longer than `max_stitch` are split at staggered points.
+there and back first (back between the holes of the way out), and zigs longer than
+`max_stitch` are split at staggered points.
 """
 
 from __future__ import annotations
@@ -150,7 +151,8 @@ def zigzag_stitch(stroke: Stroke, options: ZigzagOptions = ZigzagOptions()) -> N
         return zig
     walk = running_stitch(stroke, RunningOptions(stitch_length=options.underlay_stitch_length,
                                                  tolerance=options.tolerance), curve=curve)
-    back = walk.take(np.arange(len(walk) - 2, -1, -1))
-    under = NeedlePoints.of(np.concatenate([walk.points, back.points]),
-                            np.concatenate([walk.t, back.t]), UNDERLAY)
+    # The walk back pierces halfway between the holes of the walk out, ending on the start.
+    back_t = np.concatenate([0.5 * (walk.t[:-1] + walk.t[1:])[::-1], [walk.t[0]]])
+    under = NeedlePoints.of(np.concatenate([walk.points, stroke.points_at(back_t)]),
+                            np.concatenate([walk.t, back_t]), UNDERLAY)
     return NeedlePoints.concat([under, zig])
