@@ -1,0 +1,135 @@
+"""`onestroke laser`: a table of invocations with exit codes; bad input writes nothing."""
+
+from __future__ import annotations
+
+import importlib.util
+
+import pytest
+from click.testing import CliRunner
+
+from fabrication.cli import main
+from fabrication.laser.gcode_read import parse_gcode, validate_gcode
+from laser_fixtures import rose_drawing, trefoil_png
+from vectorize.svg_write import write_drawing
+
+
+@pytest.fixture(scope="module")
+def svg(tmp_path_factory):
+    path = tmp_path_factory.mktemp("in") / "rose.svg"
+    write_drawing(rose_drawing(), str(path))
+    return path
+
+
+def run(*args):
+    return CliRunner().invoke(main, ["laser", *map(str, args)], catch_exceptions=False)
+
+
+def test_writes_gcode_frame_and_preview(svg, tmp_path):
+    out = tmp_path / "job.gcode"
+    result = run(svg, "-o", out, "--size", "50mm", "--feed", "2000mm/min", "--power", "40%", "--passes", "2",
+                 "--frame", "--preview", tmp_path / "p.png", "--arcs")
+    assert result.exit_code == 0, result.output
+    lines = out.read_text().splitlines()
+    assert validate_gcode(lines) == []
+    assert any("estimated time" in line for line in lines[:6])
+    assert "S400F2000" in out.read_text()
+    frame = tmp_path / "job.frame.gcode"
+    assert frame.exists() and validate_gcode(frame.read_text().splitlines()) == []
+    assert (tmp_path / "p.png").stat().st_size > 1000
+    assert "estimated" in result.stdout
+    moves = parse_gcode(lines)
+    burn = moves.end[moves.laser_on]
+    assert burn.max(axis=0).max() == pytest.approx(50.0, abs=0.02)
+
+
+def test_profile_and_center_origin(svg, tmp_path):
+    profile = tmp_path / "small.toml"
+    profile.write_text('name = "small"\n[bed]\nsize = "100x80mm"\n[laser]\nmax_power = 255\n')
+    out = tmp_path / "job.gcode"
+    result = run(svg, "-o", out, "--size", "40mm", "--profile", profile, "--origin", "center", "--power", "100%")
+    assert result.exit_code == 0, result.output
+    moves = parse_gcode(out.read_text().splitlines())
+    burn = moves.end[moves.laser_on]
+    centre = (burn.min(axis=0) + burn.max(axis=0)) / 2
+    assert centre == pytest.approx([50.0, 40.0], abs=0.05)
+    assert set(moves.power[moves.laser_on]) == {255.0}
+
+
+BAD = [
+    (["--size", "500mm"], "does not fit the bed"),
+    (["--power", "150%"], "--power"),
+    (["--power", "0%"], "--power"),
+    (["--feed", "0"], "--feed"),
+    (["--feed", "-100mm/min"], "--feed"),
+    (["--feed", "fast"], "--feed"),
+    (["--passes", "0"], "--passes"),
+    (["--size", "-3mm"], "--size"),
+    (["--tolerance", "0.001mm"], "tolerance"),
+    (["--profile", "/nonexistent/p.toml"], "does not exist"),
+]
+
+
+@pytest.mark.parametrize("extra,message", BAD)
+def test_bad_options_exit_2_and_write_nothing(svg, tmp_path, extra, message):
+    out = tmp_path / "job.gcode"
+    result = run(svg, "-o", out, "--preview", tmp_path / "p.png", "--frame", *extra)
+    assert result.exit_code == 2
+    assert message in result.stderr and result.stderr.startswith("error:")
+    assert len(result.stderr.strip().splitlines()) == 1 and "Traceback" not in result.output
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_bad_inputs_and_outputs(svg, tmp_path):
+    garbage = tmp_path / "broken.png"
+    garbage.write_bytes(b"not an image at all")
+    broken_profile = tmp_path / "broken.toml"
+    broken_profile.write_text("[motion]\nacceleration_x = 'fast'\n")
+    cases = [
+        ([tmp_path / "missing.svg", "-o", tmp_path / "a.gcode"], "does not exist"),
+        ([garbage, "-o", tmp_path / "a.gcode"], "broken.png"),
+        ([tmp_path, "-o", tmp_path / "a.gcode"], "directory"),
+        ([svg, "-o", tmp_path / "no" / "such" / "a.gcode"], "does not exist"),
+        ([svg, "-o", tmp_path / "a.png"], ".gcode"),
+        ([svg, "-o", tmp_path / "a.gcode", "--preview", tmp_path / "p.jpg"], "preview"),
+        ([svg, "-o", tmp_path / "a.gcode", "--profile", broken_profile], "acceleration"),
+    ]
+    for args, message in cases:
+        result = run(*args)
+        assert result.exit_code == 2, (args, result.output)
+        assert message in result.stderr, (args, result.stderr)
+        assert len(result.stderr.strip().splitlines()) == 1
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["broken.png", "broken.toml"]
+
+
+def test_unwritable_output_folder(svg, tmp_path):
+    locked = tmp_path / "locked"
+    locked.mkdir()
+    locked.chmod(0o500)
+    try:
+        import os
+
+        if os.access(locked, os.W_OK):  # running as root: permissions are not enforced
+            pytest.skip("permissions are not enforced for this user")
+        result = run(svg, "-o", locked / "a.gcode")
+        assert result.exit_code == 2 and "not writable" in result.stderr
+        assert list(locked.iterdir()) == []
+    finally:
+        locked.chmod(0o700)
+
+
+def test_failed_run_keeps_a_good_file(svg, tmp_path):
+    out = tmp_path / "job.gcode"
+    assert run(svg, "-o", out, "--size", "30mm").exit_code == 0
+    before = out.read_bytes()
+    assert run(svg, "-o", out, "--size", "900mm").exit_code == 2
+    assert out.read_bytes() == before
+
+
+@pytest.mark.skipif(importlib.util.find_spec("vectorize.cnn_classifier") is None,
+                    reason="the CNN crossing classifier is not in the tree yet")
+def test_png_end_to_end(tmp_path):
+    png = trefoil_png(tmp_path / "trefoil.png")
+    out = tmp_path / "trefoil.gcode"
+    result = run(png, "-o", out, "--size", "60mm", "--preview", tmp_path / "trefoil.png.svg")
+    assert result.exit_code == 0, result.output
+    assert validate_gcode(out.read_text().splitlines()) == []

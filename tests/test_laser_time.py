@@ -1,0 +1,117 @@
+"""The job-time estimate agrees with an independent GRBL planner simulation within 2 %."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from fabrication.laser.gcode_write import GcodeOptions, gcode_lines
+from fabrication.laser.job_time import estimate_gcode_time, format_duration
+from fabrication.laser.toolpath import ToolpathOptions, plan_toolpath
+from fabrication.placement import PlacementOptions
+from laser_fixtures import spiral_points, trefoil_png
+from laser_grbl_sim import simulate
+from machines.laser_profile import LaserProfile, load_laser_profile
+
+PROFILE = load_laser_profile()
+
+
+def _sim(lines, profile=PROFILE):
+    return simulate(lines, max_rate=(profile.max_rate_x, profile.max_rate_y),
+                    accel=(profile.acceleration_x, profile.acceleration_y),
+                    junction_deviation=profile.junction_deviation, arc_tolerance=profile.arc_tolerance,
+                    steps_per_mm=(profile.steps_per_mm_x, profile.steps_per_mm_y),
+                    planner_blocks=profile.planner_blocks)
+
+
+def straight_line(feed):
+    # G4P0 makes GRBL stop after the rapid, so the burn starts from rest (by-hand check below)
+    return ["G21", "G90", "M4S0", "G0X10Y10", "G4P0", f"G1X390Y390S600F{feed:g}", "M5", "M9"]
+
+
+def spiral(feed):
+    pts = spiral_points(segment=0.05, turns=6.0, r0=2.0, pitch=1.2)
+    body = ["G1X%.3fY%.3f" % tuple(p) for p in pts[1:]]
+    body[0] += f"S600F{feed:g}"
+    return ["G21", "G90", "M4S0", "G0X%.3fY%.3f" % tuple(pts[0])] + body + ["M5", "M9"]
+
+
+@pytest.fixture(scope="module")
+def vectorized_lines(tmp_path_factory):
+    from vectorize import VectorizeOptions, vectorize_file
+
+    png = trefoil_png(tmp_path_factory.mktemp("png") / "trefoil.png")
+    drawing = vectorize_file(png, VectorizeOptions(classifier="geometric")).drawing
+    out = {}
+    for arcs in (False, True):
+        tp = plan_toolpath(drawing, PROFILE, ToolpathOptions(placement=PlacementOptions(size=60), arcs=arcs))
+        out[arcs] = gcode_lines(tp, PROFILE, GcodeOptions(feed=3000.0, passes=2))
+    return out
+
+
+def _compare(lines, label):
+    job = estimate_gcode_time(lines, PROFILE)
+    sim = _sim(lines)
+    error = job.total_seconds / sim - 1
+    naive_error = job.naive_seconds / sim - 1
+    print(f"{label}: estimate {job.total_seconds:.3f} s, simulation {sim:.3f} s ({error:+.2%}), "
+          f"length/feed {job.naive_seconds:.3f} s ({naive_error:+.1%})")
+    assert abs(error) <= 0.02
+    return job, sim
+
+
+@pytest.mark.parametrize("feed", [1500.0, 6000.0])
+def test_long_straight_line(feed):
+    job, sim = _compare(straight_line(feed), f"straight line F{feed:g}")
+    # by hand: one trapezoid over 537.4 mm from rest to rest
+    length = np.hypot(380, 380)
+    v = feed / 60
+    accel = PROFILE.acceleration_x * np.sqrt(2)  # GRBL's per-axis limit on a diagonal
+    burn = length / v + v / accel
+    assert job.burn_seconds == pytest.approx(burn, rel=1e-3)
+
+
+@pytest.mark.parametrize("feed", [1500.0, 3000.0, 6000.0])
+def test_spiral_of_short_segments(feed):
+    job, sim = _compare(spiral(feed), f"spiral of 0.05 mm segments F{feed:g}")
+    if feed >= 3000:
+        # the planner, not the feed, limits dense work: length/feed is far too low
+        assert job.naive_seconds < 0.8 * sim
+
+
+@pytest.mark.parametrize("arcs", [False, True])
+def test_vectorized_drawing(vectorized_lines, arcs):
+    _compare(vectorized_lines[arcs], f"vectorized trefoil, {'arcs' if arcs else 'lines'}, F3000, 2 passes")
+
+
+def test_forced_stops_are_modelled():
+    # the same two strokes with an M5/M4 pair between them: GRBL stops there
+    smooth = ["G21", "G90", "M4S0", "G0X0Y0", "G1X50S500F3000", "G1X100", "M5"]
+    stopped = ["G21", "G90", "M4S0", "G0X0Y0", "G1X50S500F3000", "M5", "M4", "G1X100", "M5"]
+    a, b = estimate_gcode_time(smooth, PROFILE), estimate_gcode_time(stopped, PROFILE)
+    assert b.total_seconds > a.total_seconds + 0.05
+    assert b.total_seconds == pytest.approx(_sim(stopped), rel=0.02)
+    dwell = estimate_gcode_time(smooth[:-1] + ["G4P1.5", "M5"], PROFILE)
+    assert dwell.total_seconds == pytest.approx(a.total_seconds + 1.5, abs=1e-9)
+
+
+def test_per_line_seconds_are_cumulative():
+    lines = spiral(3000.0)
+    job = estimate_gcode_time(lines, PROFILE)
+    assert len(job.line_seconds) == len(lines)
+    assert np.all(np.diff(job.line_seconds) >= 0)
+    assert job.line_seconds[-1] == pytest.approx(job.total_seconds)
+    assert job.line_seconds[3] == pytest.approx(job.travel_seconds)  # the G0 comes first
+    assert job.line_seconds[2] == 0.0
+
+
+def test_slower_machine_takes_longer():
+    slow = LaserProfile(acceleration_x=100.0, acceleration_y=100.0)
+    lines = spiral(3000.0)
+    assert estimate_gcode_time(lines, slow).total_seconds > 1.2 * estimate_gcode_time(lines, PROFILE).total_seconds
+
+
+def test_format_duration():
+    assert format_duration(12.34) == "12.3 s"
+    assert format_duration(125) == "2:05"
+    assert format_duration(3723) == "1:02:03"
