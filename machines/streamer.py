@@ -253,7 +253,10 @@ class GrblStreamer:
                 f"no answer from {self.name} within {self.options.connect_timeout:g} s: not a GRBL board, "
                 "wrong baud rate (--baud), or still booting; check the cable and 'onestroke ports'; "
                 "nothing was sent, no line was acknowledged")
-        time.sleep(0.05)  # the ALARM-lock message follows the welcome at once
+        # A board that reboots when the port opens may greet twice (its boot, then our
+        # reset); a reset arriving after the next command would swallow it, so wait it out.
+        while (again := self._wait_welcome(0.3)) is not None:
+            welcome = again
         options = self._collect("$I")
         for reply in options:
             if isinstance(reply, Message) and reply.kind == "OPT":

@@ -2,10 +2,13 @@
 
 from __future__ import annotations
 
+import dataclasses
+
 import click
 
 from fabrication.cli.common import console, done
-from machines.ports import list_ports
+from machines.ports import list_ports, probe_grbl
+from onestroke.errors import MachineError
 
 
 @click.command("ports")
@@ -18,9 +21,16 @@ def ports(probe: bool, probe_all: bool, baud: int) -> None:
     found = list_ports(probe=False)
     if probe:
         console.print("probing serial ports for GRBL (up to 2.5 s each) ...")
-        usb = [p.device for p in found if p.vid is not None or probe_all]
-        probed = {p.device: p for p in list_ports(probe=True, baud=baud) if p.device in usb}
-        found = [probed.get(p.device, p) for p in found]
+        probed = []
+        for port in found:
+            if port.vid is None and not probe_all:
+                probed.append(port)  # built-in UARTs: probing them only costs time
+                continue
+            try:
+                probed.append(dataclasses.replace(port, grbl_version=probe_grbl(port.device, baud=baud)))
+            except MachineError as error:
+                probed.append(dataclasses.replace(port, problem=str(error)))
+        found = probed
     if not found:
         done("no serial ports found: plug the machine in over USB (and switch it on); on Linux check 'dmesg'")
         return
