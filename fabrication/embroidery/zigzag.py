@@ -73,25 +73,26 @@ class ZigzagOptions:
         return self.width > self.underlay_min_width if self.underlay is None else bool(self.underlay)
 
 
-def _drop_crowded(points: np.ndarray, min_gap: float) -> np.ndarray:
-    """Mask of points to keep so that no point comes within `min_gap` of the previous kept
-    point on its rail (rails alternate: even and odd indices). Only crowded points and the
-    ones after a dropped point are visited one by one."""
+def _drop_crowded(points: np.ndarray, min_gap: float, inner: np.ndarray) -> np.ndarray:
+    """Mask of points to keep so that no `inner` point comes within `min_gap` of the
+    previous kept point on its rail (rails alternate: even and odd indices). Points on the
+    outside of a curve or on straight parts keep the requested spacing. Only crowded points
+    and the ones after a dropped point are visited one by one."""
     keep = np.ones(len(points), dtype=bool)
     gaps = np.full(len(points), np.inf)
     gaps[2:] = np.linalg.norm(points[2:] - points[:-2], axis=1)
-    work = sorted(np.flatnonzero(gaps < min_gap).tolist())
+    work = sorted(np.flatnonzero((gaps < min_gap) & inner).tolist())
     queued = set(work)
     while work:
         i = heapq.heappop(work)
-        if i == len(points) - 1:
+        if i == len(points) - 1 or not inner[i]:
             continue  # the end point anchors the lock
         k = i - 2
         while k >= 0 and not keep[k]:
             k -= 2
         if k >= 0 and np.hypot(*(points[i] - points[k])) < min_gap:
             keep[i] = False
-            if i + 2 < len(points) and i + 2 not in queued:
+            if i + 2 < len(points) and inner[i + 2] and i + 2 not in queued:
                 queued.add(i + 2)
                 heapq.heappush(work, i + 2)
     return keep
@@ -143,7 +144,8 @@ def zigzag_stitch(stroke: Stroke, options: ZigzagOptions = ZigzagOptions()) -> N
     short = inner & (rail_gap < options.short_stitch_distance) & ((np.arange(len(s)) // 2) % 2 == 1)
     reach[short] *= 1.0 - options.short_stitch_inset
     points = centre + normal * (side * reach)[:, None]
-    keep = _drop_crowded(points, options.min_gap)
+    # Inner points of a real curve (radius under 50 mm) may be dropped when crowded.
+    keep = _drop_crowded(points, options.min_gap, inner & (np.abs(kappa) > 0.02))
     points, t = points[keep], t[keep]
     points, t = _split_long(points, t, options.max_stitch - 2 * SNAP_ALLOWANCE)
     zig = NeedlePoints.of(points, t, BODY)

@@ -1,0 +1,173 @@
+"""Whole-design rules: locks, minimum and maximum stitch, trims, hoops, stats and density."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from embroidery_fixtures import design, lock_figure_ok, sewn_stitches, spiral, stroke_rows
+from fabrication.embroidery.hooping import check_plan_in_hoop, fit_to_hoop
+from fabrication.embroidery.locks import LOCK_FORMS, LockOptions, lock_points, tack_points
+from fabrication.embroidery.needles import BODY, LOCK, TACK, TRAVEL
+from fabrication.embroidery.plan import (JUMP, STITCH, TRIM, PlanOptions, StitchPlan, plan_embroidery,
+                                         style_options, style_reach)
+from fabrication.embroidery.running import RunningOptions
+from fabrication.embroidery.stats import embroidery_stats
+from fabrication.embroidery.thread import parse_color
+from fabrication.embroidery.zigzag import ZigzagOptions
+from fabrication.placement import PlacementOptions, place
+from machines.hoops import Hoop, hoop_named
+from onestroke.errors import InputError
+from vectorize.drawing import Drawing
+from vectorize.stroke import Stroke
+
+
+def _line(*pts):
+    return Stroke.from_polyline(np.array(pts, dtype=float))
+
+
+def test_half_stitch_lock_walks_back_along_the_path():
+    path = np.array([[0.0, 0.0], [2.5, 0.0], [5.0, 0.0]])
+    assert np.allclose(lock_points(path), [[4.25, 0], [3.5, 0], [4.25, 0], [5.0, 0]])
+    assert np.allclose(tack_points(path), [[0, 0], [0.75, 0], [1.5, 0], [0.75, 0]])
+    # A path shorter than the lock length: the lock spans the path.
+    short = np.array([[0.0, 0.0], [0.8, 0.0]])
+    assert np.allclose(lock_points(short), [[0.4, 0], [0, 0], [0.4, 0], [0.8, 0]])
+    assert np.allclose(lock_points(path, LockOptions(form="back_forth")),
+                       [[3.5, 0], [5, 0], [3.5, 0], [5, 0]])
+    for form in LOCK_FORMS:
+        assert np.all(np.diff(LOCK_FORMS[form]) != 0)  # never a zero-length lock stitch
+    with pytest.raises(InputError):
+        LockOptions(form="bowtie")
+
+
+@pytest.mark.parametrize("form", list(LOCK_FORMS))
+def test_lock_forms_in_a_plan_never_have_zero_length(form):
+    plan = plan_embroidery(design(), PlanOptions(lock=LockOptions(form=form)))
+    assert np.hypot(*sewn_stitches(plan).T).min() > 0
+
+
+def test_short_stitches_are_merged_away_outside_locks():
+    # A wobbly line with 0.05-0.25 mm pieces and a long stitch length chosen so that the
+    # running stitch must follow the pieces: min-stitch merging has to act.
+    x = np.cumsum(np.r_[0, np.tile([0.05, 0.25, 0.1], 40)])
+    y = np.tile([0.0, 0.3], len(x))[:len(x)]
+    stroke = _line(*np.c_[x, y])
+    for minimum in (0.3, 1.0):
+        plan = plan_embroidery(Drawing((stroke,), 20, 2, "mm"),
+                               PlanOptions(style=RunningOptions(corner_angle=170), min_stitch=minimum))
+        lengths = np.hypot(*sewn_stitches(plan).T)
+        roles = plan.roles[np.flatnonzero(plan.stitch_mask)]
+        assert lengths.min() > 0
+        assert lengths[~np.isin(roles, (TACK, LOCK))].min() >= minimum - 1e-9
+        rows = stroke_rows(plan)[0]
+        assert lock_figure_ok(plan.points[rows[:5]]) and lock_figure_ok(plan.points[rows[-5:]])
+
+
+def test_long_needle_down_moves_are_split_into_stitches_not_jumps():
+    # Two strokes 2.9 mm apart are joined by a stitch; a running stitch of 10 mm with a
+    # 4 mm maximum gets split on the 0.1 mm grid into real stitches.
+    drawing = Drawing((_line([0, 0], [30, 0]), _line([30, 2.9], [0, 2.9])), 30, 3, "mm")
+    plan = plan_embroidery(drawing, PlanOptions(style=RunningOptions(stitch_length=10.0), max_stitch=4.0))
+    assert not (plan.kinds != STITCH).any()
+    assert np.abs(sewn_stitches(plan)).max() <= 4.0 + 1e-9
+    assert np.allclose(plan.points * 10, np.rint(plan.points * 10))
+    with pytest.raises(InputError):
+        PlanOptions(max_stitch=0.5)
+
+
+def test_trim_only_when_strokes_are_far_apart():
+    near = Drawing((_line([0, 0], [10, 0]), _line([12.9, 0], [20, 0])), 20, 1, "mm")
+    far = Drawing((_line([0, 0], [10, 0]), _line([13.5, 0], [20, 0])), 20, 1, "mm")
+    plan_near, plan_far = plan_embroidery(near), plan_embroidery(far)
+    assert not (plan_near.kinds != STITCH).any()
+    rows = stroke_rows(plan_near)[1]
+    assert plan_near.roles[rows[0]] == TRAVEL  # a short travel stitch, then the tack
+    assert list(plan_far.kinds[plan_far.kinds != STITCH]) == [TRIM, JUMP]
+    trim = int(np.flatnonzero(plan_far.kinds == TRIM)[0])
+    assert plan_far.roles[trim - 1] == LOCK and np.allclose(plan_far.points[trim], [10, 0])
+    assert np.allclose(plan_far.points[trim + 1], [13.5, 0])
+    custom = plan_embroidery(near, PlanOptions(trim_distance=1.0))
+    assert (custom.kinds == TRIM).sum() == 1
+
+
+def test_strokes_too_short_to_sew_are_skipped_and_counted():
+    drawing = Drawing((_line([0, 0], [10, 0]), _line([20, 0], [20.1, 0])), 20, 1, "mm")
+    plan = plan_embroidery(drawing)
+    assert plan.skipped == 1 and set(np.unique(plan.strokes[plan.kinds == STITCH])) == {0}
+    with pytest.raises(InputError):
+        plan_embroidery(Drawing((_line([0, 0], [0.1, 0]),), 1, 1, "mm"))
+    with pytest.raises(InputError):
+        plan_embroidery(Drawing((_line([0, 0], [10, 0]),), 10, 1, "px"))
+
+
+def test_style_options_by_name():
+    assert isinstance(style_options("zigzag", width=3.0, stitch_length=9.0), ZigzagOptions)
+    assert style_options("zigzag", width=3.0).width == 3.0
+    assert style_options("RUNNING", stitch_length=None).stitch_length == 2.5
+    with pytest.raises(InputError, match="unknown stitch style 'satin'"):
+        style_options("satin")
+    assert style_reach(ZigzagOptions(width=3.0, pull_compensation=0.4)) == pytest.approx(1.7)
+
+
+def test_hoop_check_refuses_or_fits():
+    drawing = Drawing((spiral(0, 0, 5.0, 40.0, 2.0),), 100, 100, "mm")
+    big = place(drawing, PlacementOptions(size=120.0))
+    hoop = hoop_named("4x4")
+    with pytest.raises(InputError, match=r"hoop 100x100 \(4x4\) holds 100 x 100 mm"):
+        fit_to_hoop(big, hoop)
+    style = ZigzagOptions(width=3.0)
+    fitted = fit_to_hoop(big, hoop, reach=style_reach(style), fit=True)
+    plan = plan_embroidery(fitted, PlanOptions(style=style))
+    check_plan_in_hoop(plan, hoop)
+    xmin, ymin, xmax, ymax = plan.bounds()
+    assert max(xmax - xmin, ymax - ymin) > 95.0  # scaled to fill the hoop, not shrunk to nothing
+    small = place(drawing, PlacementOptions(size=60.0))
+    assert fit_to_hoop(small, hoop) is small
+    custom = hoop_named("70x50")
+    with pytest.raises(InputError):
+        check_plan_in_hoop(plan_embroidery(small), custom)
+
+
+def test_stats_count_time_thread_and_size():
+    plan = plan_embroidery(design())
+    stats = embroidery_stats(plan, stitches_per_minute=600, trim_seconds=10)
+    needles = int((plan.kinds == STITCH).sum())
+    assert stats.stitches == needles and stats.trims == 2 and stats.jumps == 2
+    assert stats.seconds == pytest.approx(needles / 600 * 60 + 2 * 10)
+    assert stats.thread_length == pytest.approx(np.hypot(*sewn_stitches(plan).T).sum())
+    # Thread is at least the drawing's length (plus locks and travel), and not much more.
+    assert design().length < stats.thread_length < design().length * 1.1
+    xmin, ymin, xmax, ymax = plan.bounds()
+    assert (stats.width, stats.height) == pytest.approx((xmax - xmin, ymax - ymin))
+    assert not stats.too_dense and stats.warnings == ()
+    assert any(line.startswith("stitches") for line in stats.lines())
+
+
+def test_density_warning_at_six_needle_points_within_half_a_millimetre():
+    def plan_of(points):
+        n = len(points)
+        return StitchPlan(points=np.asarray(points, float), kinds=np.zeros(n, np.uint8),
+                          roles=np.full(n, BODY, np.uint8), params=np.linspace(0, 1, n),
+                          strokes=np.zeros(n, int))
+    five = [[0, 0], [0.3, 0], [0, 0.3], [0.3, 0.3], [0.2, 0.1], [5, 5]]
+    six = five[:5] + [[0.1, 0.4], [5, 5]]
+    assert embroidery_stats(plan_of(five)).max_density == 5
+    assert not embroidery_stats(plan_of(five)).too_dense
+    stats = embroidery_stats(plan_of(six))
+    assert stats.too_dense and stats.max_density == 6 and stats.dense_points == 6
+    assert "too dense" in stats.warnings[0]
+    # A zigzag at 0.1 mm spacing is too dense; the default 0.4 mm on a straight line is not.
+    line = Drawing((_line([0, 0], [20, 0]),), 20, 1, "mm")
+    assert embroidery_stats(plan_embroidery(line, PlanOptions(style=ZigzagOptions(spacing=0.1)))).too_dense
+    assert not embroidery_stats(plan_embroidery(line, PlanOptions(style=ZigzagOptions()))).too_dense
+
+
+def test_thread_colours():
+    assert parse_color("#c81e28") == (200, 30, 40)
+    assert parse_color("c81e28") == (200, 30, 40)
+    assert parse_color("navy") == (0, 0, 128)
+    with pytest.raises(InputError, match="'blurple' is not a colour"):
+        parse_color("blurple")
+    with pytest.raises(InputError):
+        PlanOptions(color=(300, 0, 0))
