@@ -7,9 +7,14 @@ import time
 
 import click
 
-from fabrication.cli.common import console, done, warn
+from fabrication.cli.common import console, done
 from onestroke.atomic import check_writable
 from onestroke.errors import InputError
+
+
+def warn(message: str) -> None:
+    """A one-line warning (soft wrap: long messages stay on one line in logs)."""
+    console.print(f"[yellow]warning:[/yellow] {message}", soft_wrap=True)
 
 # CLI option -> field name in the style options; which styles use it (for warnings).
 _STYLE_FIELDS = {
@@ -158,7 +163,7 @@ def embroider(source: str, output: str, style: str, size: str | None, width: str
     for message in stats.warnings:
         warn(message)
     for line in stats.lines():
-        console.print(line)
+        console.print(line, soft_wrap=True)
     extra = f" and {preview_path}" if preview_path else ""
     done(f"wrote {output}{extra}: {stats.stitches} stitches, {stats.trims} trims, "
          f"{stats.thread_length / 1000:.2f} m thread, {stats.width:.1f} x {stats.height:.1f} mm "

@@ -10,9 +10,15 @@ import os
 
 import click
 
-from fabrication.cli.common import console, done, warn
+from fabrication.cli.common import console, done
 from onestroke.atomic import check_writable
 from onestroke.errors import InputError
+
+
+def warn(message: str) -> None:
+    """A one-line warning (soft wrap: long messages stay on one line in logs)."""
+    console.print(f"[yellow]warning:[/yellow] {message}", soft_wrap=True)
+
 
 GCODE_SUFFIXES = (".gcode", ".nc", ".gc", ".ngc")
 DRAWING_SUFFIXES = (".svg", ".json")
@@ -85,6 +91,6 @@ def preview(source: str, output: str, width_px: int, hoop: str | None, spm: floa
     for message in stats.warnings:
         warn(message)
     for line in stats.lines():
-        console.print(line)
+        console.print(line, soft_wrap=True)
     done(f"wrote {output}: {stats.stitches} stitches, {stats.trims} trims, "
          f"{stats.width:.1f} x {stats.height:.1f} mm")
