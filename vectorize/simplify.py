@@ -101,7 +101,7 @@ def _merge(graph: MedialGraph, a: int, b: int, bid: int) -> int:
         (a, join.points[: mid + 1][::-1], join.radii[: mid + 1][::-1], join.sins[:mid][::-1]),
         (b, join.points[mid:], join.radii[mid:], join.sins[mid:]),
     ):
-        for other in list(graph.incident[old]):
+        for other in dict.fromkeys(graph.incident[old]):  # a loop is listed twice
             branch = graph.remove_branch(other)
             if branch.a == branch.b:
                 # A loop at the old junction: both of its ends move to the new node.
@@ -123,24 +123,53 @@ def simplify(graph: MedialGraph, *, stroke_width: float, multi: bool) -> Simplif
     reach = 2.5 * stroke_width
     merged = 0
 
-    def is_y(node: int) -> bool:
+    def spike_slot(node: int) -> int | None:
+        """Slot of the branch drawn out and back at a degree-3 node, if it has one.
+
+        A V-shaped spike (two sides at an acute angle, paper's Y-junction) has its free
+        end on the foot. A spike retraced exactly over itself leaves a T: a branch to a
+        free end across a straight line. In a single-line drawing that is a spike too
+        (the pen cannot end there and go on); in multi mode it is a stroke ending on
+        another (paper 4.5).
+        """
         if graph.degree(node) != 3:
-            return False
+            return None
         node_slots = slots(graph, node)
-        foot = node_slots[foot_slot(directions(graph, node, reach))]
-        far = graph.branches[foot[0]].other(node)
-        return graph.degree(far) == 1
+        dirs = directions(graph, node, reach)
+        foot = foot_slot(dirs)
+        far = [graph.branches[bid].other(node) for bid, _ in node_slots]
+        if graph.degree(far[foot]) == 1:
+            return foot
+        if multi or node not in t_spikes:
+            return None
+        stub = _t_stub(graph, node, reach, stroke_width)
+        # The line the spike leaves from runs on roughly straight (turns under 55 degrees).
+        return stub[0] if stub is not None and stub[1] > np.cos(np.radians(55.0)) else None
+
+    # T-shaped spikes are only plausible while the drawing has more free ends than the
+    # two a single line can have: take the straightest T's first, until two ends remain.
+    t_spikes: set[int] = set()
+    if not multi:
+        t_spikes = set(graph.incident)  # let spike_slot test the T shape of every node
+        leaves = len(graph.nodes_of_degree(1))
+        v_spikes = [n for n in graph.nodes_of_degree(3) if _v_spike(graph, n, reach)]
+        shaped = sorted(((_t_stub(graph, n, reach, stroke_width)[1], n) for n in graph.nodes_of_degree(3)
+                         if n not in v_spikes and spike_slot(n) is not None), reverse=True)
+        room = max(0, leaves - len(v_spikes) - 2)
+        t_spikes = {n for _, n in shaped[:room]}
 
     def candidates() -> list[int]:
-        return sorted(n for n in graph.nodes_of_degree(3) if not is_y(n))
+        return sorted(n for n in graph.nodes_of_degree(3) if spike_slot(n) is None)
 
     def joining(node: int, other_ok) -> dict[str, int | None]:
         """This node's picks: by widest narrowest radius (paper) and by foot."""
         node_slots = slots(graph, node)
         options = [(bid, graph.branches[bid].other(node)) for bid, _ in node_slots
                    if graph.branches[bid].a != graph.branches[bid].b]
+        # A crossing at angle a keeps its two lines' inks merged over about w / sin(a / 2):
+        # 40 stroke widths admits crossings down to ~3 degrees.
         options = [(bid, far) for bid, far in options if other_ok(far)
-                   and graph.branches[bid].length < 14.0 * stroke_width]
+                   and graph.branches[bid].length < 40.0 * stroke_width]
         widest = max(options, key=lambda o: _min_radius(graph.branches[o[0]]), default=None)
         foot_bid = node_slots[foot_slot(directions(graph, node, reach))][0]
         foot = next((o for o in options if o[0] == foot_bid), None)
@@ -185,11 +214,10 @@ def simplify(graph: MedialGraph, *, stroke_width: float, multi: bool) -> Simplif
         if degree == 3:
             node_slots = slots(graph, node)
             dirs = directions(graph, node, reach)
-            foot = foot_slot(dirs)
-            far = graph.branches[node_slots[foot][0]].other(node)
-            if graph.degree(far) == 1:
-                y_feet[node] = foot
-                y_tips.add(far)
+            spike = spike_slot(node)
+            if spike is not None:
+                y_feet[node] = spike
+                y_tips.add(graph.branches[node_slots[spike][0]].other(node))
             elif _is_t_shape(dirs):
                 # A stroke ending on another line: an end of the drawing (paper 3.3, 4.5).
                 t_ends.append(node)
@@ -210,3 +238,29 @@ def _is_t_shape(dirs: np.ndarray) -> bool:
     pairs = [(0, 1), (0, 2), (1, 2)]
     angles = sorted(float(np.degrees(np.arccos(np.clip(np.dot(dirs[i], dirs[j]), -1, 1)))) for i, j in pairs)
     return angles[2] > 150.0 and abs(angles[1] - angles[0]) < 40.0
+
+
+def _v_spike(graph: MedialGraph, node: int, reach: float) -> bool:
+    """The paper's Y-junction: the foot of a degree-3 node ends in a free end."""
+    node_slots = slots(graph, node)
+    foot = foot_slot(directions(graph, node, reach))
+    return graph.degree(graph.branches[node_slots[foot][0]].other(node)) == 1
+
+
+def _t_stub(graph: MedialGraph, node: int, reach: float, stroke_width: float) -> tuple[int, float] | None:
+    """The free branch of a degree-3 node that leaves the straightest line behind, and how
+    straight that line is (-cos of the angle between the two other branches); None when
+    no branch longer than a stroke width ends free."""
+    node_slots = slots(graph, node)
+    dirs = directions(graph, node, reach)
+    stubs = [i for i, (bid, _) in enumerate(node_slots)
+             if graph.degree(graph.branches[bid].other(node)) == 1 and graph.branches[bid].length > stroke_width]
+
+    def straightness(stub: int) -> float:
+        a, b = (i for i in range(3) if i != stub)
+        return -float(np.dot(dirs[a], dirs[b]))
+
+    if not stubs:
+        return None
+    stub = max(stubs, key=straightness)
+    return stub, straightness(stub)
