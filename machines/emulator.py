@@ -45,7 +45,7 @@ DEFAULT_SETTINGS: dict[int, float] = {
 _INT_SETTINGS = {0, 1, 2, 3, 4, 5, 6, 10, 13, 20, 21, 22, 23, 26, 32}
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, kw_only=True)
 class Faults:
     """Faults to inject, counted in G-code lines executed (1 = the first program line).
 
@@ -67,7 +67,7 @@ class Faults:
     error_at: int | None = None
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, kw_only=True)
 class EmulatorOptions:
     """How the emulated machine behaves.
 

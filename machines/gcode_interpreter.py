@@ -77,7 +77,7 @@ _M_GROUPS = {0: "stop", 1: "stop", 2: "stop", 30: "stop", 3: "spindle", 4: "spin
              7: "coolant", 8: "coolant", 9: "coolant"}
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, kw_only=True)
 class MachineConfig:
     """What the interpreter needs from the settings: laser mode, soft limits and travel (mm)."""
 

@@ -20,7 +20,7 @@ SOME_LARGE_VALUE = 1.0e38
 MINIMUM_FEED_RATE = 1.0 / 60.0  # mm/s, GRBL's MINIMUM_FEED_RATE of 1 mm/min
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, kw_only=True)
 class Kinematics:
     """Machine limits for the planner model.
 

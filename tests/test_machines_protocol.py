@@ -108,10 +108,8 @@ def test_junction_deviation_speed_matches_formula():
     builder = BlockBuilder(kin)
     builder.make((0, 0, 0), (10, 0, 0), feed_mm_min=6000, rapid=False, from_rest=True)
     corner = builder.make((10, 0, 0), (10, 10, 0), feed_mm_min=6000, rapid=False, from_rest=False)
-    theta = math.pi / 2  # the angle between the moves' directions reversed: 90 degrees
-    s = math.sin(theta / 2)
-    a = 500.0 * math.sqrt(2)  # acceleration along the junction vector (1,-1)/sqrt(2)... limited per axis
-    a = min(500.0 / (1 / math.sqrt(2)), a)
+    s = math.sin(math.pi / 4)  # a 90 degree corner: theta/2 = 45 degrees
+    a = 500.0 * math.sqrt(2)  # along the junction vector (-1, 1)/sqrt(2) each axis gives 500 mm/s^2
     assert corner.junction_sqr == pytest.approx(a * 0.01 * s / (1 - s))
     straight = builder.make((10, 10, 0), (10, 20, 0), feed_mm_min=6000, rapid=False, from_rest=False)
     reverse = builder.make((10, 20, 0), (10, 15, 0), feed_mm_min=6000, rapid=False, from_rest=False)

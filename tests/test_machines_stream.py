@@ -112,6 +112,10 @@ def test_pause_and_resume_lose_and_repeat_nothing(emulator):
     assert len(emu.executed) == held and emu.stats().blocks_executed == moved  # nothing moves in Hold:0
     assert not emu.beam_on or not emu._motion_busy
     streamer.resume()
+    streamer.feed_override(10)
+    streamer.power_override(-10)
+    report = streamer.wait_status(lambda s: s.overrides == (110, 100, 90), 3.0)
+    assert report is not None and (emu.feed_ov, emu.spindle_ov) == (110, 90)
     thread.join(30)
     streamer.close()
     assert "result" in done
