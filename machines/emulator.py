@@ -9,7 +9,7 @@ parsing, motion) that many times faster than a real machine.
 
 Use it in-process (`GrblEmulator(...).start_pty()` returns a device path for pyserial),
 through pyserial as `sim://` (see `machines.sim_url`), or from a shell:
-`python -m machines.emulator` prints a device path to give to `onestroke stream --port`.
+`onestroke emulator` prints a device path for any sender.
 """
 
 from __future__ import annotations
@@ -885,33 +885,3 @@ class GrblEmulator:
         if self.hold:
             self.hold_complete = True
         self._cond.notify_all()
-
-
-def main() -> None:  # pragma: no cover - manual use
-    """`python -m machines.emulator [--speed N]`: serve GRBL on a pty and print its path."""
-    import argparse
-
-    parser = argparse.ArgumentParser(description="GRBL 1.1 emulator on a pseudo-terminal")
-    parser.add_argument("--speed", type=float, default=1.0, help="time scale (1 = real time)")
-    parser.add_argument("--log", help="write the executed lines here on exit")
-    args = parser.parse_args()
-    emulator = GrblEmulator(EmulatorOptions(time_scale=args.speed))
-    print(emulator.start_pty(), flush=True)
-    try:
-        while True:
-            time.sleep(1.0)
-    except KeyboardInterrupt:
-        pass
-    finally:
-        emulator.stop()
-        if args.log:
-            from pathlib import Path
-
-            Path(args.log).write_text("\n".join(emulator.executed) + "\n", encoding="utf-8")
-        stats = emulator.stats()
-        print(f"{stats.lines_executed} lines, {stats.blocks_executed} blocks, "
-              f"planner-limited {stats.planner_limited_time:.2f} s, overflow {stats.rx_overflow_bytes} B")
-
-
-if __name__ == "__main__":  # pragma: no cover
-    main()

@@ -262,3 +262,23 @@ def test_cli_sim_dry_run_and_frame(tmp_path):
     assert result.exit_code == 0 and "framed" in result.stdout and "beam off" in result.stdout
     result = CliRunner().invoke(main, ["ports", "--no-probe"])
     assert result.exit_code == 0 and "serial port" in result.stdout
+
+
+def test_emulator_command_serves_a_pty_and_logs_executed_lines(tmp_path):
+    log = tmp_path / "executed.txt"
+    process = subprocess.Popen([sys.executable, "-c", "from fabrication.cli import main; main()", "emulator",
+                                "--speed", "50", "--log", str(log)], stdout=subprocess.PIPE,
+                               stderr=subprocess.PIPE, text=True)
+    try:
+        device = process.stdout.readline().strip()
+        assert device.startswith("/dev/")
+        path = tmp_path / "job.gcode"
+        text = job_text(100)
+        path.write_text(text)
+        result = CliRunner().invoke(main, ["stream", str(path), "--port", device])
+        assert result.exit_code == 0, result.output
+    finally:
+        process.send_signal(signal.SIGINT)
+        out, err = process.communicate(timeout=10)
+    assert process.returncode == 0 and "planner-limited" in out
+    assert log.read_text().splitlines() == cleaned(text) + [DRAIN_LINE]

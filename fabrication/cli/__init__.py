@@ -45,9 +45,10 @@ def _register() -> None:
     from fabrication.cli.laser_cmd import laser
 
     main.add_command(laser)
-    from fabrication.cli.stream_cmd import stream
+    from fabrication.cli.stream_cmd import emulator, stream
 
     main.add_command(stream)
+    main.add_command(emulator)
     from fabrication.cli.ports_cmd import ports
 
     main.add_command(ports)

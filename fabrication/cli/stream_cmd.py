@@ -212,3 +212,34 @@ def run_stream(gcode_path, *, port: str, baud: int = 115200, check: bool = False
 def stream(gcode: Path, port: str, baud: int, check: bool, frame: bool, profile: Path | None) -> None:
     """Stream GCODE to a GRBL laser over USB serial (pause, resume and abort leave the beam off)."""
     run_stream(gcode, port=port, baud=baud, check=check, frame=frame, profile=profile)
+
+
+@click.command("emulator")
+@click.option("--speed", type=float, default=1.0, show_default=True, help="Time scale (1 = a real machine's pace).")
+@click.option("--log", "log_path", type=click.Path(dir_okay=False, path_type=Path), default=None,
+              help="On exit, write every line the emulator executed to this file.")
+def emulator(speed: float, log_path: Path | None) -> None:
+    """Serve a GRBL 1.1 emulator on a pseudo-terminal until Ctrl-C (for any sender, or tests)."""
+    from machines.emulator import EmulatorOptions, GrblEmulator
+    from onestroke.atomic import atomic_write_text, check_writable
+
+    if not speed > 0:
+        raise InputError(f"--speed {speed:g} must be greater than zero (1 = real time)")
+    if log_path is not None:
+        check_writable(log_path)
+    emu = GrblEmulator(EmulatorOptions(time_scale=speed))
+    device = emu.start_pty()
+    click.echo(device)
+    console.print(f"GRBL 1.1h emulator on {device} ({speed:g}x); Ctrl-C to stop")
+    try:
+        while True:
+            time.sleep(0.5)
+    except KeyboardInterrupt:
+        pass
+    finally:
+        emu.stop()
+        stats = emu.stats()
+        if log_path is not None:
+            atomic_write_text(log_path, "".join(line + "\n" for line in emu.executed))
+        done(f"emulator: {stats.lines_executed} lines, {stats.blocks_executed} blocks, planner-limited "
+             f"{_format_seconds(stats.planner_limited_time)}, RX overflow {stats.rx_overflow_bytes} B")
