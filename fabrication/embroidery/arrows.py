@@ -72,15 +72,19 @@ def arrow_stitch(stroke: Stroke, options: ArrowOptions = ArrowOptions(), *,
     radius = 1.0 / np.maximum(np.abs(curve.curvature), 1e-12)
     reach_lo = np.searchsorted(curve.s, tips - options.size)
     reach_hi = np.searchsorted(curve.s, tips, side="right")
-    scale = np.ones(len(tips))
-    barrier = np.concatenate([[0.0], curve.s[corner]])  # stroke start and corners
-    for i, (lo, hi) in enumerate(zip(reach_lo, reach_hi)):
-        # Python loop over motifs only (one per `spacing`, a few hundred at most per stroke).
-        r = radius[lo:hi][~corner[lo:hi]].min(initial=np.inf)
-        scale[i] = min(1.0, r / (options.tight_radius * options.size))
-        before = barrier[barrier < tips[i] - 1e-9]
-        room = (tips[i] - before.max()) / options.size if len(before) else np.inf
-        scale[i] = min(scale[i], room)
+    free = np.where(corner, np.inf, radius)  # a corner is handled as a barrier below
+    # Smallest radius in each motif's window [lo, hi) of dense vertices (empty -> inf).
+    # Windows do not overlap (spacing > size), so [lo0, hi0, lo1, hi1, ...] is sorted and
+    # every other reduceat result is one window's minimum.
+    padded = np.append(free, np.inf)
+    bounds = np.minimum(np.column_stack([reach_lo, reach_hi]).ravel(), len(free))
+    smallest = np.minimum.reduceat(padded, bounds)[::2] if len(bounds) else np.zeros(0)
+    smallest[reach_hi <= reach_lo] = np.inf
+    scale = np.minimum(1.0, smallest / (options.tight_radius * options.size))
+    # The arms must not reach back across a corner or the start of the stroke.
+    barrier = np.concatenate([[0.0], curve.s[corner]])
+    last = barrier[np.maximum(np.searchsorted(barrier, tips - 1e-9) - 1, 0)]
+    scale = np.minimum(scale, (tips - last) / options.size)
     ok = scale >= options.min_scale
     tips, scale = tips[ok], scale[ok]
 
