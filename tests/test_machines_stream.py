@@ -189,8 +189,9 @@ def test_no_answer_at_connect(tmp_path, emulator):
     assert emu.executed == [] and not emu.beam_on
 
 
-def test_lost_ok(tmp_path, emulator):
-    emu = emulator(faults=Faults(drop_ok_at=200))
+@pytest.mark.parametrize("report_mask", [1, 3], ids=["no-Bf", "with-Bf"])
+def test_lost_ok(tmp_path, emulator, report_mask):
+    emu = emulator(faults=Faults(drop_ok_at=200), settings={10: report_mask})
     result, errors = run_cli(tmp_path, emu, job_text(400))
     assert result.exit_code == 1 and len(errors) == 1
     assert "'ok' was lost" in errors[0]
@@ -198,8 +199,9 @@ def test_lost_ok(tmp_path, emulator):
     assert_beam_off_after(emu)
 
 
-def test_idle_stall_with_queued_blocks_is_recovered(tmp_path, emulator):
-    emu = emulator(faults=Faults(stall_at=300))
+@pytest.mark.parametrize("report_mask", [1, 3], ids=["no-Bf", "with-Bf"])
+def test_idle_stall_with_queued_blocks_is_recovered(tmp_path, emulator, report_mask):
+    emu = emulator(faults=Faults(stall_at=300), settings={10: report_mask})
     text = job_text(600)
     result, errors = run_cli(tmp_path, emu, text)
     assert result.exit_code == 0, result.output
