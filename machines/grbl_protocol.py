@@ -147,7 +147,9 @@ class Unknown:
 
 Reply = Ok | ErrorReply | Alarm | Welcome | Message | Setting | StatusReport | Unknown
 
-_WELCOME = re.compile(r"^Grbl\s+(\S+)\s+\['\$' for help\]$")
+# GRBL 1.1 "Grbl 1.1h ['$' for help]"; forks: "GrblHAL 1.1f ['$' or '$HELP' for help]",
+# "Grbl 3.7 [FluidNC v3.7.8 (wifi) '$' for help]".
+_WELCOME = re.compile(r"^Grbl\w*\s+(\S+)\s+\[.*for help\]$")
 _SETTING = re.compile(r"^\$(\d+)=([-+]?\d*\.?\d+)")
 _NUMBER_LIST = re.compile(r"^[-+]?\d*\.?\d+(,[-+]?\d*\.?\d+)*$")
 

@@ -129,6 +129,7 @@ class GrblStreamer:
         self._running = True
         self._polling = False
         self._alarm_locked = False
+        self._last_query = 0.0
         self._abort = threading.Event()
         self.rx_buffer = DEFAULT_RX_BUFFER
         self.planner_blocks = DEFAULT_PLANNER_BLOCKS
@@ -175,13 +176,24 @@ class GrblStreamer:
             self._alarm_locked = False
         self._replies.put(reply)
 
+    @property
+    def _query_period(self) -> float:
+        return 1.0 / max(0.1, min(self.options.status_hz, 5.0))
+
+    def _query_status(self) -> None:
+        """Send `?` unless one went out less than a poll period ago (GRBL: at most 5 Hz)."""
+        with self._write_lock:
+            if time.monotonic() - self._last_query < self._query_period:
+                return
+            self._last_query = time.monotonic()
+        self._write(STATUS_QUERY)
+
     def _poll_loop(self) -> None:
-        period = 1.0 / max(0.1, min(self.options.status_hz, 5.0))
         while self._running:
-            time.sleep(period)
+            time.sleep(self._query_period / 4)
             if self._polling:
                 try:
-                    self._write(STATUS_QUERY)
+                    self._query_status()
                 except MachineError:
                     return
 
@@ -224,17 +236,17 @@ class GrblStreamer:
             return None
 
     def wait_status(self, predicate: Callable[[StatusReport], bool], timeout: float) -> StatusReport | None:
-        """Ask `?` every 50 ms until a report satisfies `predicate`; None on timeout."""
+        """Poll `?` (at most 5 Hz) until a new report satisfies `predicate`; None on timeout."""
         deadline = time.monotonic() + timeout
+        seen = self._status_time
         while time.monotonic() < deadline:
-            asked = time.monotonic()
-            self._write(STATUS_QUERY)
+            self._query_status()
             with self._status_cond:
-                self._status_cond.wait_for(lambda: self._status_time >= asked, timeout=0.05)
-                status = self._status if self._status_time >= asked else None
-            if status is not None and predicate(status):
-                return status
-            time.sleep(0.05)
+                self._status_cond.wait_for(lambda: self._status_time > seen, timeout=0.05)
+                if self._status_time > seen:
+                    seen = self._status_time
+                    if predicate(self._status):
+                        return self._status
         return None
 
     # ------------------------------------------------------------------ connect
@@ -481,9 +493,9 @@ class GrblStreamer:
                 elif isinstance(reply, Unknown):
                     raise stop(f"unreadable bytes from {self.name}: {reply.raw[:24]!r} (electrical noise, a bad "
                                "USB cable or a wrong --baud); the answers can no longer be trusted")
-            # Every line is answered; the drain line's `ok` means the planner is empty.
-            final = self.wait_status(lambda s: s.state in ("Idle", "Check", "Alarm"), timeout=10.0)
-            if final is not None and final.state == "Alarm":
+            # Every line is answered, and GRBL answers the drain line (G4P0) only once the
+            # planner is empty and the machine Idle: the job is done.
+            if self._alarm_locked:
                 raise stop("the machine went into ALARM at the end of the job")
         except KeyboardInterrupt:
             raise stop("stopped by Ctrl-C", cls=StreamInterrupted) from None
@@ -491,6 +503,8 @@ class GrblStreamer:
             if isinstance(error, StreamError):
                 raise
             raise stop(str(error), halt=False) from None
+        except Exception as error:  # a bug must not leave the machine burning: halt first
+            raise stop(f"internal error {type(error).__name__}: {error}") from error
         elapsed = time.monotonic() - started
         return StreamResult(total, elapsed, mode, recoveries, tuple(check_errors), tuple(self.warnings))
 
