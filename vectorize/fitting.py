@@ -54,10 +54,11 @@ def bspline_to_bezier(tck, u_start: float, u_end: float) -> np.ndarray:
     return np.stack([pa, pa + h * da, pb - h * db, pb], axis=1)
 
 
-def fit_piece(points: np.ndarray, *, closed: bool, sigma: float) -> np.ndarray:
+def fit_piece(points: np.ndarray, *, closed: bool, sigma: float, anchor: bool = True) -> np.ndarray:
     """Fit one piece: (N, 2) ordered points -> Bézier control points (K, 4, 2).
 
     sigma: expected noise of the points in px; the smoothing allows that much residual.
+    anchor: make an open piece start and end exactly on its first and last points.
     """
     points = _dedupe(points, 1e-3)
     if closed and len(points) > 3 and np.linalg.norm(points[0] - points[-1]) < 1e-6:
@@ -78,36 +79,123 @@ def fit_piece(points: np.ndarray, *, closed: bool, sigma: float) -> np.ndarray:
     except (ValueError, TypeError):
         return Stroke.from_polyline(points).control
     control = bspline_to_bezier(tck, 0.0, 1.0)
-    if not closed:
+    if not closed and anchor:
         # Anchor the ends on the data: strokes must start and end where the ink does.
         control[0, 1] += points[0] - control[0, 0]
         control[0, 0] = points[0]
         control[-1, 2] += points[-1] - control[-1, 3]
         control[-1, 3] = points[-1]
-    else:
+    if closed:
         control[-1, 3] = control[0, 0]
     return control
 
 
-def fit_stroke(traced: list[TracedPoint], *, closed: bool, sigma: float) -> Stroke:
-    """Filter, split at sharp features and fit one traversed stroke."""
+def _turn(xy: np.ndarray, arc: np.ndarray, reach: float, closed: bool) -> np.ndarray:
+    """Turning angle (rad) at each point between the chords to the points `reach` before and after."""
+    total = arc[-1]
+    before = arc - reach
+    after = arc + reach
+    if closed:
+        before, after = np.mod(before, total), np.mod(after, total)
+    p0 = np.column_stack([np.interp(before, arc, xy[:, 0]), np.interp(before, arc, xy[:, 1])])
+    p2 = np.column_stack([np.interp(after, arc, xy[:, 0]), np.interp(after, arc, xy[:, 1])])
+    u, v = xy - p0, p2 - xy
+    norm = np.linalg.norm(u, axis=1) * np.linalg.norm(v, axis=1)
+    cos = np.where(norm > 1e-12, (u * v).sum(1) / np.maximum(norm, 1e-12), 1.0)
+    angle = np.arccos(np.clip(cos, -1.0, 1.0))
+    if not closed:
+        angle[(arc < reach) | (arc > total - reach)] = 0.0
+    return angle
+
+
+def sharp_corners(xy: np.ndarray, stroke_width: float, *, closed: bool) -> np.ndarray:
+    """Indices of sharp corners: turns over 40 degrees within 1.5 stroke widths, most of it
+    within half a width (a tight smooth bend spreads its turn out; a corner does not)."""
+    if len(xy) < 5:
+        return np.zeros(0, dtype=int)
+    arc = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(xy, axis=0), axis=1))])
+    wide = _turn(xy, arc, 1.5 * stroke_width, closed)
+    narrow = _turn(xy, arc, 0.5 * stroke_width, closed)
+    candidate = (wide > np.radians(40.0)) & (narrow > 0.6 * wide)
+    corners: list[int] = []
+    for i in np.argsort(-wide):
+        if not candidate[i]:
+            break
+        if all(abs(arc[i] - arc[j]) > 2.0 * stroke_width for j in corners):
+            corners.append(int(i))
+    return np.array(sorted(corners), dtype=int)
+
+
+def _corner_point(before: np.ndarray, after: np.ndarray, fallback: np.ndarray, limit: float) -> np.ndarray:
+    """Where the end tangent of `before` meets the start tangent of `after` (Bézier (K, 4, 2)).
+
+    Near a sharp corner the medial axis bends away from the centre line (towards the
+    inner corner's Voronoi region); the two straight-ish sides, extended, meet where the
+    pen turned. Falls back to `fallback` when the sides are near parallel or meet far away.
+    """
+    a, da = before[-1, 3], before[-1, 3] - before[-1, 2]
+    b, db = after[0, 0], after[0, 1] - after[0, 0]
+    matrix = np.column_stack([da, -db])
+    if abs(np.linalg.det(matrix)) < 1e-9 * (np.linalg.norm(da) * np.linalg.norm(db) + 1e-12):
+        return fallback
+    s_a, s_b = np.linalg.solve(matrix, b - a)
+    point = a + s_a * da
+    if s_a < 0 or s_b > 0 or np.linalg.norm(point - fallback) > limit:
+        return fallback
+    return point
+
+
+def fit_stroke(traced: list[TracedPoint], *, closed: bool, sigma: float, stroke_width: float) -> Stroke:
+    """Filter, split at sharp features (Y-feet tips, corners) and fit one traversed stroke."""
     xy = np.array([p.xy for p in traced])
     keep = np.array([p.keep for p in traced])
     split = np.array([p.split for p in traced])
+    corner = np.zeros(len(xy), dtype=bool)
+    found = sharp_corners(xy, stroke_width, closed=closed)
+    corner[found[keep[found] & ~split[found]]] = True
+    split |= corner
     split_at = np.flatnonzero(split)
     if closed and split_at.size:
         # Start a closed stroke at its first sharp feature: then it is a chain of open pieces.
         shift = int(split_at[0])
-        xy, keep, split = (np.roll(a, -shift, axis=0) for a in (xy, keep, split))
-        xy, keep, split = np.vstack([xy, xy[:1]]), np.append(keep, True), np.append(split, True)
+        xy, keep, split, corner = (np.roll(a, -shift, axis=0) for a in (xy, keep, split, corner))
+        xy = np.vstack([xy, xy[:1]])
+        keep, split, corner = np.append(keep, True), np.append(split, True), np.append(corner, corner[0])
         closed = False
+    # Around a corner the axis is off the centre line for about a stroke width: leave it out.
+    arc = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(xy, axis=0), axis=1))])
+    for i in np.flatnonzero(corner):
+        keep &= np.abs(arc - arc[i]) > stroke_width
     cuts = [0] + [int(i) for i in np.flatnonzero(split) if 0 < i < len(xy) - 1] + [len(xy) - 1]
     pieces = []
     for lo, hi in zip(cuts[:-1], cuts[1:]):
         mask = keep[lo:hi + 1].copy()
         if not closed:
             mask[0] = mask[-1] = True
+            mask[0] &= not corner[lo]
+            mask[-1] &= not corner[hi]
         piece = xy[lo:hi + 1][mask]
-        pieces.append(fit_piece(piece, closed=closed and len(cuts) == 2, sigma=sigma))
+        if len(piece) < 2:
+            piece = xy[[lo, hi]]
+        control = fit_piece(piece, closed=closed and len(cuts) == 2, sigma=sigma,
+                            anchor=not (corner[lo] or corner[hi]))
+        pieces.append(np.array(control))  # writable: the joints move its ends
+    # Join the pieces: at corners where their sides meet, elsewhere where they end.
+    joints = list(zip(range(len(pieces) - 1), range(1, len(pieces)), cuts[1:-1]))
+    if corner[0] and corner[-1] and len(pieces) > 1:
+        joints.append((len(pieces) - 1, 0, 0))
+    for k, m, at in joints:
+        before, after = pieces[k], pieces[m]
+        if corner[at]:
+            point = _corner_point(before, after, xy[at], 2.0 * stroke_width)
+        else:
+            point = (before[-1, 3] + after[0, 0]) / 2.0
+        if not corner[at]:
+            # Elsewhere move the inner handles along, keeping both end tangents; at a
+            # corner the point lies on the tangents already.
+            before[-1, 2] += point - before[-1, 3]
+            after[0, 1] += point - after[0, 0]
+        before[-1, 3] = point
+        after[0, 0] = point
     control = np.concatenate(pieces, axis=0)
     return Stroke(control)

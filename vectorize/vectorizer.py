@@ -149,7 +149,7 @@ def run_pipeline(image: np.ndarray, options: VectorizeOptions, *,
     for traced, closed in _trace(graph, simple, ordering, junctions, verdicts, w):
         if len(traced) < 2:
             continue
-        strokes.append(_orient(fit_stroke(traced, closed=closed, sigma=sigma), closed))
+        strokes.append(_orient(fit_stroke(traced, closed=closed, sigma=sigma, stroke_width=w), closed))
     strokes = [s for s in strokes if s.length > 0.5 * w or len(strokes) == 1]
     strokes.sort(key=lambda s: (round(float(s.start.sum()) / (4 * w)), float(s.start[0])))
     clock.lap("fitting")
