@@ -87,6 +87,33 @@ def _arc_fits(p: np.ndarray, tolerance: float, quantum: float, box=None) -> tupl
     return centre, direction
 
 
+def _hopeless_triples(p: np.ndarray, tolerance: float) -> np.ndarray:
+    """(N,) True where vertices i, i+1, i+2 fit neither a line nor an arc within tolerance.
+
+    A necessary condition, vectorized: a run from i that cannot take in i+2 cannot take
+    in anything longer, so the greedy loop writes one line there without fitting.
+    """
+    out = np.zeros(len(p), dtype=bool)
+    if len(p) < 3:
+        return out
+    a, m, b = p[:-2], p[1:-1], p[2:]
+    ab, am = b - a, m - a
+    cross = ab[:, 0] * am[:, 1] - ab[:, 1] * am[:, 0]
+    chord = np.hypot(*ab.T)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        line_err = np.abs(cross) / chord  # distance of m from the line a-b
+        # circumradius R = |ab| |am| |mb| / (2 |cross|)
+        radius = chord * np.hypot(*am.T) * np.hypot(*(b - m).T) / (2 * np.abs(cross))
+        longest = np.maximum(np.hypot(*am.T), np.hypot(*(b - m).T))
+        sag = longest * longest / (8 * radius)
+    # the projection of m must also fall between a and b for the line to pass near it
+    t = (am * ab).sum(axis=1) / np.where(chord > 0, chord * chord, 1.0)
+    line_ok = (line_err <= tolerance) & (t >= 0) & (t <= 1)
+    arc_ok = np.isfinite(radius) & (radius <= MAX_RADIUS) & (sag <= tolerance)
+    out[:-2] = ~(line_ok | arc_ok) & (chord > 0)
+    return out
+
+
 def fit_arcs(points: np.ndarray, tolerance: float, *, quantum: float = 0.001, box=None
              ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Lines and arcs through a subset of `points` that pass within `tolerance` of all.
@@ -97,6 +124,7 @@ def fit_arcs(points: np.ndarray, tolerance: float, *, quantum: float = 0.001, bo
     """
     p = np.asarray(points, dtype=float)
     n = len(p)
+    hopeless = _hopeless_triples(p, tolerance)
     keep = [0]
     kinds: list[int] = []
     centres: list[tuple[float, float]] = []
@@ -114,6 +142,13 @@ def fit_arcs(points: np.ndarray, tolerance: float, *, quantum: float = 0.001, bo
 
     i = 0
     while i < n - 1:
+        if i + 2 <= n - 1 and hopeless[i]:
+            # nothing longer than one segment can start here: write the line at once
+            keep.append(i + 1)
+            kinds.append(LINE)
+            centres.append((np.nan, np.nan))
+            i += 1
+            continue
         good_j, good = i + 1, fit(i, i + 1)
         step = 2
         bad_j = None

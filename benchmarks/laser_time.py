@@ -1,0 +1,119 @@
+"""Benchmark: the job-time estimate against independent models, and vector vs raster time.
+
+Run from the repo root: `python benchmarks/laser_time.py`. For each job it prints
+- estimate: fabrication.laser.job_time (closed-form trapezoids, vectorized look-ahead);
+- simulation: tests/laser_grbl_sim.py, written separately from GRBL's documented rules
+  (literal 15-slot planner buffer, GRBL's incremental arc generator, time-stepped motion
+  at 0.1 ms; shares no code with the estimator);
+- machines model: machines.gcode_program.analyze_program, the emulator/streamer helper's
+  own planner model (written by another author), when it is importable;
+- length/feed: what common senders (LaserGRBL, bCNC) show.
+Then the paper's Fig. 14 comparison: vector engraving vs raster engraving of the same
+drawing on the same machine model.
+"""
+
+from __future__ import annotations
+
+import sys
+import tempfile
+import time
+from pathlib import Path
+from statistics import median
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))
+sys.path.insert(0, str(ROOT / "tests"))
+
+from fabrication.laser.gcode_write import GcodeOptions, gcode_lines  # noqa: E402
+from fabrication.laser.job_time import estimate_gcode_time  # noqa: E402
+from fabrication.laser.raster_time import raster_time  # noqa: E402
+from fabrication.laser.toolpath import ToolpathOptions, plan_toolpath  # noqa: E402
+from fabrication.placement import PlacementOptions  # noqa: E402
+from laser_fixtures import spiral_points, trefoil_png  # noqa: E402
+from laser_grbl_sim import simulate  # noqa: E402
+from machines.laser_profile import load_laser_profile  # noqa: E402
+
+PROFILE = load_laser_profile()
+
+
+def machines_model(lines):
+    try:
+        from machines.gcode_program import analyze_program, program_from_text
+    except ImportError:
+        return None
+    settings = {110: PROFILE.max_rate_x, 111: PROFILE.max_rate_y, 120: PROFILE.acceleration_x,
+                121: PROFILE.acceleration_y, 11: PROFILE.junction_deviation, 12: PROFILE.arc_tolerance, 32: 1}
+    return analyze_program(program_from_text("\n".join(lines)), settings=settings).total_seconds
+
+
+def straight_line(feed):
+    return ["G21", "G90", "M4S0", "G0X10Y10", "G4P0", f"G1X390Y390S600F{feed:g}", "M5", "M9"]
+
+
+def spiral(feed):
+    pts = spiral_points(segment=0.05, turns=6.0, r0=2.0, pitch=1.2)
+    body = ["G1X%.3fY%.3f" % tuple(p) for p in pts[1:]]
+    body[0] += f"S600F{feed:g}"
+    return ["G21", "G90", "M4S0", "G0X%.3fY%.3f" % tuple(pts[0])] + body + ["M5", "M9"]
+
+
+def vectorized_drawing():
+    from vectorize import VectorizeOptions, vectorize_file
+
+    with tempfile.TemporaryDirectory() as folder:
+        png = trefoil_png(Path(folder) / "trefoil.png")
+        try:
+            result = vectorize_file(png, VectorizeOptions())
+            how = "cnn"
+        except Exception:  # the CNN classifier may not be in the tree yet
+            result = vectorize_file(png, VectorizeOptions(classifier="geometric"))
+            how = "geometric"
+    return result.drawing, how
+
+
+def row(label, lines):
+    start = time.perf_counter()
+    job = estimate_gcode_time(lines, PROFILE)
+    est_seconds = time.perf_counter() - start
+    sim = simulate(lines, max_rate=(PROFILE.max_rate_x, PROFILE.max_rate_y),
+                   accel=(PROFILE.acceleration_x, PROFILE.acceleration_y),
+                   junction_deviation=PROFILE.junction_deviation, arc_tolerance=PROFILE.arc_tolerance,
+                   steps_per_mm=(PROFILE.steps_per_mm_x, PROFILE.steps_per_mm_y),
+                   planner_blocks=PROFILE.planner_blocks)
+    other = machines_model(lines)
+    other_text = f"{other:9.3f} ({other / sim - 1:+6.2%})" if other is not None else "      n/a         "
+    print(f"{label:44s} {len(lines):6d} {job.total_seconds:9.3f} {sim:9.3f} {job.total_seconds / sim - 1:+7.2%} "
+          f"{other_text} {job.naive_seconds:9.3f} ({job.naive_seconds / sim - 1:+6.1%})  [{est_seconds * 1000:.0f} ms]")
+
+
+def main() -> None:
+    print(f"{'job':44s} {'lines':>6s} {'estimate':>9s} {'simulat.':>9s} {'diff':>7s} "
+          f"{'machines model':>18s} {'len/feed':>9s} (vs sim)  [estimator run time]")
+    for feed in (1500, 6000):
+        row(f"long straight line 537 mm, F{feed}", straight_line(feed))
+    for feed in (1500, 3000, 6000):
+        row(f"spiral of 0.05 mm segments, F{feed}", spiral(feed))
+    drawing, how = vectorized_drawing()
+    for feed in (1500, 3000):
+        for arcs in (False, True):
+            tp = plan_toolpath(drawing, PROFILE, ToolpathOptions(placement=PlacementOptions(size=60), arcs=arcs))
+            lines = gcode_lines(tp, PROFILE, GcodeOptions(feed=float(feed)))
+            row(f"vectorized trefoil ({how}) 60 mm, {'arcs' if arcs else 'lines'}, F{feed}", lines)
+
+    print()
+    print("Fig. 14 comparison (same machine model, same feed):")
+    for size, feed in ((60, 1500), (60, 3000), (100, 3000)):
+        tp = plan_toolpath(drawing, PROFILE, ToolpathOptions(placement=PlacementOptions(size=size)))
+        vector = estimate_gcode_time(gcode_lines(tp, PROFILE, GcodeOptions(feed=float(feed))), PROFILE)
+        times = []
+        for _ in range(3):
+            start = time.perf_counter()
+            raster = raster_time(tp, PROFILE, interval=0.1, feed=float(feed))
+            times.append(time.perf_counter() - start)
+        print(f"  trefoil {size} mm at F{feed}: vector {vector.total_seconds:7.1f} s, raster at 0.1 mm "
+              f"{raster.seconds:7.1f} s ({raster.rows} rows), ratio {raster.seconds / vector.total_seconds:5.1f}x"
+              f"  [raster model {median(times) * 1000:.0f} ms]")
+
+
+if __name__ == "__main__":
+    main()
