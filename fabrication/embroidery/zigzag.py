@@ -13,6 +13,7 @@ there and back first (back between the holes of the way out), and zigs longer th
 from __future__ import annotations
 
 import heapq
+import itertools
 from dataclasses import dataclass
 
 import numpy as np
@@ -73,28 +74,32 @@ class ZigzagOptions:
         return self.width > self.underlay_min_width if self.underlay is None else bool(self.underlay)
 
 
-def _drop_crowded(points: np.ndarray, min_gap: float, inner: np.ndarray) -> np.ndarray:
-    """Mask of points to keep so that no `inner` point comes within `min_gap` of the
-    previous kept point on its rail (rails alternate: even and odd indices). Points on the
-    outside of a curve or on straight parts keep the requested spacing. Only crowded points
-    and the ones after a dropped point are visited one by one."""
-    keep = np.ones(len(points), dtype=bool)
-    gaps = np.full(len(points), np.inf)
-    gaps[2:] = np.linalg.norm(points[2:] - points[:-2], axis=1)
-    work = sorted(np.flatnonzero((gaps < min_gap) & inner).tolist())
+def _drop_crowded(points: np.ndarray, min_gap: float, inner: np.ndarray, *, window: int = 6) -> np.ndarray:
+    """Mask of points to keep so that no `inner` point comes within `min_gap` of the last
+    `window` kept points on its rail (rails alternate: even and odd indices; on a very
+    tight curve the inner rail winds round a small circle, so not only the previous point
+    can be near). Points outside curves or on straight parts keep the requested spacing.
+    Only crowded points and the ones after a dropped point are visited one by one."""
+    n = len(points)
+    keep = np.ones(n, dtype=bool)
+    nearest = np.full(n, np.inf)
+    for lag in range(2, 2 * window + 1, 2):
+        d = np.linalg.norm(points[lag:] - points[:-lag], axis=1)
+        nearest[lag:] = np.minimum(nearest[lag:], d)
+    work = np.flatnonzero((nearest < min_gap) & inner).tolist()
+    heapq.heapify(work)
     queued = set(work)
     while work:
         i = heapq.heappop(work)
-        if i == len(points) - 1 or not inner[i]:
+        if i == n - 1 or not inner[i]:
             continue  # the end point anchors the lock
-        k = i - 2
-        while k >= 0 and not keep[k]:
-            k -= 2
-        if k >= 0 and np.hypot(*(points[i] - points[k])) < min_gap:
+        kept = list(itertools.islice((k for k in range(i - 2, -1, -2) if keep[k]), window))
+        if kept and np.min(np.hypot(*(points[kept] - points[i]).T)) < min_gap:
             keep[i] = False
-            if i + 2 < len(points) and inner[i + 2] and i + 2 not in queued:
-                queued.add(i + 2)
-                heapq.heappush(work, i + 2)
+            for nxt in range(i + 2, min(n, i + 2 * window + 1), 2):
+                if inner[nxt] and nxt not in queued:
+                    queued.add(nxt)
+                    heapq.heappush(work, nxt)
     return keep
 
 
@@ -130,7 +135,15 @@ def zigzag_stitch(stroke: Stroke, options: ZigzagOptions = ZigzagOptions()) -> N
     s = np.linspace(0.0, length, steps + 1)
     t = curve.t_at(s)
     centre = stroke.points_at(t)
-    tangent = stroke.tangents_at(t)
+    # Direction of the chord over +-reach around each point: the tangent on straight parts
+    # and arcs, and a fan that turns smoothly round a sharp corner instead of jumping
+    # (which would leave a wedge outside the corner and cross over inside it).
+    w = options.reach
+    ahead = stroke.points_at(curve.t_at(np.minimum(s + w, length)))
+    behind = stroke.points_at(curve.t_at(np.maximum(s - w, 0.0)))
+    chord = ahead - behind
+    norm = np.linalg.norm(chord, axis=1, keepdims=True)
+    tangent = np.where(norm > 1e-9, chord / np.maximum(norm, 1e-12), stroke.tangents_at(t))
     normal = np.column_stack([-tangent[:, 1], tangent[:, 0]])
     theta = np.unwrap(np.arctan2(tangent[:, 1], tangent[:, 0]))
     kappa = np.gradient(theta, s) if len(s) > 2 else np.zeros(len(s))
