@@ -133,3 +133,14 @@ def test_png_end_to_end(tmp_path):
     result = run(png, "-o", out, "--size", "60mm", "--preview", tmp_path / "trefoil.png.svg")
     assert result.exit_code == 0, result.output
     assert validate_gcode(out.read_text().splitlines()) == []
+
+
+def test_port_streams_the_written_job_to_the_emulator(svg, tmp_path):
+    pytest.importorskip("fabrication.cli.stream_cmd")
+    out = tmp_path / "job.gcode"
+    result = run(svg, "-o", out, "--size", "15mm", "--port", "sim://?speed=50")
+    assert result.exit_code == 0, result.output
+    # the estimate is printed before the run starts, the stream summary after it
+    text = result.output
+    assert text.index("estimated") < text.index("streamed")
+    assert "beam off" in text

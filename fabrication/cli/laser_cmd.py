@@ -143,4 +143,5 @@ def laser(source: str, output: str, size: str | None, width: str | None, height:
     if port is not None:
         from fabrication.cli.stream_cmd import run_stream
 
-        run_stream(output, port=port, baud=baud, check=False, frame=False)
+        # the estimate above was printed first: the user sees the job time before it runs
+        run_stream(output, port=port, baud=baud, check=False, frame=False, profile=profile_path)
