@@ -34,6 +34,8 @@ def inputs(tmp_path_factory):
     folder = tmp_path_factory.mktemp("inputs")
     (folder / "d.svg").write_text(SVG)
     (folder / "j.gcode").write_text(GCODE)
+    (folder / "garbage.pes").write_bytes(np.random.default_rng(4).integers(0, 256, 3000, dtype=np.uint8).tobytes())
+    (folder / "empty.dst").write_bytes(b"")
     spiral = np.c_[np.cos(np.linspace(0, 12, 200)), np.sin(np.linspace(0, 12, 200))] * np.linspace(5, 40, 200)[:, None]
     write_drawing(Drawing((Stroke.from_polyline(spiral + 50),), 100, 100, "px"), folder / "d.json")
     return folder
@@ -92,6 +94,8 @@ BAD = [
     (["preview", "{in}/thing.xyz", "-o", "p.png"], "thing.xyz"),
     (["preview", "{in}/missing.pes", "-o", "p.png"], "missing.pes"),
     (["preview", "{in}/d.svg", "-o", "p.png", "--width", "5"], "width 5"),
+    (["preview", "{in}/garbage.pes", "-o", "p.png"], "not a valid .pes file"),
+    (["preview", "{in}/empty.dst", "-o", "p.png"], "holds no stitches"),
 ]
 
 

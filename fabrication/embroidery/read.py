@@ -43,7 +43,8 @@ def read_embroidery(path: str | os.PathLike) -> EmbroideryFile:
     try:
         pattern = pyembroidery.read(path)
     except Exception as error:  # pyembroidery raises anything on a corrupt file
-        raise InputError(f"cannot read {path!r}: {type(error).__name__}: {error}") from None
+        raise InputError(f"cannot read {path!r}: not a valid {suffix} file "
+                         f"({type(error).__name__}: {error})") from None
     if pattern is None or not pattern.stitches:
         raise InputError(f"{path!r} holds no stitches pyembroidery can read")
     rows = np.asarray(pattern.stitches, dtype=float).reshape(-1, 3)
@@ -53,6 +54,8 @@ def read_embroidery(path: str | os.PathLike) -> EmbroideryFile:
     kinds[command == pyembroidery.JUMP] = JUMP
     kinds[np.isin(command, _CUTS)] = TRIM
     keep = kinds != 255
+    if not (kinds == STITCH).any():
+        raise InputError(f"{path!r} holds no stitches pyembroidery can read")
     changes = int(np.isin(command, (pyembroidery.COLOR_CHANGE, pyembroidery.NEEDLE_SET)).sum())
     points, kinds = rows[keep, :2] / 10.0, kinds[keep]
     params = np.linspace(0.0, 1.0, len(points)) if len(points) > 1 else np.zeros(len(points))
