@@ -119,3 +119,18 @@ def test_same_input_same_svg_bytes():
     first = drawing_to_svg(vectorize_image(image, VectorizeOptions()).drawing)
     second = drawing_to_svg(vectorize_image(image, VectorizeOptions()).drawing)
     assert first == second
+
+
+@pytest.mark.parametrize("name, lines, lengths", [
+    ("T", [[[80, 80], [320, 80]], [[200, 80], [200, 350]]], [240, 270]),
+    ("A", [[[100, 350], [200, 50], [300, 350]], [[140, 230], [260, 230]]], [632, 120]),
+    ("H", [[[100, 50], [100, 350]], [[300, 50], [300, 350]], [[100, 200], [300, 200]]], [300, 300, 200]),
+])
+def test_multi_mode_letters_keep_their_strokes(name, lines, lengths):
+    image = render_polylines([np.array(line, dtype=float) for line in lines])
+    result = vectorize_image(image, VectorizeOptions(multi=True, classifier="geometric"))
+    assert result.report.intersections == 0  # T-junctions are stroke ends, never crossings
+    found = sorted(s.length for s in result.drawing.strokes)
+    assert len(found) == len(lengths)
+    # A stroke ending on another line stops at that line's centre: up to half a width short.
+    assert np.allclose(found, sorted(lengths), atol=6.0)

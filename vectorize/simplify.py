@@ -134,12 +134,8 @@ def simplify(graph: MedialGraph, *, stroke_width: float, multi: bool) -> Simplif
         """
         if graph.degree(node) != 3:
             return None
-        node_slots = slots(graph, node)
-        dirs = directions(graph, node, reach)
-        foot = foot_slot(dirs)
-        far = [graph.branches[bid].other(node) for bid, _ in node_slots]
-        if graph.degree(far[foot]) == 1:
-            return foot
+        if _v_spike(graph, node, reach):
+            return foot_slot(directions(graph, node, reach))
         if multi or node not in t_spikes:
             return None
         stub = _t_stub(graph, node, reach, stroke_width)
@@ -168,10 +164,19 @@ def simplify(graph: MedialGraph, *, stroke_width: float, multi: bool) -> Simplif
                    if graph.branches[bid].a != graph.branches[bid].b]
         # A crossing at angle a keeps its two lines' inks merged over about w / sin(a / 2):
         # 40 stroke widths admits crossings down to ~3 degrees.
+        dirs = directions(graph, node, reach)
+        index = {bid: i for i, (bid, _) in enumerate(node_slots)}
+
+        def opens_a_v(bid: int) -> bool:
+            # Half a crossing: the two other branches leave at the crossing's acute
+            # angle. At a T (a stroke ending on a line) they are nearly straight.
+            a, b = (i for i in range(3) if i != index[bid])
+            return float(np.dot(dirs[a], dirs[b])) > np.cos(np.radians(CROSSING_HALF_MAX_ANGLE))
+
         options = [(bid, far) for bid, far in options if other_ok(far)
-                   and graph.branches[bid].length < 40.0 * stroke_width]
+                   and graph.branches[bid].length < 40.0 * stroke_width and opens_a_v(bid)]
         widest = max(options, key=lambda o: _min_radius(graph.branches[o[0]]), default=None)
-        foot_bid = node_slots[foot_slot(directions(graph, node, reach))][0]
+        foot_bid = node_slots[foot_slot(dirs)][0]
         foot = next((o for o in options if o[0] == foot_bid), None)
         return {"widest": widest, "foot": foot}
 
@@ -240,11 +245,23 @@ def _is_t_shape(dirs: np.ndarray) -> bool:
     return angles[2] > 150.0 and abs(angles[1] - angles[0]) < 40.0
 
 
+# At half a crossing the two branches other than the joining one meet at the crossing's
+# acute angle (<= 90 degrees, plus measuring noise).
+CROSSING_HALF_MAX_ANGLE = 125.0
+# The two sides of a V-shaped spike leave its junction at an acute angle; a T (90 degrees
+# each way) would otherwise pass the paper's foot test by a coin toss.
+V_SPIKE_MAX_ANGLE = 75.0
+
+
 def _v_spike(graph: MedialGraph, node: int, reach: float) -> bool:
-    """The paper's Y-junction: the foot of a degree-3 node ends in a free end."""
-    node_slots = slots(graph, node)
-    foot = foot_slot(directions(graph, node, reach))
-    return graph.degree(graph.branches[node_slots[foot][0]].other(node)) == 1
+    """The paper's Y-junction: the foot of a degree-3 node (opposite its smallest angle,
+    which must be acute) ends in a free end."""
+    dirs = directions(graph, node, reach)
+    foot = foot_slot(dirs)
+    sides = [i for i in range(3) if i != foot]
+    if float(np.dot(dirs[sides[0]], dirs[sides[1]])) < np.cos(np.radians(V_SPIKE_MAX_ANGLE)):
+        return False
+    return graph.degree(graph.branches[slots(graph, node)[foot][0]].other(node)) == 1
 
 
 def _t_stub(graph: MedialGraph, node: int, reach: float, stroke_width: float) -> tuple[int, float] | None:
