@@ -74,16 +74,17 @@ class Canvas:
 
     # -- items (all coordinates in mm, widths in mm unless said) --------------------
     def segments(self, a: np.ndarray, b: np.ndarray, colors: np.ndarray, width: float,
-                 *, min_px: float = 1.0) -> None:
-        """Line segments a[i] -> b[i] (S, 2) with colours (S, 3)."""
+                 *, min_px: float = 1.0, opacity: float = 1.0) -> None:
+        """Line segments a[i] -> b[i] (S, 2) with colours (S, 3). Below full `opacity`,
+        segments sewn over each other darken, as layers of thread do."""
         self.items.append(("segments", self.px(a), self.px(b), np.asarray(colors, np.uint8),
-                           max(width * self.scale, min_px), None))
+                           max(width * self.scale, min_px), None, float(opacity)))
 
     def dashed(self, a: np.ndarray, b: np.ndarray, color, width: float, dash: float) -> None:
         """Dashed segments with dashes and gaps `dash` mm long."""
         self.items.append(("segments", self.px(a), self.px(b),
                            np.tile(np.asarray(color, np.uint8), (len(a), 1)),
-                           max(width * self.scale, 1.0), max(dash * self.scale, 2.0)))
+                           max(width * self.scale, 1.0), max(dash * self.scale, 2.0), 1.0))
 
     def dots(self, points: np.ndarray, color, radius: float, *, min_px: float = 0.8) -> None:
         self.items.append(("dots", self.px(points), tuple(color), max(radius * self.scale, min_px)))
@@ -117,15 +118,17 @@ class Canvas:
         k = _SUPERSAMPLE
         image = Image.new("RGB", (self.width * k, self.height * k), self.background)
         draw = ImageDraw.Draw(image)
+        blend = ImageDraw.Draw(image, "RGBA")  # draws with alpha blending
         for item in self.items:
             kind = item[0]
             if kind == "segments":
-                _, a, b, colors, width, dash = item
+                _, a, b, colors, width, dash, opacity = item
                 w = max(1, int(round(width * k)))
                 if dash is not None:
                     a, b, colors = _dash_pieces(a, b, colors, dash)
+                pen, alpha = (draw, ()) if opacity >= 1.0 else (blend, (int(round(opacity * 255)),))
                 for (x0, y0), (x1, y1), c in zip((a * k).tolist(), (b * k).tolist(), colors.tolist()):
-                    draw.line((x0, y0, x1, y1), fill=tuple(c), width=w)
+                    pen.line((x0, y0, x1, y1), fill=tuple(c) + alpha, width=w)
             elif kind == "dots":
                 _, p, color, r = item
                 r *= k
@@ -165,7 +168,7 @@ class Canvas:
         for item in self.items:
             kind = item[0]
             if kind == "segments":
-                _, a, b, colors, width, dash = item
+                _, a, b, colors, width, dash, opacity = item
                 dash_attr = f' stroke-dasharray="{dash:.1f} {dash:.1f}"' if dash is not None else ""
                 # One path per distinct colour keeps the file small.
                 keys = colors[:, 0].astype(np.int64) << 16 | colors[:, 1].astype(np.int64) << 8 | colors[:, 2]
@@ -173,8 +176,9 @@ class Canvas:
                     sel = keys == key
                     d = " ".join(f"M{x0:.2f} {y0:.2f}L{x1:.2f} {y1:.2f}"
                                  for (x0, y0), (x1, y1) in zip(a[sel].tolist(), b[sel].tolist()))
+                    alpha = f' stroke-opacity="{opacity:.2f}"' if opacity < 1.0 else ""
                     out.append(f'<path d="{d}" fill="none" stroke="#{int(key):06x}" '
-                               f'stroke-width="{width:.2f}" stroke-linecap="round"{dash_attr}/>')
+                               f'stroke-width="{width:.2f}" stroke-linecap="round"{dash_attr}{alpha}/>')
             elif kind == "dots":
                 _, p, color, r = item
                 d = " ".join(f"M{x:.2f} {y:.2f}h0" for x, y in p.tolist())

@@ -19,6 +19,9 @@ from onestroke.errors import InputError
 from vectorize.drawing import Drawing
 
 THREAD_WIDTH = 0.35  # mm: a 40 wt embroidery thread
+# Thread is drawn slightly see-through so that layers sewn over each other (triple stitch,
+# locks, overlapping zigs) show darker, as they do on fabric.
+THREAD_OPACITY = 0.7
 NEEDLE_RADIUS = 0.12  # mm
 JUMP_COLOR = (110, 110, 110)
 TRIM_COLOR = (220, 30, 30)
@@ -81,7 +84,7 @@ def stitch_canvas(plan: StitchPlan, *, hoop: Hoop | None = None, stats: Embroide
     finite = np.isfinite(params)
     lo, hi = (params[finite].min(), params[finite].max()) if finite.any() else (0.0, 1.0)
     u = (params - lo) / max(hi - lo, 1e-12)
-    canvas.segments(a, b, gradient(u), THREAD_WIDTH)
+    canvas.segments(a, b, gradient(u), THREAD_WIDTH, opacity=THREAD_OPACITY)
     needles = points[kinds == STITCH]
     if options.needles and len(needles):
         canvas.dots(needles, (25, 25, 25), NEEDLE_RADIUS)
