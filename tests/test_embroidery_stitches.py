@@ -231,3 +231,18 @@ def test_arrow_options_refuse_bad_values():
     for kw in (dict(size=0), dict(width=-1), dict(spacing=1.0, size=2.0), dict(min_scale=0)):
         with pytest.raises(InputError):
             ArrowOptions(**kw)
+
+
+def test_zigzag_short_stitches_inset_every_other_inner_point():
+    radius = 2.5  # inner rail gap 0.4 x (1 - 1.1 / 2.5) = 0.22 mm < 0.25 mm
+    arc = spiral(0, 0, radius, radius, 0.5, n=8)
+    zig = zigzag_stitch(arc, ZigzagOptions(width=2.0, underlay=False))
+    offset = np.linalg.norm(zig.points, axis=1) - radius  # + outside, - inside
+    inner = -offset[offset < 0][3:-3]
+    assert set(np.round(inner, 2)) == {1.1, round(1.1 * 0.85, 2)}  # full reach and 15 % inset
+    assert np.all(np.abs(np.diff(np.round(inner, 2))) > 0.1)  # they alternate
+    outer = offset[offset > 0]
+    assert np.allclose(outer, 1.1, atol=0.01)
+    straight = zigzag_stitch(Stroke.from_polyline(np.array([[0.0, 0.0], [10.0, 0.0]])),
+                             ZigzagOptions(width=2.0, underlay=False))
+    assert np.allclose(np.abs(straight.points[:, 1]), 1.1)  # no inset on straight parts

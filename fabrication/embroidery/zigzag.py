@@ -138,12 +138,11 @@ def zigzag_stitch(stroke: Stroke, options: ZigzagOptions = ZigzagOptions()) -> N
     # Direction of the chord over +-reach around each point: the tangent on straight parts
     # and arcs, and a fan that turns smoothly round a sharp corner instead of jumping
     # (which would leave a wedge outside the corner and cross over inside it).
-    w = options.reach
-    ahead = stroke.points_at(curve.t_at(np.minimum(s + w, length)))
-    behind = stroke.points_at(curve.t_at(np.maximum(s - w, 0.0)))
-    chord = ahead - behind
+    # The window stays symmetric near the ends, where it shrinks to the exact tangent.
+    w = np.minimum(options.reach, np.minimum(s, length - s))
+    chord = stroke.points_at(curve.t_at(s + w)) - stroke.points_at(curve.t_at(s - w))
     norm = np.linalg.norm(chord, axis=1, keepdims=True)
-    tangent = np.where(norm > 1e-9, chord / np.maximum(norm, 1e-12), stroke.tangents_at(t))
+    tangent = np.where(norm > 1e-6, chord / np.maximum(norm, 1e-12), stroke.tangents_at(t))
     normal = np.column_stack([-tangent[:, 1], tangent[:, 0]])
     theta = np.unwrap(np.arctan2(tangent[:, 1], tangent[:, 0]))
     kappa = np.gradient(theta, s) if len(s) > 2 else np.zeros(len(s))
