@@ -72,7 +72,8 @@ class EmulatorOptions:
     """How the emulated machine behaves.
 
     time_scale: speed-up over a real machine (wire, parsing and motion all scale).
-    baud: wire rate in bit/s (10 bits a byte). parse_time: seconds a line takes to parse
+    baud: wire rate in bit/s (10 bits a byte), both ways. usb_latency: seconds a USB-serial
+    adapter adds in each direction (about 1 ms a round trip). parse_time: seconds a line takes to parse
     and plan on the AVR (GRBL parses about 500 lines/s). eeprom_write_time: seconds during
     which incoming bytes are lost after an EEPROM write. settings: $N values replacing
     `DEFAULT_SETTINGS`. boot_alarm: power up locked in ALARM (also when $22=1).
@@ -80,6 +81,7 @@ class EmulatorOptions:
 
     time_scale: float = 1.0
     baud: int = 115200
+    usb_latency: float = 0.0005
     parse_time: float = 0.002
     eeprom_write_time: float = 0.017
     rx_buffer: int = 128
@@ -139,6 +141,9 @@ class GrblEmulator:
         self.alarms: list[int] = []
         self._cond = threading.Condition()
         self._write_lock = threading.Lock()
+        self._out_cond = threading.Condition()
+        self._outbox: deque[tuple[float, bytes]] = deque()
+        self._out_free = 0.0
         self._fd: int | None = None
         self._slave_fd: int | None = None
         self.device: str | None = None
@@ -208,7 +213,7 @@ class GrblEmulator:
         os.set_blocking(fd, False)
         self._fd = fd
         for target, name in ((self._reader_loop, "rx"), (self._protocol_loop, "protocol"),
-                             (self._motion_loop, "motion")):
+                             (self._motion_loop, "motion"), (self._writer_loop, "tx")):
             thread = threading.Thread(target=target, name=f"grbl-emu-{name}", daemon=True)
             self._threads.append(thread)
             thread.start()
@@ -218,6 +223,8 @@ class GrblEmulator:
         with self._cond:
             self._stopping = True
             self._cond.notify_all()
+        with self._out_cond:
+            self._out_cond.notify_all()
         for thread in self._threads:
             if thread is not threading.current_thread():
                 thread.join(timeout=2.0)
@@ -288,19 +295,38 @@ class GrblEmulator:
     # ------------------------------------------------------------------ output
 
     def _send(self, text: str | bytes) -> None:
+        """Queue bytes for the host; they arrive after the USB latency and their wire time."""
         if self.options.faults.silent or self._fd is None:
             return
         data = text.encode("ascii") if isinstance(text, str) else text
-        with self._write_lock:
-            fd = self._fd
-            while data and fd is not None:
-                try:
-                    written = os.write(fd, data)
-                    data = data[written:]
-                except BlockingIOError:
-                    time.sleep(0.001)  # host not reading yet: the pty holds 4 KB, wait
-                except OSError:
+        byte_time = 10.0 / self.options.baud / self.scale
+        with self._out_cond:
+            start = max(time.monotonic() + self.options.usb_latency / self.scale, self._out_free)
+            self._out_free = start + len(data) * byte_time
+            self._outbox.append((self._out_free, data))
+            self._out_cond.notify()
+
+    def _writer_loop(self) -> None:
+        while True:
+            with self._out_cond:
+                while not self._outbox and not self._stopping:
+                    self._out_cond.wait(0.05)
+                if self._stopping and not self._outbox:
                     return
+                due, data = self._outbox[0]
+                wait = due - time.monotonic()
+                if wait > 0:
+                    self._out_cond.wait(wait)
+                    continue
+                self._outbox.popleft()
+            with self._write_lock:
+                while data and self._fd is not None:
+                    try:
+                        data = data[os.write(self._fd, data):]
+                    except BlockingIOError:
+                        time.sleep(0.001)  # host not reading yet: the pty holds 4 KB, wait
+                    except (OSError, TypeError):
+                        break
 
     def _reply(self, line: str) -> None:
         self._send(line + "\r\n")
@@ -337,8 +363,8 @@ class GrblEmulator:
                         continue
                     return
                 if data:
-                    if not pending:
-                        wire_t = max(wire_t, time.monotonic())
+                    if not pending:  # a new burst: the USB adapter delivers it after its latency
+                        wire_t = max(wire_t, time.monotonic() + self.options.usb_latency / self.scale)
                     pending += data
             if pending:
                 now = time.monotonic()
@@ -832,11 +858,17 @@ class GrblEmulator:
                     self.spindle_mode, self.spindle_s = planned.mode, planned.s
                     self.spindle_history.append((planned.mode, planned.s))
                 end = t0 + profile.duration / self.scale
+                known = len(self.planner)
                 while not (self._stopping or self._reset_pending or self.hold or self.critical):
                     left = end - time.monotonic()
                     if left <= 0:
                         break
                     self._cond.wait(left)
+                    if len(self.planner) > known and self.planner and self.planner[0] is planned:
+                        # GRBL re-plans the running block when a new one arrives: its exit
+                        # speed may rise now that the look-ahead reaches further.
+                        known = len(self.planner)
+                        profile, t0, end = self._replan_running(planned, profile, t0, end, v)
                 if self._stopping:
                     return
                 if self._reset_pending or self.critical:
@@ -858,6 +890,25 @@ class GrblEmulator:
                 self._current = None
                 v, clock = profile.v_exit, end
                 self._cond.notify_all()
+
+    def _replan_running(self, planned: _Planned, profile, t0: float, end: float, v_entry: float):
+        """Raise the running block's exit speed if the grown look-ahead allows (lock held)."""
+        fo, ro = self.feed_ov / 100.0, self.rapid_ov / 100.0
+        new_exit = exit_speed([p.block for p in self.planner], feed_override=fo, rapid_override=ro)
+        if new_exit <= profile.v_exit + 1e-9:
+            return profile, t0, end
+        now = time.monotonic()
+        tau = (now - t0) * self.scale
+        remaining = planned.block.length - profile.distance_at(tau)
+        if tau >= profile.duration or remaining <= 1e-9:
+            return profile, t0, end
+        speed = profile.speed_at(tau)
+        planned.start = planned.start + np.array(planned.block.unit) * profile.distance_at(tau)
+        planned.block = dataclasses.replace(planned.block, length=remaining)
+        block = planned.block
+        profile = trapezoid(speed, new_exit, block.nominal(fo, ro), block.acceleration, remaining)
+        self._current = (planned, profile, now)
+        return profile, now, now + profile.duration / self.scale
 
     def _feed_hold(self, planned: _Planned, profile, t0: float) -> None:
         """Decelerate to a stop inside the current block (lock held), then wait in Hold:0."""
