@@ -110,3 +110,15 @@ def test_bad_preview_requests_write_nothing(plan, tmp_path):
     with pytest.raises(InputError):
         PreviewOptions(width=10)
     assert list(tmp_path.iterdir()) == []
+
+
+def test_stats_box_takes_the_corner_with_fewest_stitches():
+    from fabrication.embroidery.canvas import Canvas
+
+    canvas = Canvas.fitting((0.0, 0.0, 100.0, 100.0), 1000)
+    busy_top_left = np.random.default_rng(1).uniform(0, 30, (500, 2))
+    canvas.text_box(["stitches  1", "thread    2 m"], avoid=busy_top_left)
+    origin = canvas.items[-1][3]
+    assert origin[0] > 500 and origin[1] < 50  # top-right, the first free corner
+    canvas.text_box(["stitches  1"], avoid=np.zeros((0, 2)))
+    assert canvas.items[-1][3] == (6.0, 6.0)

@@ -96,9 +96,29 @@ class Canvas:
         lo, hi = self.px(np.array(box[:2])), self.px(np.array(box[2:]))
         self.items.append(("rect", lo, hi, tuple(color), width_px))
 
-    def text_box(self, lines: list[str], *, swatch=None, corner: str = "top-left") -> None:
-        """Lines of text in a light box in a corner; `swatch` an RGB shown beside it."""
-        self.items.append(("text", list(lines), swatch, corner))
+    def text_box(self, lines: list[str], *, swatch=None, avoid: np.ndarray | None = None) -> None:
+        """Lines of text in a light box in a corner; `swatch` an RGB shown beside it. The
+        corner covering fewest of the points `avoid` (mm, (N, 2)) is used (top-left first)."""
+        lines = list(lines)
+        w, h = self._text_size(lines, swatch)
+        corners = [(6.0, 6.0), (self.width - w - 6.0, 6.0), (6.0, self.height - h - 6.0),
+                   (self.width - w - 6.0, self.height - h - 6.0)]
+        origin = corners[0]
+        if avoid is not None and len(avoid):
+            p = self.px(avoid)
+            covered = [int(np.count_nonzero((p[:, 0] >= x - 4) & (p[:, 0] <= x + w + 4)
+                                            & (p[:, 1] >= y - 4) & (p[:, 1] <= y + h + 4)))
+                       for x, y in corners]
+            origin = corners[int(np.argmin(covered))]
+        self.items.append(("text", lines, swatch, origin))
+
+    def _text_size(self, lines: list[str], swatch) -> tuple[float, float]:
+        """(width, height) px of the text box drawn by `text_box`."""
+        font = ImageFont.load_default(size=self._font_size())
+        boxes = [font.getbbox(line) for line in lines]
+        line_h = max(b[3] - b[1] for b in boxes) + 4
+        text_w = max(b[2] - b[0] for b in boxes)
+        return text_w + 12 + (line_h if swatch is not None else 0), line_h * len(lines) + 12
 
     # -- output ---------------------------------------------------------------------
     def save(self, path: str | os.PathLike) -> None:
@@ -144,20 +164,18 @@ class Canvas:
                 _, lo, hi, color, width = item
                 draw.rectangle((*(lo * k), *(hi * k)), outline=color, width=max(1, int(width * k)))
             elif kind == "text":
-                _, lines, swatch, _corner = item
+                _, lines, swatch, (ox, oy) = item
+                w, h = self._text_size(lines, swatch)
                 font = ImageFont.load_default(size=self._font_size() * k)
-                pad = 6 * k
-                boxes = [draw.textbbox((0, 0), line, font=font) for line in lines]
-                line_h = max(b[3] - b[1] for b in boxes) + 4 * k
-                text_w = max(b[2] - b[0] for b in boxes)
-                sw = line_h if swatch is not None else 0
-                draw.rectangle((pad, pad, 3 * pad + text_w + sw, 3 * pad + line_h * len(lines)),
-                               fill=(255, 255, 255), outline=(150, 150, 150), width=k)
+                line_h = (h - 12) / len(lines) * k
+                x0, y0 = ox * k, oy * k
+                draw.rectangle((x0, y0, x0 + w * k, y0 + h * k), fill=(255, 255, 255),
+                               outline=(150, 150, 150), width=k)
                 for j, line in enumerate(lines):
-                    draw.text((2 * pad, 2 * pad + j * line_h), line, fill=(20, 20, 20), font=font)
+                    draw.text((x0 + 6 * k, y0 + 6 * k + j * line_h), line, fill=(20, 20, 20), font=font)
                 if swatch is not None:
-                    x = 2 * pad + text_w + pad
-                    draw.rectangle((x, 2 * pad, x + sw - pad, 2 * pad + sw - pad), fill=tuple(swatch),
+                    x = x0 + (w - 6) * k - line_h
+                    draw.rectangle((x, y0 + 6 * k, x + line_h - 6 * k, y0 + line_h), fill=tuple(swatch),
                                    outline=(60, 60, 60), width=k)
         return image.resize((self.width, self.height), Image.LANCZOS)
 
@@ -196,19 +214,19 @@ class Canvas:
                            f'height="{hi[1] - lo[1]:.2f}" fill="none" stroke="{_hex(color)}" '
                            f'stroke-width="{width:.1f}"/>')
             elif kind == "text":
-                _, lines, swatch, _corner = item
+                _, lines, swatch, (ox, oy) = item
+                w, h = self._text_size(lines, swatch)
                 size = self._font_size()
-                line_h = size + 4
-                w = max(len(s) for s in lines) * size * 0.62 + 24 + (line_h if swatch is not None else 0)
-                out.append(f'<rect x="6" y="6" width="{w:.0f}" height="{line_h * len(lines) + 12}" '
+                line_h = (h - 12) / len(lines)
+                out.append(f'<rect x="{ox:.0f}" y="{oy:.0f}" width="{w:.0f}" height="{h:.0f}" '
                            'fill="white" stroke="#969696"/>')
                 for j, line in enumerate(lines):
                     text = line.replace("&", "&amp;").replace("<", "&lt;")
-                    out.append(f'<text x="12" y="{12 + size + j * line_h}" font-family="monospace" '
-                               f'font-size="{size}" xml:space="preserve">{text}</text>')
+                    out.append(f'<text x="{ox + 6:.0f}" y="{oy + 6 + size + j * line_h:.0f}" '
+                               f'font-family="sans-serif" font-size="{size}" xml:space="preserve">{text}</text>')
                 if swatch is not None:
-                    out.append(f'<rect x="{w - line_h:.0f}" y="12" width="{line_h - 6}" '
-                               f'height="{line_h - 6}" fill="{_hex(swatch)}" stroke="#3c3c3c"/>')
+                    out.append(f'<rect x="{ox + w - 6 - line_h:.0f}" y="{oy + 6:.0f}" width="{line_h - 6:.0f}" '
+                               f'height="{line_h - 6:.0f}" fill="{_hex(swatch)}" stroke="#3c3c3c"/>')
         out.append("</svg>")
         return "\n".join(out) + "\n"
 

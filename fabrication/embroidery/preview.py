@@ -98,7 +98,7 @@ def stitch_canvas(plan: StitchPlan, *, hoop: Hoop | None = None, stats: Embroide
         if hoop is not None:
             lines.append(f"hoop      {hoop.label}")
         lines.append("colour    start blue -> end red")
-        canvas.text_box(lines, swatch=plan.color)
+        canvas.text_box(lines, swatch=plan.color, avoid=plan.points)
     return canvas
 
 
@@ -137,5 +137,6 @@ def render_drawing_preview(drawing: Drawing, path: str | os.PathLike,
         canvas.text_box([f"strokes   {len(drawing.strokes)}",
                          f"length    {drawing.length:.1f} {drawing.unit}",
                          f"size      {xmax - xmin:.1f} x {ymax - ymin:.1f} {drawing.unit}",
-                         "colour    start blue -> end red"])
+                         "colour    start blue -> end red"],
+                        avoid=np.concatenate(a_parts))
     canvas.save(path)
