@@ -157,6 +157,8 @@ def test_unused_options_are_warned_about(inputs, tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
     result = run(["embroider", "{in}/d.svg", "-o", "o.pes", "--repeats", "2"], inputs)
     assert result.exit_code == 0 and "--repeats has no effect with --style running" in result.stderr
+    result = run(["embroider", "{in}/d.svg", "-o", "z.pes", "--style", "zigzag", "--stitch-width", "0.6mm"], inputs)
+    assert result.exit_code == 0 and "hardly shows" in result.stderr
 
 
 def _png_input(folder):

@@ -86,6 +86,7 @@ def embroider(source: str, output: str, style: str, size: str | None, width: str
     from fabrication.embroidery.preview import PreviewOptions, render_stitch_preview
     from fabrication.embroidery.stats import embroidery_stats
     from fabrication.embroidery.thread import parse_color
+    from fabrication.embroidery.zigzag import ZigzagOptions
     from fabrication.placement import PlacementOptions, place
     from machines.hoops import load_embroidery_profile
     from onestroke.units import parse_length, parse_positive_length
@@ -139,6 +140,12 @@ def embroider(source: str, output: str, style: str, size: str | None, width: str
         raise InputError(f"--spm {spm:g} must be greater than zero")
     for flag in unused:
         warn(f"{flag} has no effect with --style {style}")
+    if isinstance(stitch_options, ZigzagOptions):
+        if stitch_options.width < 1.0:
+            warn(f"a zigzag {stitch_options.width:g} mm wide hardly shows; --style triple sews a bold line")
+        elif stitch_options.width > 7.0:
+            warn(f"zigzag stitches {stitch_options.width:g} mm wide lie loose and snag; "
+                 f"they are split only above {plan_options.max_stitch:g} mm")
 
     if source.lower().endswith(".json"):
         from vectorize.svg_write import drawing_from_json
