@@ -2,7 +2,7 @@
 
 Greedy and deterministic: from each vertex take the longest run of following vertices that
 one straight line or one circular arc passes within `tolerance` of, found by exponential
-then binary search on the run length. Arc centres are rounded the way they will be written
+search (from the previous run's length) then binary search on the run length. Arc centres are rounded the way they will be written
 (I, J to 0.001 mm from the start point) before the fit is checked, so the check holds for
 the arc GRBL will actually cut.
 """
@@ -22,14 +22,15 @@ _RADIUS_MISMATCH = 0.002
 
 
 def _line_fits(p: np.ndarray, tolerance: float) -> bool:
-    a, b = p[0], p[-1]
-    d = b - a
-    length2 = float(d @ d)
+    a = p[0]
+    dx, dy = p[-1, 0] - a[0], p[-1, 1] - a[1]
+    length2 = dx * dx + dy * dy
     if length2 == 0.0:
         return False
-    t = np.clip(((p - a) @ d) / length2, 0.0, 1.0)
-    err = np.linalg.norm(p - (a + t[:, None] * d), axis=1)
-    return bool(err.max() <= tolerance)
+    rx, ry = p[:, 0] - a[0], p[:, 1] - a[1]
+    t = np.clip((rx * dx + ry * dy) / length2, 0.0, 1.0)
+    ex, ey = rx - t * dx, ry - t * dy
+    return bool((ex * ex + ey * ey).max() <= tolerance * tolerance)
 
 
 def _leaves_box(centre, radius, start_angle, sweep, box) -> bool:
@@ -67,22 +68,25 @@ def _arc_fits(p: np.ndarray, tolerance: float, quantum: float, box=None) -> tupl
         return None
     if abs(float(np.hypot(*(b - centre))) - radius) > _RADIUS_MISMATCH:
         return None
-    rel = p - centre
-    if np.abs(np.hypot(rel[:, 0], rel[:, 1]) - radius).max() > tolerance:
+    rx, ry = p[:, 0] - centre[0], p[:, 1] - centre[1]
+    err = np.abs(np.sqrt(rx * rx + ry * ry) - radius).max()
+    if err > tolerance:
         return None
-    angles = np.unwrap(np.arctan2(rel[:, 1], rel[:, 0]))
-    steps = np.diff(angles)
-    # the points must advance monotonically around the centre, all one way
     direction = CCW if cross < 0 else CW
-    sign = 1.0 if direction == CCW else -1.0
-    if np.any(steps * sign <= 0) or abs(angles[-1] - angles[0]) > MAX_SWEEP:
+    # the points must advance around the centre one way: every step turns with the arc
+    turn = np.arctan2(rx[:-1] * ry[1:] - ry[:-1] * rx[1:], rx[:-1] * rx[1:] + ry[:-1] * ry[1:])
+    if direction == CW:
+        turn = -turn
+    sweep = float(turn.sum())
+    if turn.min() <= 0 or sweep > MAX_SWEEP:
         return None
     # chords between consecutive points may cut inside the circle: bound their sagitta
-    chord = np.hypot(*np.diff(p, axis=0).T).max()
-    if chord * chord / (8 * radius) + np.abs(np.hypot(rel[:, 0], rel[:, 1]) - radius).max() > tolerance:
+    cx, cy = np.diff(p[:, 0]), np.diff(p[:, 1])
+    if (cx * cx + cy * cy).max() / (8 * radius) + err > tolerance:
         return None
     # reversed (later passes), the arc is written from its other end: allow for that radius
-    if _leaves_box(centre, radius + _RADIUS_MISMATCH, angles[0], angles[-1] - angles[0], box):
+    start_angle = float(np.arctan2(ry[0], rx[0]))
+    if _leaves_box(centre, radius + _RADIUS_MISMATCH, start_angle, sweep if direction == CCW else -sweep, box):
         return None
     return centre, direction
 
@@ -121,6 +125,7 @@ def fit_arcs(points: np.ndarray, tolerance: float, *, quantum: float = 0.001, bo
     points: (N, 2) dense polyline, mm, machine frame (+y up, so G2 = clockwise).
     Returns vertices (M, 2) (a subset of points, first and last kept), kinds (M-1,) int8
     (1 line, 2 clockwise arc, 3 counter-clockwise arc) and centres (M-1, 2) (NaN for lines).
+    box: (xmin, ymin, xmax, ymax) that no arc may bulge out of (the bed), or None.
     """
     p = np.asarray(points, dtype=float)
     n = len(p)
@@ -141,6 +146,7 @@ def fit_arcs(points: np.ndarray, tolerance: float, *, quantum: float = 0.001, bo
         return arc[1], arc[0]
 
     i = 0
+    guess = 2
     while i < n - 1:
         if i + 2 <= n - 1 and hopeless[i]:
             # nothing longer than one segment can start here: write the line at once
@@ -150,12 +156,11 @@ def fit_arcs(points: np.ndarray, tolerance: float, *, quantum: float = 0.001, bo
             i += 1
             continue
         good_j, good = i + 1, fit(i, i + 1)
-        step = 2
+        # runs along a smooth curve have similar lengths: search from the last one's
+        step = max(2, guess)
         bad_j = None
         while True:
-            j = i + step
-            if j >= n - 1:
-                j = n - 1
+            j = min(i + step, n - 1)
             result = fit(i, j) if j > good_j else None
             if result is None:
                 bad_j = j if j > good_j else None
@@ -174,6 +179,7 @@ def fit_arcs(points: np.ndarray, tolerance: float, *, quantum: float = 0.001, bo
                 else:
                     lo, good = mid, result
             good_j = lo
+        guess = good_j - i
         kind, centre = good
         keep.append(good_j)
         kinds.append(kind)

@@ -4,7 +4,7 @@ Shows the truth of the file, not of the plan: every move is read back with `gcod
 Burn moves are coloured along the job's order (blue first, through purple and red, to
 yellow last), travel is dashed grey, the first burn is marked with a green ring, machine
 (0, 0) with a cross. The main view is zoomed on the job; a thumbnail shows it on the bed
-outline. The side panel prints the GRBL planner-model time and the length/feed figure.
+outline (travel leaving the view is clipped). The side panel prints the GRBL planner-model time and the length/feed figure.
 """
 
 from __future__ import annotations
@@ -89,9 +89,10 @@ def _scene(moves: GcodeMoves, job: JobTime, profile: LaserProfile, name: str) ->
         colours.append(np.repeat(order_colours(np.array([frac])), len(pts), axis=0))
     if current:
         burn.append((np.vstack(current), np.vstack(colours)))
-    everything = [p for p, _ in burn] + travel
-    if everything:
-        pts = np.vstack(everything)
+    # the view is zoomed on what is burned; travel leaving it is clipped at the edge
+    shown = [p for p, _ in burn] or travel
+    if shown:
+        pts = np.vstack(shown)
         bounds = (*pts.min(axis=0), *pts.max(axis=0))
     else:
         bounds = (0.0, 0.0, profile.bed_width, profile.bed_height)
@@ -101,7 +102,7 @@ def _scene(moves: GcodeMoves, job: JobTime, profile: LaserProfile, name: str) ->
             f"length / feed: {format_duration(job.naive_seconds)} (common senders)",
             f"burn {burn_len:.0f} mm, travel {travel_len:.0f} mm",
             f"{moves.n_lines} lines, {job.blocks} planner blocks",
-            f"job {bounds[2] - bounds[0]:.1f} x {bounds[3] - bounds[1]:.1f} mm",
+            f"burn area {bounds[2] - bounds[0]:.1f} x {bounds[3] - bounds[1]:.1f} mm",
             f"bed {profile.bed_width:g} x {profile.bed_height:g} mm",
             "", "colour: burn order (first -> last)", "dashed grey: travel, laser off",
             "green ring: start, cross: (0, 0)"]
