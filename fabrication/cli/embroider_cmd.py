@@ -156,7 +156,11 @@ def embroider(source: str, output: str, style: str, size: str | None, width: str
         from fabrication.cli.common import read_drawing
 
         drawing = read_drawing(source, multi=multi, threshold=threshold, blur=blur, classifier=classifier)
-    placed = fit_to_hoop(place(drawing, placement), the_hoop, reach=style_reach(stitch_options), fit=fit)
+    unfitted = place(drawing, placement)
+    placed = fit_to_hoop(unfitted, the_hoop, reach=style_reach(stitch_options), fit=fit)
+    if placed is not unfitted:
+        x0, y0, x1, y1 = placed.bounds()
+        warn(f"scaled down to {x1 - x0:.1f} x {y1 - y0:.1f} mm to fit hoop {the_hoop.label}")
     plan = plan_embroidery(placed, plan_options)
     check_plan_in_hoop(plan, the_hoop)
     stats = embroidery_stats(plan, stitches_per_minute=spm or profile.stitches_per_minute,
