@@ -2,6 +2,8 @@
 
 Centre points every spacing/2 along the curve (an even number of them), each pushed
 perpendicular to the local direction by width/2 + pull_compensation/2, alternating sides.
+The direction is the chord over +-reach around the point: the tangent on straight parts
+and arcs, a fan round a sharp corner.
 On tight inner curves the inside points crowd: every other inner point is inset
 (Ink/Stitch's short stitches), the inside reach is capped below the curve radius, and a
 rail point still closer than `min_gap` to the previous one on its rail is dropped (the
