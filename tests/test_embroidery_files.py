@@ -69,10 +69,11 @@ def test_file_reads_back_as_planned_and_is_sewable(style, ext, folder):
     check_plan_in_hoop(back, HOOP)
 
 
+@pytest.mark.parametrize("ext", FORMATS)
 @pytest.mark.parametrize("style", STYLE_NAMES)
-def test_every_stroke_begins_with_a_tack_and_ends_with_a_lock(style, folder):
+def test_every_stroke_begins_with_a_tack_and_ends_with_a_lock(style, ext, folder):
     plan = planned(style)
-    back = written(style, "dst", folder).plan
+    back = written(style, ext, folder).plan
     needles_back = back.points[back.kinds == STITCH]
     needles_plan_rows = np.flatnonzero(plan.kinds == STITCH)
     position = {row: i for i, row in enumerate(needles_plan_rows)}
