@@ -171,3 +171,35 @@ def test_thread_colours():
         parse_color("blurple")
     with pytest.raises(InputError):
         PlanOptions(color=(300, 0, 0))
+
+
+def _dots(n):
+    return tuple(_line([i * 5.0, 0.0], [i * 5.0 + 0.5, 0.0]) for i in range(n))
+
+
+EDGE_CASES = {
+    "no strokes": (Drawing((), 10, 10, "mm"), InputError),
+    "one point": (Drawing((Stroke(np.zeros((1, 4, 2))),), 1, 1, "mm"), InputError),
+    "shorter than a stitch": (Drawing((_line([0, 0], [0.2, 0]),), 1, 1, "mm"), InputError),
+    "just over the minimum": (Drawing((_line([0, 0], [0.35, 0]),), 1, 1, "mm"), None),
+    "closed loop": (Drawing((spiral(0, 0, 10, 10, 1.0),), 20, 20, "mm"), None),
+    "300 short strokes": (Drawing(_dots(300), 1500, 1, "mm"), None),
+    "pixels, not placed": (Drawing((_line([0, 0], [10, 0]),), 10, 1, "px"), InputError),
+}
+
+
+@pytest.mark.parametrize("name", list(EDGE_CASES))
+@pytest.mark.parametrize("style", ["running", "triple", "zigzag", "arrows"])
+def test_edge_cases(name, style):
+    drawing, error = EDGE_CASES[name]
+    options = PlanOptions(style=style_options(style))
+    if error is not None:
+        with pytest.raises(error):
+            plan_embroidery(drawing, options)
+        return
+    plan = plan_embroidery(drawing, options)
+    lengths = np.hypot(*sewn_stitches(plan).T)
+    assert lengths.min() > 0 and np.abs(sewn_stitches(plan)).max() <= 12.1 + 1e-9
+    assert len(stroke_rows(plan)) == len(drawing.strokes)
+    if name == "300 short strokes":
+        assert (plan.kinds == TRIM).sum() == 299  # 5 mm apart: lock, trim, jump, tack each time
