@@ -16,7 +16,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from onestroke.errors import InputError
-from onestroke.units import parse_length, parse_positive_length, parse_size_pair, parse_speed
+from onestroke.units import parse_positive_length, parse_size_pair, parse_speed
 
 DEFAULT_PROFILE_PATH = Path(__file__).with_name("profiles") / "laser-default.toml"
 

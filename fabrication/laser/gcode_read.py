@@ -24,9 +24,17 @@ _GARBAGE = re.compile(r"[^A-Z0-9.+\-\s]")
 INCH = 25.4
 
 
+_SPACE = re.compile(r"\s+")
+
+
 def strip_line(line: str) -> str:
     """What GRBL keeps of a line: upper case, without comments and spaces."""
-    return re.sub(r"\s+", "", _COMMENT.sub("", line)).upper()
+    # the regexes only run when needed: most lines onestroke writes have neither
+    if "(" in line or ";" in line:
+        line = _COMMENT.sub("", line)
+    if " " in line or "\t" in line or "\r" in line or "\n" in line:
+        line = _SPACE.sub("", line)
+    return line.upper()
 
 
 @dataclass(frozen=True)

@@ -81,7 +81,10 @@ def _path_lines(path: BurnPath, position: tuple[str, str], first_words: str) -> 
             words += "Y" + y
         if kind != LINE:
             # GRBL needs at least one of I, J; zero offsets are left out
-            words += ("I" + i_words[k] if i_words[k] != "0" else "") + ("J" + j_words[k] if j_words[k] != "0" or i_words[k] == "0" else "")
+            if i_words[k] != "0":
+                words += "I" + i_words[k]
+            if j_words[k] != "0" or i_words[k] == "0":
+                words += "J" + j_words[k]
         if k == 0:
             words += first_words
         lines.append(words)
@@ -98,7 +101,7 @@ def gcode_lines(toolpath: Toolpath, profile: LaserProfile, options: GcodeOptions
     lines += ["G21", "G90", "M4S0" if options.dynamic else "M3S0"]
     if air:
         lines.append("M8")
-    position = ("0", "0")  # GRBL's position is unknown here; a G0 to the start always follows
+    # the head's position is unknown before the job: the first stroke always gets its G0
     position = ("", "")
     for index in range(options.passes):
         paths = toolpath.paths if index % 2 == 0 else tuple(p.reversed() for p in toolpath.paths[::-1])
