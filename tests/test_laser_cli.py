@@ -125,14 +125,32 @@ def test_failed_run_keeps_a_good_file(svg, tmp_path):
     assert out.read_bytes() == before
 
 
-@pytest.mark.skipif(importlib.util.find_spec("vectorize.cnn_classifier") is None,
-                    reason="the CNN crossing classifier is not in the tree yet")
-def test_png_end_to_end(tmp_path):
+@pytest.mark.parametrize("classifier", ["geometric", "cnn"])
+def test_png_end_to_end(tmp_path, classifier):
+    if classifier == "cnn" and importlib.util.find_spec("vectorize.cnn_classifier") is None:
+        pytest.skip("the CNN crossing classifier is not in the tree yet")
     png = trefoil_png(tmp_path / "trefoil.png")
     out = tmp_path / "trefoil.gcode"
-    result = run(png, "-o", out, "--size", "60mm", "--preview", tmp_path / "trefoil.png.svg")
+    result = run(png, "-o", out, "--size", "60mm", "--classifier", classifier,
+                 "--preview", tmp_path / "trefoil.preview.svg")
     assert result.exit_code == 0, result.output
-    assert validate_gcode(out.read_text().splitlines()) == []
+    lines = out.read_text().splitlines()
+    assert validate_gcode(lines) == []
+    moves = parse_gcode(lines)
+    # one single-line drawing: one G0 to its start, then one continuous burn
+    assert int((moves.kind == 0).sum()) == 1
+    burn = moves.end[moves.laser_on]
+    assert max(burn.max(axis=0) - burn.min(axis=0)) == pytest.approx(60.0, abs=0.05)
+
+
+def test_preview_command_reads_laser_gcode(svg, tmp_path):
+    out = tmp_path / "job.gcode"
+    assert run(svg, "-o", out, "--size", "30mm").exit_code == 0
+    result = CliRunner().invoke(main, ["preview", str(out), "-o", str(tmp_path / "p.png")])
+    if result.exit_code != 0 and "No such command" in result.output:
+        pytest.skip("the preview command is not registered")
+    assert result.exit_code == 0, result.output
+    assert (tmp_path / "p.png").stat().st_size > 1000
 
 
 def test_port_streams_the_written_job_to_the_emulator(svg, tmp_path):

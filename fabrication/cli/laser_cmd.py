@@ -49,13 +49,15 @@ def frame_path_for(output: str) -> str:
               help="Line interval of the raster engraving the time is compared with.")
 @click.option("--multi", is_flag=True, help="Raster input: multi-stroke vectorization.")
 @click.option("--threshold", type=float, default=None, help="Raster input: ink threshold in (0, 1).")
+@click.option("--classifier", type=click.Choice(["cnn", "geometric"]), default="cnn", show_default=True,
+              help="Raster input: how the vectorizer tells crossings from touchings.")
 @click.option("--port", default=None, help="After writing, stream the job to this serial port (sim:// for a dry run).")
 @click.option("--baud", type=int, default=115200, show_default=True, help="Baud rate for --port.")
 def laser(source: str, output: str, size: str | None, width: str | None, height: str | None, rotate: float,
           origin: str, feed: str, power: str, passes: int, tolerance: str, arcs: bool, keep_order: bool,
           profile_path: str | None, air_assist: bool | None, return_home: bool, frame: bool, frame_power: str,
           preview_path: str | None, raster_interval: str, multi: bool, threshold: float | None,
-          port: str | None, baud: int) -> None:
+          classifier: str, port: str | None, baud: int) -> None:
     """Turn SOURCE (PNG/JPG/SVG) into G-code for a GRBL 1.1 laser in one continuous pass per stroke."""
     from fabrication.cli.common import read_drawing
     from fabrication.laser.framing import framing_lines
@@ -106,7 +108,7 @@ def laser(source: str, output: str, size: str | None, width: str | None, height:
         raise InputError(f"input file {source!r} does not exist")
 
     with console.status(f"reading {os.path.basename(source)}"):
-        drawing = read_drawing(source, multi=multi, threshold=threshold)
+        drawing = read_drawing(source, multi=multi, threshold=threshold, classifier=classifier)
     with console.status("planning the toolpath"):
         toolpath = plan_toolpath(drawing, profile, toolpath_options)
         lines = gcode_lines(toolpath, profile, gcode_options)
