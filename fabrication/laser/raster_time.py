@@ -14,7 +14,6 @@ from dataclasses import dataclass
 import numpy as np
 from PIL import Image, ImageDraw
 
-from fabrication.laser.arcs import LINE
 from fabrication.laser.job_time import block_times
 from fabrication.laser.toolpath import Toolpath
 from machines.laser_profile import LaserProfile
@@ -32,32 +31,6 @@ class RasterTime:
     rows: int
     interval: float
     moves: int
-
-
-def path_polyline(path, *, max_angle: float = 0.05) -> np.ndarray:
-    """The path as a polyline (N, 2), arcs sampled every `max_angle` radians."""
-    if not (path.kinds != LINE).any():
-        return path.points
-    out = [path.points[:1]]
-    for k, kind in enumerate(path.kinds.tolist()):
-        a, b = path.points[k], path.points[k + 1]
-        if kind == LINE:
-            out.append(b[None])
-            continue
-        c = path.centres[k]
-        a0 = np.arctan2(a[1] - c[1], a[0] - c[0])
-        sweep = np.arctan2((a - c)[0] * (b - c)[1] - (a - c)[1] * (b - c)[0], float((a - c) @ (b - c)))
-        if kind == 3 and sweep <= 0:
-            sweep += 2 * np.pi
-        if kind == 2 and sweep >= 0:
-            sweep -= 2 * np.pi
-        n = max(2, int(np.ceil(abs(sweep) / max_angle)))
-        t = a0 + sweep * np.arange(1, n + 1) / n
-        r = np.hypot(*(a - c))
-        pts = c + r * np.c_[np.cos(t), np.sin(t)]
-        pts[-1] = b
-        out.append(pts)
-    return np.vstack(out)
 
 
 def raster_time(toolpath: Toolpath, profile: LaserProfile, *, interval: float = 0.1, feed: float = 1500.0,
@@ -82,7 +55,7 @@ def raster_time(toolpath: Toolpath, profile: LaserProfile, *, interval: float = 
     draw = ImageDraw.Draw(image)
     px_width = max(1, int(round(width_mm / interval)))
     for path in toolpath.paths:
-        pts = path_polyline(path)
+        pts = path.polyline()
         xy = np.c_[(pts[:, 0] - xmin + pad) / interval, (pts[:, 1] - ymin + pad) / interval]
         draw.line([tuple(p) for p in xy.tolist()], fill=1, width=px_width)
     ink = np.asarray(image, dtype=bool)

@@ -85,6 +85,30 @@ class BurnPath:
         out[arc] = r * np.abs(sweep)
         return out
 
+    def polyline(self, *, max_angle: float = 0.05) -> np.ndarray:
+        """The path as a polyline (N, 2), arcs sampled every `max_angle` radians."""
+        if not (self.kinds != LINE).any():
+            return self.points
+        out = [self.points[:1]]
+        for k, kind in enumerate(self.kinds.tolist()):
+            a, b = self.points[k], self.points[k + 1]
+            if kind == LINE:
+                out.append(b[None])
+                continue
+            c = self.centres[k]
+            ra, rb = a - c, b - c
+            sweep = np.arctan2(ra[0] * rb[1] - ra[1] * rb[0], float(ra @ rb))
+            if kind == CCW and sweep <= 0:
+                sweep += 2 * np.pi
+            if kind == CW and sweep >= 0:
+                sweep -= 2 * np.pi
+            n = max(2, int(np.ceil(abs(sweep) / max_angle)))
+            angles = np.arctan2(ra[1], ra[0]) + sweep * np.arange(1, n + 1) / n
+            pts = c + np.hypot(*ra) * np.c_[np.cos(angles), np.sin(angles)]
+            pts[-1] = b
+            out.append(pts)
+        return np.vstack(out)
+
     @property
     def length(self) -> float:
         return float(self.segment_lengths().sum())
@@ -211,8 +235,8 @@ def plan_toolpath(drawing: Drawing, profile: LaserProfile,
             planned.append((path, stroke))
     if not planned:
         raise InputError("every stroke of the drawing has zero length; nothing to engrave")
-    # the bed check runs on the points that will be burned: that is what must stay inside
-    everything = np.vstack([p.points for p, _ in planned])
+    # the bed check runs on what will be burned, arcs included: that is what must stay inside
+    everything = np.vstack([p.polyline(max_angle=0.01) for p, _ in planned])
     bounds = (*map(float, everything.min(axis=0)), *map(float, everything.max(axis=0)))
     _check_bed(bounds, profile)
     starts = np.array([p.points[0] for p, _ in planned])
