@@ -211,8 +211,9 @@ def _plan_stroke(stroke: Stroke, tolerance: float, arcs: bool, box) -> BurnPath 
         return BurnPath(points, kinds, centres)
     simple = shapely.get_coordinates(
         shapely.simplify(shapely.linestrings(dense), fit_tolerance, preserve_topology=False))
-    points = _dedupe(simple) if len(simple) >= 2 else dense[[0, -1]]
+    points = _dedupe(simple)
     if len(points) < 2:
+        # a tiny closed loop can simplify to a single point: keep its first segment at least
         points = dense[[0, -1]] if np.any(dense[0] != dense[-1]) else dense[:2]
     kinds = np.full(len(points) - 1, LINE, dtype=np.int8)
     return BurnPath(points, kinds, np.full((len(points) - 1, 2), np.nan))
@@ -224,6 +225,12 @@ def plan_toolpath(drawing: Drawing, profile: LaserProfile,
     if not drawing.strokes:
         raise InputError("the drawing has no strokes to engrave")
     machine = _to_machine(drawing, profile, options)
+    # refuse a design larger than the bed before flattening it (that can take long)
+    w, h = machine.width, machine.height
+    if w > profile.bed_width + QUANTUM or h > profile.bed_height + QUANTUM:
+        x0, y0 = (0.0, 0.0) if options.origin == "lower-left" else (
+            (profile.bed_width - w) / 2, (profile.bed_height - h) / 2)
+        _check_bed((x0, y0, x0 + w, y0 + h), profile)
     box = (0.0, 0.0, profile.bed_width, profile.bed_height)  # no arc may bulge out of the bed
     planned: list[tuple[BurnPath, Stroke]] = []
     dropped = 0
