@@ -42,6 +42,15 @@ def test_writes_gcode_frame_and_preview(svg, tmp_path):
     assert burn.max(axis=0).max() == pytest.approx(50.0, abs=0.02)
 
 
+def test_long_unicode_file_name_keeps_lines_valid(svg, tmp_path):
+    source = tmp_path / ("ünïcödé drawing " * 8 + ".svg")
+    source.write_bytes(svg.read_bytes())
+    out = tmp_path / "job.gcode"
+    assert run(source, "-o", out, "--size", "20mm").exit_code == 0
+    text = out.read_text(encoding="ascii")
+    assert validate_gcode(text.splitlines()) == []
+
+
 def test_profile_and_center_origin(svg, tmp_path):
     profile = tmp_path / "small.toml"
     profile.write_text('name = "small"\n[bed]\nsize = "100x80mm"\n[laser]\nmax_power = 255\n')

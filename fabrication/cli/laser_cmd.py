@@ -61,7 +61,7 @@ def laser(source: str, output: str, size: str | None, width: str | None, height:
     """Turn SOURCE (PNG/JPG/SVG) into G-code for a GRBL 1.1 laser in one continuous pass per stroke."""
     from fabrication.cli.common import read_drawing
     from fabrication.laser.framing import framing_lines
-    from fabrication.laser.gcode_write import GcodeOptions, gcode_lines, write_gcode
+    from fabrication.laser.gcode_write import GcodeOptions, comment_line, gcode_lines, write_gcode
     from fabrication.laser.job_time import estimate_gcode_time, format_duration
     from fabrication.laser.raster_time import raster_time
     from fabrication.laser.toolpath import ToolpathOptions, plan_toolpath
@@ -121,7 +121,7 @@ def laser(source: str, output: str, size: str | None, width: str | None, height:
         f"estimated time {format_duration(job.total_seconds)} (GRBL planner model)",
         f"profile: {profile.name}",
     )
-    lines = [f"; {c}" for c in comments] + lines
+    lines = [comment_line(c) for c in comments] + lines
     write_gcode(output, lines)
     if frame_file:
         write_gcode(frame_file, framing_lines(toolpath.bounds, profile, power=frame_fraction))

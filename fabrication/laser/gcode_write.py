@@ -48,6 +48,12 @@ class GcodeOptions:
             raise InputError(f"passes {self.passes!r} must be a whole number >= 1")
 
 
+def comment_line(text: str) -> str:
+    """A `;` comment line: ASCII only, one line, at most 80 characters."""
+    clean = " ".join(text.split()).encode("ascii", "replace").decode("ascii")
+    return ("; " + clean)[:MAX_LINE].rstrip()
+
+
 def fmt(value: float) -> str:
     """A compact G-code number: 3 decimals at most, no trailing zeros, no '-0'."""
     text = ("%.3f" % value).rstrip("0").rstrip(".")
@@ -97,7 +103,7 @@ def gcode_lines(toolpath: Toolpath, profile: LaserProfile, options: GcodeOptions
     air = profile.air_assist if options.air_assist is None else options.air_assist
     s_value = fmt(options.power * profile.max_power)
     first_words = f"S{s_value}F{fmt(options.feed)}"
-    lines = ["; " + c[:MAX_LINE - 2].rstrip() for c in comments]
+    lines = [comment_line(c) for c in comments]
     lines += ["G21", "G90", "M4S0" if options.dynamic else "M3S0"]
     if air:
         lines.append("M8")
