@@ -31,7 +31,7 @@ def _limit(limits, unit):
 
 def simulate(lines, *, max_rate=(6000.0, 6000.0), accel=(500.0, 500.0), junction_deviation=0.01,
              arc_tolerance=0.002, steps_per_mm=(80.0, 80.0), planner_blocks=15, dt=1e-4) -> float:
-    """Seconds GRBL takes for `lines`, planner kept full. Rates mm/min, accel mm/s²."""
+    """Seconds GRBL takes for `lines` in laser mode, planner kept full. Rates mm/min, accel mm/s²."""
     rates = (max_rate[0] / 60.0, max_rate[1] / 60.0)
     program = _targets(lines, arc_tolerance)  # list of ("move", x, y, feed, rapid) | ("sync",)
     clock = 0.0
@@ -165,6 +165,7 @@ def _targets(lines, arc_tolerance):
         words = _WORDS.findall(text)
         vals = {}
         sync = False
+        old_motion, old_spindle = motion, spindle
         for k, v in words:
             if k == "G":
                 g = int(float(v))
@@ -191,19 +192,23 @@ def _targets(lines, arc_tolerance):
         if "F" in vals:
             feed = vals["F"]
         moving = ("X" in vals or "Y" in vals)
-        if "S" in vals and vals["S"] != s_val:
-            if spindle != 5 and not (moving and motion != 0):
-                sync = True
+        # laser mode ($32=1), gcode.c step 4: a line with axis words never syncs on S; one
+        # without them syncs on an S change while the spindle is on, and under M3 also when
+        # it switches between rapid and cutting motion modes
+        forced = (not moving and old_spindle == 3
+                  and (old_motion in (1, 2, 3)) != (motion in (1, 2, 3)))
+        if old_spindle != 5 and not moving and (("S" in vals and vals["S"] != s_val) or forced):
+            sync = True
+        if "S" in vals:
             s_val = vals["S"]
         if sync:
             out.append(("sync",))
         if not moving:
             continue
-        tx = (x if not relative else 0.0) if "X" not in vals else vals["X"] + (x if relative else 0.0)
-        ty = (y if not relative else 0.0) if "Y" not in vals else vals["Y"] + (y if relative else 0.0)
         if relative:
-            tx = x + vals.get("X", 0.0)
-            ty = y + vals.get("Y", 0.0)
+            tx, ty = x + vals.get("X", 0.0), y + vals.get("Y", 0.0)
+        else:
+            tx, ty = vals.get("X", x), vals.get("Y", y)
         if motion in (2, 3):
             out.extend(_arc(x, y, tx, ty, vals.get("I", 0.0), vals.get("J", 0.0), motion == 2, feed, arc_tolerance))
         else:

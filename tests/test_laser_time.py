@@ -95,6 +95,31 @@ def test_forced_stops_are_modelled():
     assert dwell.total_seconds == pytest.approx(a.total_seconds + 1.5, abs=1e-9)
 
 
+@pytest.mark.parametrize("between,same_without_stop,stops", [
+    (["G1X60S300"], ["G1X60"], False),                # S change on a moving G1: laser mode keeps going
+    (["G0X60S300", "G1X70"], ["G0X60", "G1X70"], False),  # ... on a moving G0 too (any line with axes)
+    (["S300"], [], True),                            # S change on a line that does not move
+    (["M8"], [], True),                              # coolant (air assist) change
+    (["M4"], [], False),                             # spindle state unchanged: no stop
+    (["G4P0"], [], True),                            # dwell
+])
+def test_what_forces_a_stop(between, same_without_stop, stops):
+    base = ["G21", "G90", "M4S0", "G0X0Y0", "G1X50S500F3000"]
+    after = ["G1X100Y0", "M5"]
+    smooth = estimate_gcode_time(base + same_without_stop + after, PROFILE)
+    job = estimate_gcode_time(base + between + after, PROFILE)
+    assert (job.total_seconds > smooth.total_seconds + 0.02) == stops
+    assert job.total_seconds == pytest.approx(_sim(base + between + after), rel=0.02)
+
+
+def test_m3_mode_switch_without_motion_stops():
+    base = ["G21", "G90", "M3S500", "G1X50F3000", "G1X60"]
+    plain = estimate_gcode_time(base + ["G1X100", "M5"], PROFILE)
+    switched = estimate_gcode_time(base + ["G0", "G1X100", "M5"], PROFILE)
+    assert switched.total_seconds > plain.total_seconds + 0.02
+    assert switched.total_seconds == pytest.approx(_sim(base + ["G0", "G1X100", "M5"]), rel=0.02)
+
+
 def test_per_line_seconds_are_cumulative():
     lines = spiral(3000.0)
     job = estimate_gcode_time(lines, PROFILE)

@@ -88,6 +88,7 @@ def parse_gcode(lines, *, laser_mode: bool = True) -> GcodeMoves:
         g_codes = [float(v) for k, v in words if k == "G"]
         m_codes = [int(float(v)) for k, v in words if k == "M"]
         values = {k: float(v) for k, v in words if k not in "GM"}
+        previous_motion, spindle_before = motion, spindle
         for g in g_codes:
             if g in (0, 1, 2, 3):
                 motion = int(g)
@@ -113,10 +114,17 @@ def parse_gcode(lines, *, laser_mode: bool = True) -> GcodeMoves:
             feed = values["F"] * scale
         has_axes = "X" in values or "Y" in values
         is_motion = has_axes and 4 not in g_codes and not any(g in (28, 30, 53, 92, 10) for g in g_codes)
-        if "S" in values and values["S"] != s_value:
-            # GRBL keeps moving through S changes only on laser-mode G1/G2/G3 lines
-            if spindle != 5 and not (laser_mode and is_motion and motion != 0):
-                pending_stop = True
+        # GRBL gcode.c: in laser mode any line that moves (G0 too) carries its S through the
+        # planner; a spindle-on S change on a line that does not move drains the planner, and
+        # so does, under M3, a switch between G0 and G1/G2/G3 mode on a line that does not move
+        force_sync = False
+        if laser_mode and not is_motion and spindle_before == 3:
+            cutting_before, cutting_now = previous_motion in (1, 2, 3), motion in (1, 2, 3)
+            force_sync = cutting_before != cutting_now
+        s_changed = "S" in values and values["S"] != s_value
+        if (s_changed or force_sync) and spindle_before != 5 and not (laser_mode and is_motion):
+            pending_stop = True
+        if "S" in values:
             s_value = values["S"]
         if not is_motion:
             continue
