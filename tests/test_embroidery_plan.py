@@ -203,3 +203,24 @@ def test_edge_cases(name, style):
     assert len(stroke_rows(plan)) == len(drawing.strokes)
     if name == "300 short strokes":
         assert (plan.kinds == TRIM).sum() == 299  # 5 mm apart: lock, trim, jump, tack each time
+
+
+def test_embroider_pipeline_places_fits_stitches_and_measures():
+    from fabrication.embroidery.pipeline import EmbroideryJob, embroider
+
+    px = Drawing((spiral(300, 300, 20, 200, 2.0),), 600, 600, "px")
+    result = embroider(px)  # 90 mm in the 4x4 hoop, running stitch
+    xmin, ymin, xmax, ymax = result.drawing.bounds()
+    assert max(xmax - xmin, ymax - ymin) == pytest.approx(90.0, abs=1e-6)
+    assert result.fit_scale == 1.0 and result.stats.stitches == int((result.plan.kinds == STITCH).sum())
+    job = EmbroideryJob(placement=PlacementOptions(size=150.0), hoop=hoop_named("4x4"), fit=True,
+                        plan=PlanOptions(style=ZigzagOptions(width=8.0)), stitches_per_minute=800)
+    fitted = embroider(px, job)
+    assert fitted.fit_scale < 0.7 and any("scaled down" in w for w in fitted.warnings)
+    assert any("lie loose" in w for w in fitted.warnings)
+    check_plan_in_hoop(fitted.plan, hoop_named("4x4"))
+    assert fitted.stats.stitches_per_minute == 800
+    with pytest.raises(InputError, match="hoop 100x100"):
+        embroider(px, EmbroideryJob(placement=PlacementOptions(size=150.0)))
+    with pytest.raises(InputError):
+        EmbroideryJob(stitches_per_minute=0)

@@ -80,14 +80,12 @@ def embroider(source: str, output: str, style: str, size: str | None, width: str
     """Sew SOURCE (PNG/JPG/SVG/JSON drawing) along its curve into an embroidery file."""
     from fabrication.embroidery.canvas import check_preview_path
     from fabrication.embroidery.export import PES_VERSIONS, write_embroidery
-    from fabrication.embroidery.hooping import check_plan_in_hoop, fit_to_hoop
     from fabrication.embroidery.locks import LockOptions
-    from fabrication.embroidery.plan import PlanOptions, plan_embroidery, style_options, style_reach
+    from fabrication.embroidery.pipeline import EmbroideryJob, embroider as embroider_drawing
+    from fabrication.embroidery.plan import PlanOptions, style_options
     from fabrication.embroidery.preview import PreviewOptions, render_stitch_preview
-    from fabrication.embroidery.stats import embroidery_stats
     from fabrication.embroidery.thread import parse_color
-    from fabrication.embroidery.zigzag import ZigzagOptions
-    from fabrication.placement import PlacementOptions, place
+    from fabrication.placement import PlacementOptions
     from machines.hoops import load_embroidery_profile
     from onestroke.units import parse_length, parse_positive_length
 
@@ -138,14 +136,11 @@ def embroider(source: str, output: str, style: str, size: str | None, width: str
                                color=parse_color(color))
     if spm is not None and not spm > 0:
         raise InputError(f"--spm {spm:g} must be greater than zero")
+    job = EmbroideryJob(placement=placement, hoop=the_hoop, fit=fit, plan=plan_options,
+                        stitches_per_minute=spm or profile.stitches_per_minute,
+                        trim_seconds=profile.trim_seconds)
     for flag in unused:
         warn(f"{flag} has no effect with --style {style}")
-    if isinstance(stitch_options, ZigzagOptions):
-        if stitch_options.width < 1.0:
-            warn(f"a zigzag {stitch_options.width:g} mm wide hardly shows; --style triple sews a bold line")
-        elif stitch_options.width > 7.0:
-            warn(f"zigzag stitches {stitch_options.width:g} mm wide lie loose and snag; "
-                 f"they are split only above {plan_options.max_stitch:g} mm")
 
     if source.lower().endswith(".json"):
         from vectorize.svg_write import drawing_from_json
@@ -156,23 +151,15 @@ def embroider(source: str, output: str, style: str, size: str | None, width: str
         from fabrication.cli.common import read_drawing
 
         drawing = read_drawing(source, multi=multi, threshold=threshold, blur=blur, classifier=classifier)
-    unfitted = place(drawing, placement)
-    placed = fit_to_hoop(unfitted, the_hoop, reach=style_reach(stitch_options), fit=fit)
-    if placed is not unfitted:
-        x0, y0, x1, y1 = placed.bounds()
-        warn(f"scaled down to {x1 - x0:.1f} x {y1 - y0:.1f} mm to fit hoop {the_hoop.label}")
-    plan = plan_embroidery(placed, plan_options)
-    check_plan_in_hoop(plan, the_hoop)
-    stats = embroidery_stats(plan, stitches_per_minute=spm or profile.stitches_per_minute,
-                             trim_seconds=profile.trim_seconds)
-    write_embroidery(plan, output, pes_version=pes_version)
+    result = embroider_drawing(drawing, job)
+    write_embroidery(result.plan, output, pes_version=pes_version)
     if preview_path is not None:
-        render_stitch_preview(plan, preview_path, hoop=the_hoop, stats=stats, options=preview_options)
+        render_stitch_preview(result.plan, preview_path, hoop=the_hoop, stats=result.stats,
+                              options=preview_options)
 
-    if plan.skipped:
-        warn(f"{plan.skipped} stroke(s) shorter than the minimum stitch were left out")
-    for message in stats.warnings:
+    for message in result.warnings:
         warn(message)
+    stats = result.stats
     for line in stats.lines():
         console.print(line, soft_wrap=True)
     extra = f" and {preview_path}" if preview_path else ""
