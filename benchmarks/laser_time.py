@@ -101,18 +101,19 @@ def main() -> None:
             row(f"vectorized trefoil ({how}) 60 mm, {'arcs' if arcs else 'lines'}, F{feed}", lines)
 
     print()
-    print("Fig. 14 comparison (same machine model, same feed):")
-    for size, feed in ((60, 1500), (60, 3000), (100, 3000)):
+    print("Fig. 14 comparison (same machine model):")
+    for size, feed, raster_feed, interval in ((60, 1500, 1500, 0.1), (60, 3000, 3000, 0.1),
+                                              (60, 3000, 6000, 0.1), (60, 3000, 6000, 0.2), (100, 3000, 6000, 0.1)):
         tp = plan_toolpath(drawing, PROFILE, ToolpathOptions(placement=PlacementOptions(size=size)))
         vector = estimate_gcode_time(gcode_lines(tp, PROFILE, GcodeOptions(feed=float(feed))), PROFILE)
         times = []
         for _ in range(3):
             start = time.perf_counter()
-            raster = raster_time(tp, PROFILE, interval=0.1, feed=float(feed))
+            raster = raster_time(tp, PROFILE, interval=interval, feed=float(raster_feed))
             times.append(time.perf_counter() - start)
-        print(f"  trefoil {size} mm at F{feed}: vector {vector.total_seconds:7.1f} s, raster at 0.1 mm "
-              f"{raster.seconds:7.1f} s ({raster.rows} rows), ratio {raster.seconds / vector.total_seconds:5.1f}x"
-              f"  [raster model {median(times) * 1000:.0f} ms]")
+        print(f"  trefoil {size} mm: vector at F{feed} {vector.total_seconds:6.1f} s; raster at {interval} mm, "
+              f"F{raster_feed}: {raster.seconds:7.1f} s ({raster.rows} rows), ratio "
+              f"{raster.seconds / vector.total_seconds:5.1f}x  [raster model {median(times) * 1000:.0f} ms]")
 
 
 if __name__ == "__main__":

@@ -47,6 +47,8 @@ def frame_path_for(output: str) -> str:
               help="Write a preview image of the job (.png or .svg).")
 @click.option("--raster-interval", default="0.1mm", show_default=True,
               help="Line interval of the raster engraving the time is compared with.")
+@click.option("--raster-feed", default=None,
+              help="Scan speed of that raster engraving; default: --feed (the same burn per mm).")
 @click.option("--multi", is_flag=True, help="Raster input: multi-stroke vectorization.")
 @click.option("--threshold", type=float, default=None, help="Raster input: ink threshold in (0, 1).")
 @click.option("--classifier", type=click.Choice(["cnn", "geometric"]), default="cnn", show_default=True,
@@ -56,7 +58,7 @@ def frame_path_for(output: str) -> str:
 def laser(source: str, output: str, size: str | None, width: str | None, height: str | None, rotate: float,
           origin: str, feed: str, power: str, passes: int, tolerance: str, arcs: bool, keep_order: bool,
           profile_path: str | None, air_assist: bool | None, return_home: bool, frame: bool, frame_power: str,
-          preview_path: str | None, raster_interval: str, multi: bool, threshold: float | None,
+          preview_path: str | None, raster_interval: str, raster_feed: str | None, multi: bool, threshold: float | None,
           classifier: str, port: str | None, baud: int) -> None:
     """Turn SOURCE (PNG/JPG/SVG) into G-code for a GRBL 1.1 laser in one continuous pass per stroke."""
     from fabrication.cli.common import read_drawing
@@ -90,6 +92,9 @@ def laser(source: str, output: str, size: str | None, width: str | None, height:
     frame_fraction = parse_fraction(frame_power, what="--frame-power")
     tol = parse_positive_length(tolerance, what="--tolerance")
     interval = parse_positive_length(raster_interval, what="--raster-interval")
+    raster_feed_mm = feed_mm if raster_feed is None else parse_speed(raster_feed, what="--raster-feed")
+    if not raster_feed_mm > 0:
+        raise InputError(f"--raster-feed {raster_feed!r} must be greater than 0 mm/min")
     if passes < 1:
         raise InputError(f"--passes {passes} must be at least 1")
     placement = PlacementOptions(
@@ -125,7 +130,7 @@ def laser(source: str, output: str, size: str | None, width: str | None, height:
     write_gcode(output, lines)
     if frame_file:
         write_gcode(frame_file, framing_lines(toolpath.bounds, profile, power=frame_fraction))
-    raster = raster_time(toolpath, profile, interval=interval, feed=feed_mm)
+    raster = raster_time(toolpath, profile, interval=interval, feed=raster_feed_mm)
     if preview_path is not None:
         from fabrication.laser.preview import render_gcode_preview
 
@@ -137,7 +142,7 @@ def laser(source: str, output: str, size: str | None, width: str | None, height:
                   f"greedy -> {toolpath.travel_after:.1f} mm after 2-opt")
     console.print(f"time: {format_duration(job.total_seconds)} by GRBL's planner model "
                   f"(length/feed says {format_duration(job.naive_seconds)}); as a raster at "
-                  f"{interval:g} mm: {format_duration(raster.seconds)}")
+                  f"{interval:g} mm and {raster_feed_mm:g} mm/min: {format_duration(raster.seconds)}")
     made = [output] + ([frame_file] if frame_file else []) + ([preview_path] if preview_path else [])
     done(f"{', '.join(made)}: {len(lines)} lines, {toolpath.segment_count} moves, burn "
          f"{toolpath.burn_length:.0f} mm, {w:.1f} x {h:.1f} mm, estimated {format_duration(job.total_seconds)}, "
