@@ -224,3 +224,38 @@ def test_embroider_pipeline_places_fits_stitches_and_measures():
         embroider(px, EmbroideryJob(placement=PlacementOptions(size=150.0)))
     with pytest.raises(InputError):
         EmbroideryJob(stitches_per_minute=0)
+
+
+def _random_drawing(seed: int) -> Drawing:
+    """Random cubic strokes: smooth, kinked, tiny and long ones, some close together."""
+    rng = np.random.default_rng(seed)
+    strokes = []
+    for _ in range(rng.integers(1, 5)):
+        k = int(rng.integers(1, 8))
+        scale = float(rng.choice([0.5, 5.0, 30.0]))
+        start = rng.uniform(-30, 30, 2)
+        control = start + np.cumsum(rng.normal(0, scale, (k, 4, 2)), axis=1)
+        control[1:, 0] = control[:-1, 3]  # segments join
+        strokes.append(Stroke(control))
+    return Drawing(tuple(strokes), 100, 100, "mm")
+
+
+@pytest.mark.parametrize("seed", range(10))
+@pytest.mark.parametrize("style", ["running", "triple", "zigzag", "arrows"])
+def test_random_drawings_keep_every_rule(seed, style):
+    drawing = place(_random_drawing(seed), PlacementOptions(size=80.0))
+    options = PlanOptions(style=style_options(style))
+    try:
+        plan = plan_embroidery(drawing, options)
+    except InputError as error:
+        assert "long enough" in str(error)
+        return
+    deltas = sewn_stitches(plan)
+    lengths = np.hypot(*deltas.T)
+    assert lengths.min() > 0 and np.abs(deltas).max() <= 12.1 + 1e-9
+    roles = plan.roles[np.flatnonzero(plan.stitch_mask)]
+    assert lengths[~np.isin(roles, (TACK, LOCK))].min() >= 0.3 - 1e-9
+    assert np.allclose(plan.points * 10, np.rint(plan.points * 10))
+    trims = np.flatnonzero(plan.kinds == TRIM)
+    assert (plan.roles[trims - 1] == LOCK).all() and (plan.kinds[trims + 1] == JUMP).all()
+    assert plan.roles[np.flatnonzero(plan.kinds == STITCH)[-1]] == LOCK

@@ -150,6 +150,20 @@ class StitchPlan:
         return float(lo[0]), float(lo[1]), float(hi[0]), float(hi[1])
 
 
+def _lock_paths(body: NeedlePoints) -> tuple[np.ndarray, np.ndarray]:
+    """The paths tacks and locks walk along: from the start, the needle points that move
+    forward along the curve (parameter above all before); to the end, those that move
+    back along it. Triple stitch's back-and-forth and arrow arms drop out, so a lock lies
+    on the sewn line instead of folding over one short stitch."""
+    t = body.t
+    ahead = np.ones(len(t), dtype=bool)
+    ahead[1:] = t[1:] > np.maximum.accumulate(t)[:-1]
+    back = np.ones(len(t), dtype=bool)
+    rt = t[::-1]
+    back[1:] = rt[1:] < np.minimum.accumulate(rt)[:-1]
+    return body.points[ahead], body.points[::-1][back][::-1]
+
+
 def _assemble(drawing: Drawing, options: PlanOptions):
     """Rows before cleanup: float points, kinds, roles, params; and the skipped count."""
     generate = _GENERATORS[type(options.style)]
@@ -181,12 +195,12 @@ def _assemble(drawing: Drawing, options: PlanOptions):
                 add(path[0], JUMP, TRAVEL, np.nan, -1)
             else:
                 connect = TRAVEL  # a short stitch from the last stroke's end
-        tack = tack_points(path, options.lock)
-        add(tack, STITCH, [connect, TACK, TACK, TACK], index + body.t[0], index)
+        head, tail = _lock_paths(body)
+        add(tack_points(head, options.lock), STITCH, [connect, TACK, TACK, TACK], index + body.t[0], index)
         body_roles = body.roles.copy()
         body_roles[0] = TACK  # the stitch into the start closes the tack
         add(path, STITCH, body_roles, index + body.t, index)
-        add(lock_points(path, options.lock), STITCH, LOCK, index + body.t[-1], index)
+        add(lock_points(tail, options.lock), STITCH, LOCK, index + body.t[-1], index)
         current = path[-1]
     if not pts:
         raise InputError("no stroke is long enough to stitch "
@@ -231,7 +245,8 @@ def _merge_short(units: np.ndarray, kinds: np.ndarray, roles: np.ndarray, min_un
                 heapq.heappush(work, i)
                 continue
             else:
-                continue  # a stroke too short to sew properly: keep what it has
+                # The body shrank to one short stitch: drop its end, the lock stands in.
+                keep[i] = False
         else:
             continue
         if i + 1 < n:
