@@ -195,8 +195,14 @@ def run_stream(gcode_path, *, port: str, baud: int = 115200, check: bool = False
                 raise InputError(f"{path.name}: check mode: line {line} refused: {text}{more}")
             done(f"check passed: GRBL accepted all {len(program)} lines of {path.name} (nothing moved)")
             return
-        machine = result.elapsed * time_scale
-        extra = f"; {_format_seconds(machine)} of machine time" if time_scale != 1.0 else ""
+        extra = ""
+        emu = getattr(handle, "emulator", None)
+        if emu is not None:  # a sim:// dry run: the emulator's own planner time is the machine's
+            stats = emu.stats()
+            extra = (f"; dry run at {time_scale:g}x: the emulator executed {stats.lines_executed} lines, a machine "
+                     f"would take about {_format_seconds(stats.planner_limited_time)}")
+        elif time_scale != 1.0:
+            extra = f"; {_format_seconds(result.elapsed * time_scale)} of machine time"
         done(f"streamed {len(program)} lines of {path.name} to {port} in {_format_seconds(result.elapsed)} "
              f"(estimate {_format_seconds(total)}{extra}); machine Idle, beam off")
 
