@@ -199,8 +199,8 @@ def run_stream(gcode_path, *, port: str, baud: int = 115200, check: bool = False
         emu = getattr(handle, "emulator", None)
         if emu is not None:  # a sim:// dry run: the emulator's own planner time is the machine's
             stats = emu.stats()
-            extra = (f"; dry run at {time_scale:g}x: the emulator executed {stats.lines_executed} lines, a machine "
-                     f"would take about {_format_seconds(stats.planner_limited_time)}")
+            extra = (f"; dry run on the emulator at {time_scale:g}x, a machine would take about "
+                     f"{_format_seconds(stats.planner_limited_time)}")
         elif time_scale != 1.0:
             extra = f"; {_format_seconds(result.elapsed * time_scale)} of machine time"
         done(f"streamed {len(program)} lines of {path.name} to {port} in {_format_seconds(result.elapsed)} "
