@@ -269,6 +269,9 @@ class GrblStreamer:
         # reset); a reset arriving after the next command would swallow it, so wait it out.
         while (again := self._wait_welcome(0.3)) is not None:
             welcome = again
+        if welcome.version.startswith("0."):
+            raise MachineError(f"{self.name} runs GRBL {welcome.version}; onestroke speaks GRBL 1.1 (status "
+                               "reports and real-time commands differ): update the firmware to 1.1")
         options = self._collect("$I")
         for reply in options:
             if isinstance(reply, Message) and reply.kind == "OPT":
