@@ -90,7 +90,11 @@ class EmbroideryProfile:
         if not re.search(r"[xX×]", key):
             names = ", ".join(h.label for h in self.hoops)
             raise InputError(f"unknown hoop {text!r}; use one of {names} or a custom size WxH in mm")
-        width, height = parse_size_pair(text, what="hoop")
+        try:
+            width, height = parse_size_pair(text, what="hoop")
+        except InputError:
+            raise InputError(f"hoop {text!r} is not a sewing field; use WxH with both sides above "
+                             "zero (e.g. 120x90 or 4inx4in) or a named hoop") from None
         return Hoop(name=f"{width:g}x{height:g}", width=width, height=height)
 
 

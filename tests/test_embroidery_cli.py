@@ -82,7 +82,7 @@ BAD = [
     (["embroider", "{in}/nothing.svg", "-o", "out.pes"], "nothing.svg"),
     (["embroider", "{in}/d.svg", "-o", "out.pes", "--color", "blurple"], "'blurple'"),
     (["embroider", "{in}/d.svg", "-o", "out.pes", "--hoop", "potato"], "'potato'"),
-    (["embroider", "{in}/d.svg", "-o", "out.pes", "--hoop", "0x100"], "'0mm'"),
+    (["embroider", "{in}/d.svg", "-o", "out.pes", "--hoop", "0x100"], "hoop '0x100' is not a sewing field"),
     (["embroider", "{in}/d.svg", "-o", "out.pes", "--pes-version", "3"], "3"),
     (["embroider", "{in}/d.svg", "-o", "out.dst", "--pes-version", "1"], ".dst"),
     (["embroider", "{in}/d.svg", "-o", "out.pes", "--stitch-length", "0"], "'0'"),
