@@ -609,6 +609,8 @@ class GrblEmulator:
                         self._ref_items.append(None)
                         self._ref_rest = True
                         self._wait(lambda: not self.planner and not self._motion_busy)
+                elif kind == "eeprom":
+                    self._eeprom_write()
                 elif kind == "dwell":
                     if not self.check_mode:
                         self._ref_items.append(float(action[1]))
@@ -815,7 +817,11 @@ class GrblEmulator:
         self._reply("ok")
 
     def _eeprom_write(self) -> None:
-        self._eeprom_until = time.monotonic() + self.options.eeprom_write_time / self.scale
+        """Write EEPROM like the AVR: the line's answer waits, and serial input is lost meanwhile."""
+        until = time.monotonic() + self.options.eeprom_write_time / self.scale
+        with self._cond:
+            self._eeprom_until = until
+            self._wait(lambda: time.monotonic() >= until)
 
     # ------------------------------------------------------------------ motion thread
 

@@ -18,6 +18,7 @@ ARC_EPSILON = 5e-7
 # Action tuples (kept as tuples: the emulator runs tens of thousands per job).
 #   ("move", target(3,), feed_mm_min | None, rapid, spindle_mode, s)
 #   ("sync",)                     planner drains before the next action
+#   ("eeprom",)                   GRBL writes EEPROM now (serial input is lost meanwhile)
 #   ("dwell", seconds)
 #   ("spindle", mode, s)          mode in "M3", "M4", "M5"
 #   ("coolant", frozenset of "M7"/"M8")
@@ -217,7 +218,7 @@ class GcodeInterpreter:
 
         if nonmodal == 100:
             self._g10(st, words, axis, scale)
-            actions.append(("sync",))
+            actions += [("sync",), ("eeprom",)]
         elif nonmodal in (280, 300):
             stored = st.g28 if nonmodal == 280 else st.g30
             if axis:
@@ -226,7 +227,7 @@ class GcodeInterpreter:
             actions += self._line(st, list(stored), None, True)
         elif nonmodal in (281, 301):
             (st.g28 if nonmodal == 281 else st.g30)[:] = st.position
-            actions.append(("sync",))
+            actions += [("sync",), ("eeprom",)]
         elif nonmodal == 920:
             if not axis:
                 raise GcodeError(26)

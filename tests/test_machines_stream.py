@@ -18,6 +18,7 @@ from machines.emulator import EmulatorOptions, Faults, GrblEmulator
 from machines.gcode_program import program_from_text
 from machines.ports import open_port
 from machines.streamer import DRAIN_LINE, GrblStreamer, StreamOptions
+from onestroke.errors import MachineError
 
 
 def job_text(n, *, step=0.5, feed=3000, seed=0):
@@ -121,6 +122,28 @@ def test_pause_and_resume_lose_and_repeat_nothing(emulator):
     assert "result" in done
     assert emu.executed == cleaned(text) + [DRAIN_LINE]
     assert emu.position[:2] == pytest.approx((0.0, 0.0))  # the last move (G0X0Y0) completed
+
+
+def test_eeprom_writers_go_one_at_a_time_and_lose_nothing(emulator):
+    emu = emulator(time_scale=2.0)
+    lines = job_text(300).splitlines()
+    text = "\n".join(["$110=6000", "$111=6000"] + lines[:100] + ["G10L2P1X0Y0", "G28.1"] + lines[100:200]
+                     + ["G10L20P1X0Y0"] + lines[200:]) + "\n"
+    stream(emu, text)
+    assert emu.stats().eeprom_lost_bytes == 0
+    assert emu.commands[-2:] == ["$110=6000", "$111=6000"]
+    assert emu.executed == [line for line in cleaned(text) if not line.startswith("$")] + [DRAIN_LINE]
+
+
+def test_eeprom_writers_streamed_like_other_lines_lose_bytes(emulator, monkeypatch):
+    # The control for the test above: without send-response the firmware drops input.
+    monkeypatch.setattr("machines.streamer.is_eeprom_writer", lambda line: False)
+    emu = emulator(time_scale=2.0)
+    lines = job_text(300).splitlines()
+    text = "\n".join(["$110=6000"] + lines) + "\n"
+    with pytest.raises(MachineError):
+        stream(emu, text, watchdog=0.5)
+    assert emu.stats().eeprom_lost_bytes > 0
 
 
 # ---------------------------------------------------------------- faults, through the CLI
