@@ -21,6 +21,11 @@ class Block:
     __slots__ = ("length", "unit", "nominal", "accel", "max_entry", "entry", "rapid")
 
 
+def _lround(value):
+    # C's lround, as GRBL's planner uses: halves go away from zero
+    return int(math.copysign(math.floor(abs(value) + 0.5), value))
+
+
 def _limit(limits, unit):
     best = math.inf
     for lim, u in zip(limits, unit):
@@ -46,7 +51,7 @@ def simulate(lines, *, max_rate=(6000.0, 6000.0), accel=(500.0, 500.0), junction
 
     def add(x, y, feed, rapid):
         nonlocal pos_steps, prev_unit, prev_nominal
-        target = (round(x * steps_per_mm[0]), round(y * steps_per_mm[1]))
+        target = (_lround(x * steps_per_mm[0]), _lround(y * steps_per_mm[1]))
         dx = (target[0] - pos_steps[0]) / steps_per_mm[0]
         dy = (target[1] - pos_steps[1]) / steps_per_mm[1]
         if target == pos_steps:

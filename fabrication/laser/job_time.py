@@ -59,9 +59,16 @@ def _axis_limit(limits: np.ndarray, unit: np.ndarray) -> np.ndarray:
     return ratio.min(axis=1)
 
 
+def _lround(values: np.ndarray) -> np.ndarray:
+    """C's lround: nearest integer, halves away from zero (numpy's rint rounds to even)."""
+    return np.sign(values) * np.floor(np.abs(values) + 0.5)
+
+
 def expand_arcs(moves: GcodeMoves, arc_tolerance: float) -> tuple[np.ndarray, np.ndarray]:
-    """Split arcs into GRBL's chords. Returns points (B+1, 2)-style pairs as (start, end)
-    stacked in `segments` (B, 2, 2) and the index of the move each chord belongs to (B,).
+    """Split arcs into GRBL's chords (`mc_arc`); other moves pass through.
+
+    Returns segments (B, 2, 2) as (start, end) pairs in mm and owner (B,): the index of
+    the move each segment belongs to.
     """
     n = len(moves)
     is_arc = (moves.kind >= 2) & np.isfinite(moves.centre[:, 0])
@@ -92,9 +99,11 @@ def expand_arcs(moves: GcodeMoves, arc_tolerance: float) -> tuple[np.ndarray, np
         cnt = counts[owner[sel]]
         theta0 = np.arctan2(r_vec[k, 1], r_vec[k, 0])
         centre = c[k]
+
         def on_circle(i):
             angle = theta0 + travel[k] * i / cnt
             return centre + radius[k, None] * np.c_[np.cos(angle), np.sin(angle)]
+
         s_i, e_i = step[sel], step[sel] + 1
         arc_starts = np.where((s_i == 0)[:, None], moves.start[owner[sel]], on_circle(s_i))
         arc_ends = np.where((e_i == cnt)[:, None], moves.end[owner[sel]], on_circle(e_i))
@@ -110,12 +119,10 @@ def block_times(start: np.ndarray, end: np.ndarray, feed: np.ndarray, rapid: np.
     before the move. Returns (B,) seconds (0 for moves of zero steps).
     """
     steps = np.array([profile.steps_per_mm_x, profile.steps_per_mm_y])
-    # GRBL plans between step positions; this is what makes tiny segments uneven
-    s0 = np.rint(start * steps)
-    s1 = np.rint(end * steps)
-    # position is tracked in steps: each block starts where the previous one ended
-    if len(s1):
-        s0 = np.vstack([np.rint(start[:1] * steps), s1[:-1]])
+    # GRBL plans between whole step positions (lround: halves away from zero); this is
+    # what makes tiny segments uneven. Each block starts where the previous one ended.
+    s1 = _lround(end * steps)
+    s0 = np.vstack([_lround(start[:1] * steps), s1[:-1]])
     delta = (s1 - s0) / steps
     length_all = np.hypot(*delta.T) if len(delta) else np.zeros(0)
     keep = length_all > 0
