@@ -1,0 +1,506 @@
+"""Seeded synthetic single-line drawings with ground truth, for the vectorizer benchmark.
+
+Every drawing is ONE smooth curve on a 1000 x 1000 px canvas, made of cubic Bézier pieces
+(a Hermite spline through waypoints), with its stroke width (2-12 px), a `kind` tag, and
+the ground truth the metrics need: the crossing points (the intersections of Table 1), the
+touches and near-touches (not intersections; the pen turns back on its own side there), the
+out-and-back spikes (retraced, not intersections), and the drawing order (the curve's own
+parameterization).
+
+Kinds (`PLAIN_KINDS` have no touches, `TOUCH_KINDS` have at least one):
+
+- open, closed: a wandering line through 5-10 waypoints, crossing itself at whatever angles
+  arise (reflex turns make loops);
+- loops: cursive loops (a perturbed trochoid), each loop crossing itself;
+- shallow: plus 1-2 designed crossings at 5-20 degrees;
+- transversal: plus 1-2 designed crossings at 30-90 degrees;
+- spike: plus 1-3 straight out-and-back spikes (Y-junctions);
+- touch, touch-closed: two passes of the line meet tangentially at one point and separate
+  again on their own sides (curvatures of opposite sign, exact tangency);
+- near-touch: the same with the centre lines 0.5-0.95 widths apart: the ink merges
+  although the line never meets itself.
+
+Every sample is checked and regenerated until it is unambiguous for a human while staying
+hard: no three passes through one spot, no crossing shallower than 5 degrees, no tight bends
+(radius of curvature >= 0.75 width), no place where two passes come within one width of
+each other (ink merges) that is not a designed crossing/touch/near-touch, and the ink-merge
+zone of every such event at least 3 widths away from any other event and from the ends.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+
+import numpy as np
+import shapely
+from scipy.sparse import coo_matrix
+from scipy.sparse.csgraph import connected_components
+from scipy.spatial import cKDTree
+
+from benchmarks.metrics import polyline_intersections
+from vectorize.drawing import Drawing
+from vectorize.stroke import Stroke
+
+CANVAS = 1000
+MARGIN = 30  # px between the ink and the canvas edge
+PLAIN_KINDS = ("open", "closed", "loops", "shallow", "transversal", "spike")
+TOUCH_KINDS = ("touch", "touch-closed", "touch", "near-touch")
+ALL_KINDS = tuple(dict.fromkeys(PLAIN_KINDS + TOUCH_KINDS))
+MAX_ATTEMPTS = 600
+# realistic single-line drawings cross themselves: fewer crossings than this are redrawn
+MIN_CROSSINGS = {"open": 2, "closed": 2, "loops": 2, "spike": 1, "touch": 1, "touch-closed": 1,
+                 "near-touch": 1}
+
+
+@dataclass(frozen=True)
+class Event:
+    """A ground-truth place where the line meets (or nearly meets) itself.
+
+    kind: "crossing", "touch", "near-touch", "spike-base", "spike-tip" or "end";
+    point: (2,) px; angle: crossing angle in degrees (0 for the others);
+    radius: half-extent of the ink-merge zone around the point (px); group: events of one
+    feature (a spike's base and tip) share a group.
+    """
+
+    kind: str
+    point: np.ndarray
+    angle: float = 0.0
+    radius: float = 0.0
+    group: int = -1
+
+
+@dataclass(frozen=True, eq=False)
+class GroundTruth:
+    """One benchmark drawing and its ground truth.
+
+    drawing: one stroke, px on a CANVAS x CANVAS canvas, with its stroke_width;
+    intersections: (n, 2) crossing points (touches are not intersections);
+    dont_care: shapely geometries (touch points, near-touches, retraced parts) near which
+    output intersections are not counted either way; events: all designed and found events.
+    """
+
+    name: str
+    kind: str
+    drawing: Drawing
+    closed: bool
+    intersections: np.ndarray
+    events: tuple[Event, ...] = ()
+    dont_care: tuple = ()
+    meta: dict = field(default_factory=dict)
+
+    @property
+    def stroke(self) -> Stroke:
+        return self.drawing.strokes[0]
+
+    @property
+    def width(self) -> float:
+        return self.drawing.stroke_width
+
+    def count(self, kind: str) -> int:
+        return sum(1 for e in self.events if e.kind == kind)
+
+
+class Rejected(Exception):
+    """A sample that breaks a rule; the generator draws another."""
+
+
+# -- geometry helpers ---------------------------------------------------------------------------
+
+def _rot(v: np.ndarray, angle: float) -> np.ndarray:
+    c, s = np.cos(angle), np.sin(angle)
+    return np.array([c * v[0] - s * v[1], s * v[0] + c * v[1]])
+
+
+def _unit(v: np.ndarray) -> np.ndarray:
+    n = np.linalg.norm(v, axis=-1, keepdims=True)
+    return v / np.where(n > 0, n, 1.0)
+
+
+@dataclass
+class _Waypoint:
+    pos: np.ndarray
+    tangent: np.ndarray | None = None  # fixed unit tangent, or None for Catmull-Rom
+    spike: tuple[np.ndarray, float] | None = None  # (unit direction, length) out-and-back here
+
+
+def _hermite(points: Sequence[_Waypoint], closed: bool, handle: float = 0.36) -> tuple[Stroke, list]:
+    """Cubic Bézier spline through waypoints; spikes become straight out-and-back segments.
+
+    Returns the stroke and, per spike, (base, tip, segment index of its first straight piece).
+    """
+    pos = np.array([w.pos for w in points], dtype=float)
+    n = len(pos)
+    tan = np.zeros_like(pos)
+    for k, w in enumerate(points):
+        if w.tangent is not None:
+            tan[k] = _unit(np.asarray(w.tangent, dtype=float))
+            continue
+        if closed:
+            prev, nxt = pos[k - 1], pos[(k + 1) % n]
+        else:
+            prev, nxt = pos[max(k - 1, 0)], pos[min(k + 1, n - 1)]
+        tan[k] = _unit(nxt - prev)
+    segments = []
+    spikes = []
+    count = n if closed else n - 1
+    for k in range(count):
+        k2 = (k + 1) % n
+        p0, p3 = pos[k], pos[k2]
+        chord = np.linalg.norm(p3 - p0)
+        segments.append([p0, p0 + tan[k] * chord * handle, p3 - tan[k2] * chord * handle, p3])
+        w = points[k2]
+        if w.spike is not None and (closed or k2 != n - 1):
+            direction, length = w.spike
+            tip = p3 + direction * length
+            spikes.append((p3.copy(), tip, len(segments)))
+            segments.append([p3, p3 + (tip - p3) / 3, p3 + 2 * (tip - p3) / 3, tip])
+            segments.append([tip, tip + (p3 - tip) / 3, tip + 2 * (p3 - tip) / 3, p3])
+    return Stroke(np.array(segments)), spikes
+
+
+def _wander(rng: np.random.Generator, start: np.ndarray, heading: float, n: int, step: float,
+            box: float, turn: float) -> list[_Waypoint]:
+    """n waypoints of a random walk with smooth heading changes, kept inside [0, box]^2."""
+    out = []
+    p = np.array(start, dtype=float)
+    centre = np.array([box / 2, box / 2])
+    for _ in range(n):
+        heading += rng.normal(0.0, turn)
+        to_centre = centre - p
+        if np.linalg.norm(to_centre) > 0.38 * box:
+            want = np.arctan2(to_centre[1], to_centre[0])
+            diff = (want - heading + np.pi) % (2 * np.pi) - np.pi
+            heading += 0.6 * diff
+        p = p + step * rng.uniform(0.7, 1.3) * np.array([np.cos(heading), np.sin(heading)])
+        p = np.clip(p, 0.0, box)
+        out.append(_Waypoint(p.copy()))
+    return out
+
+
+def _random_points(rng: np.random.Generator, n: int, box: float, avoid: Sequence[np.ndarray] = (),
+                   min_dist: float = 0.0) -> list[_Waypoint]:
+    out = []
+    for _ in range(n):
+        for _try in range(50):
+            p = rng.uniform(0.05 * box, 0.95 * box, size=2)
+            if all(np.linalg.norm(p - q) >= min_dist for q in avoid):
+                break
+        out.append(_Waypoint(p))
+    return out
+
+
+# -- designed features --------------------------------------------------------------------------
+
+def _meeting(rng: np.random.Generator, box: float, kind: str, width: float):
+    """Waypoints around one designed meeting of two passes.
+
+    Returns (first_pass, loop, second_pass, event_point, angle): first_pass and
+    second_pass are 3 waypoints each (before, at, after the meeting), loop the waypoints the
+    line visits between the passes.
+    """
+    x = rng.uniform(0.3 * box, 0.7 * box, size=2)
+    u1 = _rot(np.array([1.0, 0.0]), rng.uniform(0, 2 * np.pi))
+    normal = _rot(u1, np.pi / 2)
+    a = rng.uniform(0.12, 0.2) * box
+    b = rng.uniform(0.12, 0.2) * box
+    reverse = rng.random() < 0.5
+    if kind in ("shallow", "transversal"):
+        lo, hi = (5.0, 20.0) if kind == "shallow" else (30.0, 90.0)
+        angle = rng.uniform(lo, hi)
+        u2 = _rot(u1, np.radians(angle) * rng.choice([-1, 1]))
+        if reverse:
+            u2 = -u2
+        p1 = [_Waypoint(x - a * u1, u1), _Waypoint(x.copy(), u1), _Waypoint(x + a * u1, u1)]
+        p2 = [_Waypoint(x - b * u2, u2), _Waypoint(x.copy(), u2), _Waypoint(x + b * u2, u2)]
+        event = x.copy()
+    else:  # touch / near-touch: two arcs bending away from each other
+        angle = 0.0
+        u2 = -u1 if reverse else u1.copy()
+        phi1 = np.radians(rng.uniform(12, 30))
+        phi2 = np.radians(rng.uniform(12, 30))
+        gap = 0.0 if kind == "touch" else rng.uniform(0.5, 0.95) * width
+        x2 = x - gap * normal
+
+        def arc(centre, u, side, chord, phi):
+            # points at chord distance, angle phi off the tangent toward `side`; tangents of a circle
+            before = centre + chord * (-np.cos(phi) * u + np.sin(phi) * side)
+            after = centre + chord * (np.cos(phi) * u + np.sin(phi) * side)
+            left = u[0] * side[1] - u[1] * side[0] > 0  # side is to the left of u
+            t_before = _rot(u, -2 * phi) if left else _rot(u, 2 * phi)
+            t_after = _rot(u, 2 * phi) if left else _rot(u, -2 * phi)
+            return [_Waypoint(before, t_before), _Waypoint(centre.copy(), u), _Waypoint(after, t_after)]
+
+        p1 = arc(x, u1, normal, a, phi1)
+        p2 = arc(x2, u2, -normal, b, phi2)
+        event = x - gap / 2 * normal
+    # the loop between the passes: from after pass 1 to before pass 2, away from the meeting
+    far = rng.integers(1, 3)
+    loop = _random_points(rng, int(far), box, avoid=[x], min_dist=0.3 * box)
+    return p1, loop, p2, event, angle
+
+
+def _trochoid(rng: np.random.Generator, box: float) -> list[_Waypoint]:
+    loops = int(rng.integers(2, 6))
+    c = 1.0
+    r = rng.uniform(1.7, 3.2)
+    step = np.pi / 3
+    t = np.arange(-np.pi / 2, 2 * np.pi * loops + np.pi / 2 + 1e-9, step)
+    amp = r * (1 + 0.15 * np.sin(rng.uniform(0, 2 * np.pi) + 0.7 * t))
+    xs = c * t - amp * np.sin(t)
+    ys = -amp * np.cos(t) * rng.uniform(0.8, 1.3)
+    dx = c - amp * np.cos(t)
+    dy = amp * np.sin(t)
+    pts = np.c_[xs, ys] + rng.normal(0, 0.06 * r, size=(len(t), 2))
+    tans = _unit(np.c_[dx, dy])
+    theta = rng.uniform(-0.5, 0.5) + (np.pi if rng.random() < 0.5 else 0.0)
+    rot = np.array([[np.cos(theta), -np.sin(theta)], [np.sin(theta), np.cos(theta)]])
+    pts = pts @ rot.T
+    tans = tans @ rot.T
+    # a gentle bend of the whole row
+    span = pts[:, 0].max() - pts[:, 0].min()
+    pts[:, 1] += rng.uniform(-0.15, 0.15) * span * np.sin(np.pi * (pts[:, 0] - pts[:, 0].min()) / span)
+    ext = np.ptp(pts, axis=0).max()
+    pts = (pts - pts.min(axis=0)) / ext * box
+    return [_Waypoint(p, tg) for p, tg in zip(pts, tans)]
+
+
+def _build(kind: str, rng: np.random.Generator, width: float, box: float) -> tuple[list[_Waypoint], bool, list]:
+    """Waypoints, closedness and the designed events (kind, point, angle) of one sample."""
+    closed = kind in ("closed", "touch-closed") or (kind in ("shallow", "transversal", "spike")
+                                                      and rng.random() < 0.35)
+    designed = []
+    if kind == "loops":
+        return _trochoid(rng, box), False, designed
+    if kind in ("open", "closed", "spike"):
+        n = int(rng.integers(8, 14))
+        start = rng.uniform(0.2 * box, 0.8 * box, size=2)
+        pts = _wander(rng, start, rng.uniform(0, 2 * np.pi), n, 0.28 * box, box, rng.uniform(1.0, 2.2))
+        if kind == "spike":
+            nspikes = int(rng.integers(1, 4))
+            candidates = rng.permutation(np.arange(1, n - 1))[:nspikes]
+            for k in candidates:
+                along = _unit(pts[k + 1].pos - pts[k - 1].pos)  # the spline's tangent there
+                direction = _rot(along, np.radians(rng.uniform(40, 140)) * rng.choice([-1, 1]))
+                length = rng.uniform(max(5 * width, 30.0), max(9 * width, 0.2 * box))
+                pts[k].spike = (direction, length)
+        return pts, closed, designed
+    meeting_kind = {"shallow": "shallow", "transversal": "transversal", "touch": "touch",
+                    "touch-closed": "touch", "near-touch": "near-touch"}[kind]
+    count = int(rng.integers(1, 3)) if kind in ("shallow", "transversal") else 1
+    seq: list[_Waypoint] = []
+    if not closed:
+        seq += _random_points(rng, int(rng.integers(1, 3)), box)
+    for _ in range(count):
+        p1, loop, p2, event, angle = _meeting(rng, box, meeting_kind, width)
+        seq += p1 + loop + p2
+        designed.append((meeting_kind, event, angle))
+        if count > 1:
+            seq += _random_points(rng, 1, box)
+    if not closed:
+        seq += _random_points(rng, int(rng.integers(1, 3)), box)
+    else:
+        seq += _random_points(rng, int(rng.integers(1, 3)), box, avoid=[d[1] for d in designed],
+                              min_dist=0.25 * box)
+    return seq, closed, designed
+
+
+# -- validation ---------------------------------------------------------------------------------
+
+def _curvature_ok(stroke: Stroke, spike_segments: set[int], min_radius: float) -> bool:
+    c = stroke.control
+    t = np.linspace(0, 1, 33)[None, :, None]
+    u = 1 - t
+    d1 = 3 * (u * u * (c[:, None, 1] - c[:, None, 0]) + 2 * u * t * (c[:, None, 2] - c[:, None, 1])
+              + t * t * (c[:, None, 3] - c[:, None, 2]))
+    d2 = 6 * (u * (c[:, None, 2] - 2 * c[:, None, 1] + c[:, None, 0]) + t * (c[:, None, 3] - 2 * c[:, None, 2]
+                                                                               + c[:, None, 1]))
+    speed = np.linalg.norm(d1, axis=2)
+    cross = np.abs(d1[..., 0] * d2[..., 1] - d1[..., 1] * d2[..., 0])
+    mask = np.ones(len(c), dtype=bool)
+    if spike_segments:
+        mask[list(spike_segments)] = False
+    if np.any(speed[mask] < 1e-6):
+        return False
+    radius = speed[mask] ** 3 / np.maximum(cross[mask], 1e-12)
+    return bool(radius.min() >= min_radius)
+
+
+def _validate(stroke: Stroke, closed: bool, width: float, designed: list, spikes: list) -> tuple[list, np.ndarray, list]:
+    """Check the rules; return (events, crossing points, dont-care geometries) or raise Rejected."""
+    w = width
+    xmin, ymin, xmax, ymax = stroke.bounds()
+    if xmin < MARGIN + w or ymin < MARGIN + w or xmax > CANVAS - MARGIN - w or ymax > CANVAS - MARGIN - w:
+        raise Rejected("outside the canvas")
+    spike_segments = {s[2] for s in spikes} | {s[2] + 1 for s in spikes}
+    if not _curvature_ok(stroke, spike_segments, 0.75 * w):
+        raise Rejected("tight bend")
+    poly = stroke.flatten(0.05)
+    inter = polyline_intersections([poly], [closed])
+    if len(inter.multiple):
+        raise Rejected("three passes meet")
+    if np.any(inter.crossing_angles < 5.0):
+        raise Rejected("crossing shallower than 5 degrees")
+    designed_touch = [e for k, e, _ in designed if k == "touch"]
+    for t in inter.touches:
+        if not any(np.linalg.norm(t - d) < 0.5 for d in designed_touch):
+            raise Rejected("accidental touch")
+    for d in designed_touch:
+        if not any(np.linalg.norm(t - d) < 0.5 for t in inter.touches):
+            raise Rejected("designed touch did not come out as a touch")
+    for k, e, ang in designed:
+        if k in ("shallow", "transversal"):
+            hit = np.linalg.norm(inter.crossings - e, axis=1) < 0.5 if len(inter.crossings) else np.array([False])
+            if not hit.any():
+                raise Rejected("designed crossing missing")
+
+    events: list[Event] = []
+    for p, ang in zip(inter.crossings, inter.crossing_angles):
+        events.append(Event("crossing", p, float(ang), w / (2 * np.sin(np.radians(ang) / 2))))
+    for k, e, _ in designed:
+        if k in ("touch", "near-touch"):
+            events.append(Event(k, np.asarray(e, dtype=float)))
+
+    # contacts: two samples closer than one width that are more than 3 widths apart along the line
+    spacing = w / 4
+    s = np.linspace(0, stroke.length, max(2, int(np.ceil(stroke.length / spacing))) + 1)
+    if closed:
+        s = s[:-1]
+    pts = stroke.points_at_lengths(s)
+    pairs = cKDTree(pts).query_pairs(w, output_type="ndarray")
+    sep = np.abs(s[pairs[:, 0]] - s[pairs[:, 1]])
+    if closed:
+        sep = np.minimum(sep, stroke.length - sep)
+    pairs = pairs[sep > 3 * w]
+    # spikes: the retrace itself and the line passing its base are not contacts
+    spike_ranges = []
+    seg_len = np.array([Stroke(stroke.control[k:k + 1]).length for k in range(stroke.segment_count)])
+    seg_start = np.concatenate([[0], np.cumsum(seg_len)])
+    for gid, (base, tip, seg) in enumerate(spikes):
+        lo, hi = seg_start[seg] - 2 * w, seg_start[seg + 2] + 2 * w
+        spike_ranges.append((lo, hi))
+        events.append(Event("spike-base", base, radius=w, group=1000 + gid))
+        events.append(Event("spike-tip", tip, radius=0.5 * w, group=1000 + gid))
+        # nothing else may come near the spike's shaft
+        shaft = shapely.LineString([base, tip])
+        far = (s < lo - 4 * w) | (s > hi + 4 * w)
+        if closed:
+            far &= (s > hi + 4 * w - stroke.length) & (s < lo - 4 * w + stroke.length)
+        if far.any():
+            dist = shapely.distance(shaft, shapely.points(pts[far]))
+            if np.min(dist) < 2.5 * w:
+                raise Rejected("line passes near a spike")
+    if spike_ranges:
+        internal = np.zeros(len(pairs), dtype=bool)
+        for lo, hi in spike_ranges:
+            a_in = (s[pairs[:, 0]] >= lo) & (s[pairs[:, 0]] <= hi)
+            b_in = (s[pairs[:, 1]] >= lo) & (s[pairs[:, 1]] <= hi)
+            internal |= a_in & b_in
+        pairs = pairs[~internal]
+    if not closed:
+        events.append(Event("end", pts[0], radius=0.5 * w, group=2000))
+        events.append(Event("end", pts[-1], radius=0.5 * w, group=2001))
+    meeting_events = [e for e in events if e.kind in ("crossing", "touch", "near-touch")]
+    if len(pairs):
+        idx = np.unique(pairs)
+        cp = pts[idx]
+        near = cKDTree(cp).query_pairs(2.0 * spacing, output_type="ndarray")
+        g = coo_matrix((np.ones(len(near)), (near[:, 0], near[:, 1])), shape=(len(cp), len(cp)))
+        ncl, label = connected_components(g, directed=False)
+        radius = {}
+        for c in range(ncl):
+            cluster = cp[label == c]
+            inside = [m for m, e in enumerate(meeting_events)
+                      if np.min(np.linalg.norm(cluster - e.point, axis=1)) <= w]
+            if len(inside) != 1:
+                raise Rejected("ink merges where no single crossing or touch explains it")
+            m = inside[0]
+            radius[m] = max(radius.get(m, 0.0), float(np.max(np.linalg.norm(cluster - meeting_events[m].point,
+                                                                              axis=1))))
+        for m, e in enumerate(meeting_events):
+            if e.kind in ("touch", "near-touch"):
+                r = radius.get(m, 0.0)
+                if r == 0.0 and e.kind == "near-touch":
+                    raise Rejected("near-touch does not merge")
+                if r > 8 * w:
+                    raise Rejected("touch merges over too long a run")
+                idx_e = events.index(e)
+                events[idx_e] = Event(e.kind, e.point, e.angle, max(r, 0.5 * w), e.group)
+    # separation of events: merge zones at least 3 widths apart
+    for i in range(len(events)):
+        for j in range(i + 1, len(events)):
+            ei, ej = events[i], events[j]
+            if ei.group >= 0 and ei.group == ej.group:
+                continue
+            if ei.kind == "end" and ej.kind == "end":
+                continue
+            need = ei.radius + ej.radius + 3 * w
+            if np.linalg.norm(ei.point - ej.point) < need:
+                raise Rejected(f"{ei.kind} and {ej.kind} too close")
+    dont_care = [shapely.Point(*e.point) for e in events if e.kind in ("touch", "near-touch")]
+    dont_care += [shapely.LineString([b, t]) for b, t, _ in spikes]
+    dont_care += list(inter.retraces)
+    return events, inter.crossings, dont_care
+
+
+# -- public API ---------------------------------------------------------------------------------
+
+def drawing_width(index: int, seed: int) -> float:
+    """Stroke width of drawing `index`: spread evenly over 2-12 px (golden-ratio sequence)."""
+    frac = (index * 0.6180339887498949 + seed * 0.3819660112501051 + 0.1) % 1.0
+    return float(np.round((2.0 + 10.0 * frac) * 4) / 4)
+
+
+def generate_drawing(kind: str, seed: int = 0, index: int = 0) -> GroundTruth:
+    """One validated drawing of `kind`, determined by (seed, index, kind)."""
+    if kind not in ALL_KINDS:
+        raise ValueError(f"unknown drawing kind {kind!r}; use one of {ALL_KINDS}")
+    width = drawing_width(index, seed)
+    kind_id = ALL_KINDS.index(kind)
+    last = "no attempt"
+    for attempt in range(MAX_ATTEMPTS):
+        rng = np.random.default_rng([seed, index, kind_id, attempt])
+        box = rng.uniform(450, CANVAS - 2 * MARGIN - 2 * width)
+        waypoints, closed, designed = _build(kind, rng, width, box)
+        stroke, spikes = _hermite(waypoints, closed)
+        # place the drawing at a random spot of the canvas
+        xmin, ymin, xmax, ymax = stroke.bounds()
+        room = CANVAS - 2 * (MARGIN + width + 1)
+        if xmax - xmin > room or ymax - ymin > room:
+            last = "too big"
+            continue
+        offset = np.array([rng.uniform(MARGIN + width + 1 - xmin, CANVAS - MARGIN - width - 1 - xmax),
+                           rng.uniform(MARGIN + width + 1 - ymin, CANVAS - MARGIN - width - 1 - ymax)])
+        stroke = stroke.transformed(np.array([[1, 0, offset[0]], [0, 1, offset[1]]]))
+        designed = [(k, np.asarray(e) + offset, a) for k, e, a in designed]
+        spikes = [(b + offset, t + offset, seg) for b, t, seg in spikes]
+        if closed:
+            stroke = _close_exactly(stroke)
+        try:
+            events, crossings, dont_care = _validate(stroke, closed, width, designed, spikes)
+            if len(crossings) < MIN_CROSSINGS.get(kind, 0):
+                raise Rejected("too few crossings")
+        except Rejected as why:
+            last = str(why)
+            continue
+        drawing = Drawing((stroke,), CANVAS, CANVAS, unit="px", stroke_width=width)
+        return GroundTruth(name=f"{kind}-{seed}-{index}", kind=kind, drawing=drawing, closed=closed,
+                           intersections=np.asarray(crossings).reshape(-1, 2), events=tuple(events),
+                           dont_care=tuple(dont_care),
+                           meta={"seed": seed, "index": index, "attempts": attempt + 1, "width": width})
+    raise RuntimeError(f"no valid {kind} drawing after {MAX_ATTEMPTS} attempts (last: {last})")
+
+
+def _close_exactly(stroke: Stroke) -> Stroke:
+    c = np.array(stroke.control)
+    c[-1, 3] = c[0, 0]
+    return Stroke(c)
+
+
+def generate_set(name: str, count: int, seed: int = 0) -> list[GroundTruth]:
+    """`count` drawings of set "plain" (PLAIN_KINDS in turn) or "touch" (TOUCH_KINDS in turn)."""
+    kinds = {"plain": PLAIN_KINDS, "touch": TOUCH_KINDS}.get(name)
+    if kinds is None:
+        raise ValueError(f"unknown generated set {name!r}; use 'plain' or 'touch'")
+    offset = 0 if name == "plain" else 10_000
+    return [generate_drawing(kinds[i % len(kinds)], seed, offset + i) for i in range(count)]

@@ -1,0 +1,384 @@
+#!/usr/bin/env python
+"""Vectorizer benchmark: one command, one table.
+
+    python benchmarks/vectorize_bench.py                       # all sets, default classifiers
+    python benchmarks/vectorize_bench.py --set touch --classifier both --count 30
+    python benchmarks/vectorize_bench.py --csv /tmp/bench.csv  # plus one row per drawing
+    python benchmarks/vectorize_bench.py --whole-process 5     # time `onestroke vectorize` as a subprocess
+    python benchmarks/vectorize_bench.py --ground-truth-as-output   # check the metrics machinery
+
+Sets: "plain" (generated, no touches), "touch" (generated, with tangential touches and
+near-touches), "hershey" (single-stroke font glyphs). Classifier "auto" runs the CNN on
+plain and hershey and both classifiers on touch. See docs/benchmark.md for the columns.
+
+Each drawing is vectorized in a fresh process forked from this one (the vectorizer's
+modules and models are loaded here first by a warm-up call, as in a long-running process):
+time is the wall time of `vectorize_image` alone; peak memory is that process's peak
+resident set size (VmHWM, reset just before the call through /proc/self/clear_refs, so it
+covers the call and everything already resident: interpreter, numpy, the model).
+"""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import gc
+import math
+import multiprocessing as mp
+import os
+import platform
+import shutil
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+import traceback
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+if str(ROOT) not in sys.path:
+    sys.path.insert(0, str(ROOT))
+
+import numpy as np  # noqa: E402
+
+from benchmarks.drawings import generate_set  # noqa: E402
+from benchmarks.hershey import hershey_set  # noqa: E402
+from benchmarks.metrics import ORDER_THRESHOLD, evaluate  # noqa: E402
+from benchmarks.render import render, to_uint8  # noqa: E402
+
+DEFAULT_COUNTS = {"plain": 42, "touch": 40, "hershey": 40}
+PSNR_CAP = 60.0  # dB; an identical render has infinite PSNR, averaged as this
+TASKS: list = []  # (set name, GroundTruth), inherited by the forked workers
+
+
+# -- one drawing, in a child process --------------------------------------------------------
+
+def _peak_rss_mb() -> tuple[float, str]:
+    try:
+        with open("/proc/self/status") as fh:
+            for line in fh:
+                if line.startswith("VmHWM:"):
+                    return int(line.split()[1]) / 1024.0, "VmHWM"
+    except OSError:
+        pass
+    import resource
+
+    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0, "ru_maxrss"
+
+
+def _reset_peak() -> bool:
+    try:
+        with open("/proc/self/clear_refs", "w") as fh:
+            fh.write("5")
+        return True
+    except OSError:
+        return False
+
+
+def _run_one(index: int, classifier: str, oracle: bool, conn) -> None:
+    set_name, gt = TASKS[index]
+    row = {"set": set_name, "classifier": classifier, "name": gt.name, "kind": gt.kind,
+           "width": gt.width, "closed": gt.closed, "gt_intersections": len(gt.intersections),
+           "error": ""}
+    try:
+        gray = render(gt.drawing)
+        image = to_uint8(gray)
+        if oracle:
+            output, seconds, peak, method, report = gt.drawing, 0.0, float("nan"), "none", None
+        else:
+            from vectorize import VectorizeOptions, vectorize_image
+
+            options = VectorizeOptions(multi=False, classifier=classifier, seed=0)
+            gc.collect()
+            reset = _reset_peak()
+            start = time.perf_counter()
+            result = vectorize_image(image, options)
+            seconds = time.perf_counter() - start
+            peak, method = _peak_rss_mb()
+            if not reset:
+                method += " (not reset: includes set-up)"
+            output, report = result.drawing, result.report
+        scores = evaluate(gt, output, gray)
+        row.update(seconds=seconds, peak_mb=peak, memory_method=method, strokes=scores.stroke_count,
+                   ssim=scores.ssim, psnr=scores.psnr, length_ratio=scores.length_ratio,
+                   out_intersections=scores.out_intersections, matched=scores.matched,
+                   order=scores.order, correct=scores.correct,
+                   warnings=" | ".join(report.warnings) if report is not None else "")
+    except BaseException as exc:  # noqa: BLE001 - a failing drawing is a result, not a crash
+        row["error"] = f"{type(exc).__name__}: {exc}".replace("\n", " ")[:300]
+        row["traceback"] = traceback.format_exc()[-2000:]
+    conn.send(row)
+    conn.close()
+
+
+def run_tasks(jobs: list[tuple[int, str]], oracle: bool, parallel: int, timeout: float, progress) -> list[dict]:
+    """Run (task index, classifier) pairs, each in a fresh forked process."""
+    ctx = mp.get_context("fork")
+    pending = list(enumerate(jobs))
+    running: dict = {}
+    rows: list[dict | None] = [None] * len(jobs)
+    while pending or running:
+        while pending and len(running) < parallel:
+            slot, (index, classifier) = pending.pop(0)
+            parent, child = ctx.Pipe(duplex=False)
+            proc = ctx.Process(target=_run_one, args=(index, classifier, oracle, child))
+            proc.start()
+            child.close()
+            running[slot] = (proc, parent, time.monotonic(), index, classifier)
+        time.sleep(0.01)
+        for slot in list(running):
+            proc, parent, started, index, classifier = running[slot]
+            row = None
+            if parent.poll():
+                try:
+                    row = parent.recv()
+                except EOFError:
+                    row = None
+            elif proc.is_alive() and time.monotonic() - started < timeout:
+                continue
+            elif proc.is_alive():
+                proc.kill()  # only our own child, by its handle
+                row = None
+            proc.join()
+            if row is None:
+                set_name, gt = TASKS[index]
+                why = f"timeout after {timeout:.0f} s" if time.monotonic() - started >= timeout else (
+                    f"worker died (exit code {proc.exitcode})")
+                row = {"set": set_name, "classifier": classifier, "name": gt.name, "kind": gt.kind,
+                       "width": gt.width, "closed": gt.closed, "gt_intersections": len(gt.intersections),
+                       "error": why}
+            rows[slot] = row
+            del running[slot]
+            progress(row)
+    return rows  # type: ignore[return-value]
+
+
+# -- tables -----------------------------------------------------------------------------------
+
+def _summary(rows: list[dict]) -> dict:
+    ok = [r for r in rows if not r.get("error")]
+    n = len(rows)
+
+    def mean(key, cap=None):
+        vals = [min(r[key], cap) if cap is not None else r[key] for r in ok]
+        return float(np.mean(vals)) if vals else float("nan")
+
+    gt_x = sum(r["gt_intersections"] for r in ok)
+    out_x = sum(r["out_intersections"] for r in ok)
+    matched = sum(r["matched"] for r in ok)
+    secs = [r["seconds"] for r in ok]
+    peaks = [r["peak_mb"] for r in ok if not math.isnan(r["peak_mb"])]
+    return {
+        "n": n,
+        "fail": n - len(ok),
+        "correct": 100.0 * sum(1 for r in ok if r["correct"]) / n if n else float("nan"),
+        "strokes": mean("strokes"),
+        "order": mean("order"),
+        "ssim": mean("ssim"),
+        "psnr": mean("psnr", PSNR_CAP),
+        "length": 100.0 * mean("length_ratio"),
+        "undetected": 100.0 * (gt_x - matched) / gt_x if gt_x else float("nan"),
+        "hallucinated": 100.0 * (out_x - matched) / out_x if out_x else 0.0,
+        "median_s": float(np.median(secs)) if secs else float("nan"),
+        "p90_s": float(np.percentile(secs, 90)) if secs else float("nan"),
+        "peak_mb": max(peaks) if peaks else float("nan"),
+    }
+
+
+COLUMNS = [  # key, header, width, format ("" = text, left-aligned)
+    ("set", "set", 8, ""), ("classifier", "classifier", 10, ""), ("n", "n", 4, "{:d}"), ("fail", "fail", 4, "{:d}"),
+    ("correct", "correct %", 9, "{:.1f}"), ("strokes", "strokes", 7, "{:.2f}"), ("order", "order", 6, "{:.3f}"),
+    ("ssim", "SSIM", 6, "{:.4f}"), ("psnr", "PSNR", 6, "{:.2f}"), ("length", "len %", 6, "{:.2f}"),
+    ("undetected", "undet %", 7, "{:.1f}"), ("hallucinated", "hall %", 6, "{:.1f}"),
+    ("median_s", "med s", 6, "{:.2f}"), ("p90_s", "p90 s", 6, "{:.2f}"), ("peak_mb", "peak MB", 7, "{:.0f}"),
+]
+
+
+def _fmt_row(values: dict) -> str:
+    cells = []
+    for key, _head, width, fmt in COLUMNS:
+        v = values[key]
+        if not fmt:
+            cells.append(str(v).ljust(width))
+        elif isinstance(v, float) and math.isnan(v):
+            cells.append("-".rjust(width))
+        else:
+            cells.append(fmt.format(v).rjust(width))
+    return "  ".join(cells)
+
+
+def _fmt_header() -> str:
+    return "  ".join(head.ljust(width) if not fmt else head.rjust(width) for _k, head, width, fmt in COLUMNS)
+
+
+def print_tables(rows: list[dict]) -> None:
+    groups: dict = {}
+    for r in rows:
+        groups.setdefault((r["set"], r["classifier"]), []).append(r)
+    print(_fmt_header())
+    for (set_name, classifier), rs in groups.items():
+        print(_fmt_row({"set": set_name, "classifier": classifier, **_summary(rs)}))
+    if len({r["set"] for r in rows} & {"plain", "hershey"}) == 2:
+        main = [r for r in rows if r["set"] in ("plain", "hershey") and r["classifier"] == "cnn"]
+        if main:
+            print(_fmt_row({"set": "plain+h", "classifier": "cnn", **_summary(main)}))
+    print()
+    print("by drawing kind:")
+    print(f"{'set':<8}  {'classifier':<10}  {'kind':<17}  {'n':>3}  {'fail':>4}  {'correct %':>9}  "
+          f"{'strokes':>7}  {'order':>6}  {'undet %':>7}  {'hall %':>6}  {'med s':>6}")
+    kinds: dict = {}
+    for r in rows:
+        kinds.setdefault((r["set"], r["classifier"], r["kind"]), []).append(r)
+    for (set_name, classifier, kind), rs in sorted(kinds.items()):
+        s = _summary(rs)
+        cells = [f"{set_name:<8}", f"{classifier:<10}", f"{kind:<17}", f"{s['n']:>3}", f"{s['fail']:>4}"]
+        for key, width, fmt in (("correct", 9, "{:.1f}"), ("strokes", 7, "{:.2f}"), ("order", 6, "{:.3f}"),
+                                ("undetected", 7, "{:.1f}"), ("hallucinated", 6, "{:.1f}"),
+                                ("median_s", 6, "{:.2f}")):
+            v = s[key]
+            cells.append(("-" if isinstance(v, float) and math.isnan(v) else fmt.format(v)).rjust(width))
+        print("  ".join(cells))
+
+
+# -- whole process ----------------------------------------------------------------------------
+
+def whole_process(gts: list, timeout: float) -> None:
+    exe = shutil.which("onestroke")
+    base = [exe] if exe else [sys.executable, "-c", "from fabrication.cli import main; main()"]
+    times = []
+    with tempfile.TemporaryDirectory(prefix="onestroke-bench-") as tmp:
+        for gt in gts:
+            from PIL import Image
+
+            src = Path(tmp) / f"{gt.name}.png"
+            out = Path(tmp) / f"{gt.name}.svg"
+            Image.fromarray(to_uint8(render(gt.drawing))).save(src)
+            start = time.perf_counter()
+            try:
+                proc = subprocess.run(base + ["vectorize", str(src), "-o", str(out)], capture_output=True,
+                                      text=True, timeout=timeout)
+                code = proc.returncode
+                msg = (proc.stdout + proc.stderr).strip().splitlines()[-1:] or [""]
+            except subprocess.TimeoutExpired:
+                code, msg = "timeout", [""]
+            elapsed = time.perf_counter() - start
+            strokes = "-"
+            if out.exists():
+                from vectorize.svg_read import read_svg
+
+                strokes = len(read_svg(str(out)).strokes)
+            times.append(elapsed)
+            print(f"  {gt.name:<28} {elapsed:6.2f} s  exit {code}  strokes {strokes}  {msg[0][:80]}")
+    print(f"whole-process `onestroke vectorize IN.png -o OUT.svg`: median {statistics.median(times):.2f} s, "
+          f"max {max(times):.2f} s over {len(times)} drawings")
+
+
+# -- main -------------------------------------------------------------------------------------
+
+def _git_commit() -> str:
+    try:
+        return subprocess.run(["git", "-C", str(ROOT), "rev-parse", "--short", "HEAD"], capture_output=True,
+                              text=True, timeout=10).stdout.strip()
+    except Exception:  # noqa: BLE001
+        return "?"
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[1], formatter_class=argparse.RawTextHelpFormatter)
+    ap.add_argument("--set", default="all", choices=["plain", "touch", "hershey", "all"])
+    ap.add_argument("--classifier", default="auto", choices=["auto", "cnn", "geometric", "both"],
+                    help="auto: cnn on plain/hershey, both on touch")
+    ap.add_argument("--count", type=int, default=None, help="drawings per set (default: plain 42, touch 40, "
+                                                            "hershey 40)")
+    ap.add_argument("--seed", type=int, default=0)
+    ap.add_argument("--jobs", type=int, default=1, help="drawings in parallel (timing is cleanest with 1)")
+    ap.add_argument("--csv", type=Path, default=None, help="write one row per drawing here")
+    ap.add_argument("--timeout", type=float, default=120.0, help="seconds per drawing before it counts as failed")
+    ap.add_argument("--whole-process", type=int, nargs="?", const=5, default=None, metavar="N",
+                    help="instead: time `onestroke vectorize` as a subprocess on N drawings (default 5)")
+    ap.add_argument("--ground-truth-as-output", action="store_true",
+                    help="score the ground truth against itself (checks the machinery; no vectorizer)")
+    args = ap.parse_args(argv)
+
+    t_start = time.perf_counter()
+    sets = ["plain", "touch", "hershey"] if args.set == "all" else [args.set]
+    for name in sets:
+        count = args.count if args.count is not None else DEFAULT_COUNTS[name]
+        gts = hershey_set(count, args.seed) if name == "hershey" else generate_set(name, count, args.seed)
+        TASKS.extend((name, gt) for gt in gts)
+    t_gen = time.perf_counter() - t_start
+
+    print(f"onestroke vectorizer benchmark  {time.strftime('%Y-%m-%d %H:%M:%S %Z')}  commit {_git_commit()}  "
+          f"python {platform.python_version()}  {os.cpu_count()} CPUs")
+    print(f"sets {', '.join(sets)}; seed {args.seed}; {len(TASKS)} drawings made in {t_gen:.1f} s")
+
+    if args.whole_process is not None:
+        picks = [gt for _, gt in TASKS[:: max(1, len(TASKS) // args.whole_process)]][: args.whole_process]
+        whole_process(picks, args.timeout)
+        return 0
+
+    jobs: list[tuple[int, str]] = []
+    for index, (name, _gt) in enumerate(TASKS):
+        if args.classifier == "auto":
+            classifiers = ["cnn", "geometric"] if name == "touch" else ["cnn"]
+        elif args.classifier == "both":
+            classifiers = ["cnn", "geometric"]
+        else:
+            classifiers = [args.classifier]
+        jobs.extend((index, c) for c in classifiers)
+    jobs.sort(key=lambda j: (j[1] != "cnn", j[0]))
+
+    if args.ground_truth_as_output:
+        print("ground truth scored as the output: every score must be perfect")
+    else:
+        # warm-up: load the vectorizer and its models once, like a long-running process
+        from vectorize import VectorizeOptions, vectorize_image
+
+        for classifier in sorted({c for _, c in jobs}):
+            start = time.perf_counter()
+            try:
+                vectorize_image(to_uint8(render(TASKS[0][1].drawing)), VectorizeOptions(classifier=classifier))
+                print(f"warm-up ({classifier}): {time.perf_counter() - start:.2f} s")
+            except Exception as exc:  # noqa: BLE001
+                print(f"warm-up ({classifier}) failed: {type(exc).__name__}: {exc}")
+        print("time = wall time of vectorize_image per drawing, each in a fresh forked process; "
+              "peak MB = that process's peak RSS during the call (VmHWM reset before it; includes "
+              "interpreter, libraries and model)")
+    print(f"correct = one stroke and order score >= {ORDER_THRESHOLD}; intersections matched within 5 px, "
+          f"pooled over the set; PSNR capped at {PSNR_CAP:.0f} dB")
+    print()
+
+    done = [0]
+
+    def progress(row):
+        done[0] += 1
+        status = row["error"] or (f"strokes {row['strokes']} order {row['order']:.3f} "
+                                  f"{row['seconds']:.2f} s")
+        print(f"[{done[0]:>3}/{len(jobs)}] {row['set']:<7} {row['classifier']:<9} {row['name']:<34} {status}",
+              file=sys.stderr, flush=True)
+
+    rows = run_tasks(jobs, args.ground_truth_as_output, max(1, args.jobs), args.timeout, progress)
+    print_tables(rows)
+    errors = [r for r in rows if r.get("error")]
+    if errors:
+        print()
+        print(f"{len(errors)} drawings failed; first errors:")
+        for r in errors[:5]:
+            print(f"  {r['set']}/{r['classifier']}/{r['name']}: {r['error']}")
+    if args.csv:
+        keys = ["set", "classifier", "name", "kind", "width", "closed", "strokes", "order", "correct", "ssim",
+                "psnr", "length_ratio", "gt_intersections", "out_intersections", "matched", "seconds",
+                "peak_mb", "error", "warnings"]
+        args.csv.parent.mkdir(parents=True, exist_ok=True)
+        with open(args.csv, "w", newline="") as fh:
+            writer = csv.DictWriter(fh, fieldnames=keys, extrasaction="ignore")
+            writer.writeheader()
+            writer.writerows(rows)
+        print(f"per-drawing rows: {args.csv}")
+    print(f"\ntotal benchmark time {time.perf_counter() - t_start:.0f} s")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

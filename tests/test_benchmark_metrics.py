@@ -1,0 +1,231 @@
+"""Fast tests of the benchmark machinery: order score, intersections, ground truth, generator."""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+if str(ROOT) not in sys.path:
+    sys.path.insert(0, str(ROOT))
+
+from benchmarks import drawings as D  # noqa: E402
+from benchmarks.hershey import Glyph, glyph_ground_truth, glyph_stroke, load_glyphs  # noqa: E402
+from benchmarks.metrics import (  # noqa: E402
+    ORDER_THRESHOLD,
+    evaluate,
+    match_points,
+    order_score,
+    order_tolerance,
+    polyline_intersections,
+)
+from benchmarks.render import render  # noqa: E402
+from vectorize.drawing import Drawing  # noqa: E402
+from vectorize.stroke import Stroke  # noqa: E402
+
+
+@pytest.fixture(scope="module")
+def touch_gt():
+    return D.generate_drawing("touch", 0, 1)
+
+
+@pytest.fixture(scope="module")
+def loops_gt():
+    return D.generate_drawing("loops", 0, 3)
+
+
+@pytest.fixture(scope="module")
+def closed_gt():
+    return D.generate_drawing("closed", 0, 2)
+
+
+def _passes(stroke: Stroke, point: np.ndarray, min_gap: float) -> tuple[float, float]:
+    """Arc lengths of the two passes of `stroke` through (or nearest to) `point`."""
+    s = np.linspace(0, stroke.length, int(stroke.length * 4))
+    d = np.linalg.norm(stroke.points_at_lengths(s) - point, axis=1)
+    first = s[np.argmin(d)]
+    d2 = np.where(np.abs(s - first) > min_gap, d, np.inf)
+    second = s[np.argmin(d2)]
+    return tuple(sorted((float(first), float(second))))
+
+
+def _piece(stroke: Stroke, a: float, b: float, spacing: float = 1.0) -> np.ndarray:
+    n = max(2, int(abs(b - a) / spacing) + 1)
+    return stroke.points_at_lengths(np.linspace(a, b, n))
+
+
+def _wrong_turns(gt, point):
+    """Outputs that turn the wrong way at `point`: the middle loop reversed, or split off."""
+    stroke = gt.stroke
+    s1, s2 = _passes(stroke, point, 10 * gt.width)
+    head = _piece(stroke, 0, s1)
+    middle = _piece(stroke, s1, s2)
+    tail = _piece(stroke, s2, stroke.length)
+    reversed_middle = Stroke.from_polyline(np.vstack([head, middle[::-1][1:], tail[1:]]))
+    split = (Stroke.from_polyline(np.vstack([head, tail[1:]])), Stroke.from_polyline(middle))
+    return reversed_middle, split, (s2 - s1) / stroke.length
+
+
+# -- order score --------------------------------------------------------------------------------
+
+def test_ground_truth_as_output_is_perfect(touch_gt, loops_gt):
+    for gt in (touch_gt, loops_gt, D.generate_drawing("spike", 0, 0)):
+        scores = evaluate(gt, gt.drawing)
+        assert scores.ssim == pytest.approx(1.0)
+        assert scores.length_ratio == pytest.approx(0.0, abs=1e-9)
+        assert scores.stroke_count == 1
+        assert scores.order == pytest.approx(1.0)
+        assert scores.correct
+        assert scores.undetected == 0 and scores.hallucinated == 0
+    assert len(loops_gt.intersections) >= 2
+
+
+def test_reversed_shifted_and_jittered_outputs_keep_the_order(closed_gt, loops_gt):
+    tol = order_tolerance(loops_gt.width)
+    assert order_score(loops_gt.stroke, [loops_gt.stroke.reversed()], tol) >= 0.995
+    # a closed curve started elsewhere (and reversed) is the same drawing
+    stroke = closed_gt.stroke
+    pts = stroke.sample_evenly(1.0)[:-1]
+    shifted = np.roll(pts, -len(pts) // 3, axis=0)
+    shifted = np.vstack([shifted, shifted[:1]])
+    tol = order_tolerance(closed_gt.width)
+    assert order_score(stroke, [Stroke.from_polyline(shifted)], tol, closed=True) >= 0.995
+    assert order_score(stroke, [Stroke.from_polyline(shifted[::-1])], tol, closed=True) >= 0.995
+    # fitting noise well inside the tolerance does not matter
+    rng = np.random.default_rng(0)
+    noisy = loops_gt.stroke.sample_evenly(2.0) + rng.normal(0, 0.4, size=(1, 2))
+    assert order_score(loops_gt.stroke, [Stroke.from_polyline(noisy)], order_tolerance(loops_gt.width)) >= 0.99
+
+
+def test_wrong_turn_at_a_touch_is_flagged(touch_gt):
+    point = next(e.point for e in touch_gt.events if e.kind == "touch")
+    reversed_middle, split, share = _wrong_turns(touch_gt, point)
+    assert share > 0.05
+    out = touch_gt.drawing.with_strokes([reversed_middle])
+    scores = evaluate(touch_gt, out)
+    assert scores.ssim > 0.999  # the image cannot tell ...
+    assert scores.stroke_count == 1
+    assert scores.order < ORDER_THRESHOLD  # ... the order score can
+    assert not scores.correct
+    split_scores = evaluate(touch_gt, touch_gt.drawing.with_strokes(split))
+    assert split_scores.order < ORDER_THRESHOLD and not split_scores.correct
+
+
+def test_wrong_pairing_at_a_crossing_is_flagged(loops_gt):
+    for point in loops_gt.intersections:
+        reversed_middle, split, share = _wrong_turns(loops_gt, point)
+        tol = order_tolerance(loops_gt.width)
+        assert order_score(loops_gt.stroke, [reversed_middle], tol) < ORDER_THRESHOLD
+        assert order_score(loops_gt.stroke, list(split), tol) < ORDER_THRESHOLD
+        # the turned output does not cross where the ground truth does
+        scores = evaluate(loops_gt, loops_gt.drawing.with_strokes([reversed_middle]))
+        assert scores.undetected >= 1
+
+
+def test_order_score_drops_with_the_missing_share(loops_gt):
+    stroke = loops_gt.stroke
+    half = Stroke.from_polyline(_piece(stroke, 0, stroke.length / 2))
+    score = order_score(stroke, [half], order_tolerance(loops_gt.width))
+    assert 0.4 < score < 0.6
+
+
+# -- intersections ------------------------------------------------------------------------------
+
+def test_crossing_touch_and_retrace_are_told_apart():
+    t = np.linspace(0, 2 * np.pi, 73)
+    circle = np.round(np.c_[np.cos(t), np.sin(t)] * 10, 9)
+    a = circle + [0, 0]
+    b = circle[::-1] + [20, 0]  # touches a at (10, 0): both have a vertex there
+    touch = polyline_intersections([a, b], [True, True])
+    assert len(touch.touches) == 1 and len(touch.crossings) == 0
+    np.testing.assert_allclose(touch.touches[0], [10, 0], atol=1e-9)
+    x = polyline_intersections([np.array([[0, 0], [10, 10.0]]), np.array([[0, 10], [10, 0.0]])], [False, False])
+    assert len(x.crossings) == 1 and x.crossing_angles[0] == pytest.approx(90.0)
+    spike = np.array([[0, 0], [10, 0], [20, 0], [20, 5], [20, 0], [30, 0.0]])  # out and back at (20, 0)
+    r = polyline_intersections([spike], [False])
+    assert len(r.crossings) == 0 and len(r.touches) == 0 and len(r.retraces) >= 1
+    loop = np.array([[0, 0], [10, 0], [10, 10], [5, 10], [5, -10.0]])  # crosses itself at (5, 0)
+    r = polyline_intersections([loop], [False])
+    np.testing.assert_allclose(r.crossings, [[5, 0]], atol=1e-9)
+
+
+def test_matching_within_five_pixels():
+    gt = np.array([[100, 100], [300, 300.0]])
+    assert match_points(gt, gt + [3, 3]) == 2
+    assert match_points(gt, gt + [4, 4]) == 0  # 5.7 px away
+    assert match_points(gt, np.array([[101, 100], [102, 100.0]])) == 1  # one-to-one
+
+
+def test_output_intersections_at_a_touch_are_not_hallucinated(touch_gt):
+    # an output whose second pass dips across the first one right at the touch
+    stroke = touch_gt.stroke
+    point = next(e.point for e in touch_gt.events if e.kind == "touch")
+    s1, s2 = _passes(stroke, point, 10 * touch_gt.width)
+    side = (stroke.points_at_lengths(s1 + 15) + stroke.points_at_lengths(s1 - 15)) / 2 - point
+    side /= np.linalg.norm(side)
+    s = np.linspace(0, stroke.length, int(stroke.length))
+    dip = 1.0 * np.exp(-(((s - s2) / 6.0) ** 2))[:, None] * side
+    wobbly = Stroke.from_polyline(stroke.points_at_lengths(s) + dip)
+    raw = polyline_intersections([wobbly.flatten(0.05)], [False])
+    assert len(raw.crossings) >= len(touch_gt.intersections) + 1  # it does cross there ...
+    scores = evaluate(touch_gt, touch_gt.drawing.with_strokes([wobbly]))
+    assert scores.hallucinated == 0  # ... inside the touch's don't-care zone
+    assert scores.correct
+
+
+# -- generator and glyphs -----------------------------------------------------------------------
+
+def test_generator_is_deterministic_by_seed():
+    a = D.generate_drawing("shallow", 7, 3)
+    b = D.generate_drawing("shallow", 7, 3)
+    c = D.generate_drawing("shallow", 8, 3)
+    np.testing.assert_array_equal(a.stroke.control, b.stroke.control)
+    np.testing.assert_array_equal(a.intersections, b.intersections)
+    assert a.width == b.width
+    assert not np.array_equal(a.stroke.control, c.stroke.control) if a.stroke.control.shape == c.stroke.control.shape \
+        else True
+
+
+def test_generated_kinds_have_their_features(touch_gt):
+    shallow = D.generate_drawing("shallow", 0, 4)
+    assert any(5 <= e.angle <= 20 for e in shallow.events if e.kind == "crossing")
+    assert all(e.angle >= 5 for e in shallow.events if e.kind == "crossing")
+    assert touch_gt.count("touch") == 1
+    touch = next(e.point for e in touch_gt.events if e.kind == "touch")
+    assert all(np.linalg.norm(p - touch) > 5 for p in touch_gt.intersections)  # a touch is no intersection
+    near = D.generate_drawing("near-touch", 0, 2)
+    assert near.count("near-touch") == 1 and near.count("touch") == 0
+    spike = D.generate_drawing("spike", 0, 1)
+    assert spike.count("spike-tip") >= 1
+    for gt in (shallow, touch_gt, near, spike):
+        assert 2.0 <= gt.width <= 12.0
+        assert gt.drawing.width == gt.drawing.height == 1000
+        assert len(gt.drawing.strokes) == 1
+
+
+def test_render_is_antialiased_and_inks_width_times_length(loops_gt):
+    image = render(loops_gt.drawing)
+    assert image.shape == (1000, 1000)
+    assert 0.0 <= image.min() < 0.05 and image.max() == 1.0
+    assert np.any((image > 0.1) & (image < 0.9))  # grey edge pixels
+    ink = (1.0 - image).sum()
+    # crossings count once, caps add a little
+    assert ink == pytest.approx(loops_gt.width * loops_gt.drawing.length, rel=0.05)
+
+
+def test_hershey_glyph_ground_truth():
+    glyphs = load_glyphs()
+    assert len(glyphs) > 100
+    eight = next(g for g in glyphs if g.font == "HersheySans1" and g.name == "eight")
+    gt = glyph_ground_truth(eight, 5.0)
+    assert gt is not None and gt.closed
+    assert len(gt.intersections) == 1
+    xmin, ymin, xmax, ymax = gt.drawing.bounds()
+    assert 40 <= xmin and xmax <= 960 and 40 <= ymin and ymax <= 960
+    # y is flipped: the glyph's top (font y up) ends up at small y
+    stroke, poly, _closed = glyph_stroke(Glyph("t", "t", "t", "M 0 0 L 0 100 L 50 100"))
+    assert poly[1, 1] < poly[0, 1]
+    assert evaluate(gt, gt.drawing).correct
