@@ -8,6 +8,7 @@ import pytest
 from fabrication.laser.framing import framing_lines
 from fabrication.laser.gcode_read import parse_gcode, strip_line, validate_gcode
 from fabrication.laser.gcode_write import GcodeOptions, fmt, gcode_lines, gcode_text
+from fabrication.laser.job_time import estimate_gcode_time
 from fabrication.laser.toolpath import ToolpathOptions, plan_toolpath
 from fabrication.placement import PlacementOptions
 from laser_fixtures import hershey_text_drawing, rose_drawing, wiggle_drawing
@@ -152,6 +153,9 @@ def test_framing_program_is_valid_and_traces_the_box():
         assert np.allclose(np.unique(np.round(ends[:, 0], 3)), np.round([xmin, xmax], 3))
         assert np.allclose(np.unique(np.round(ends[:, 1], 3)), np.round([ymin, ymax], 3))
         assert moves.laser_on.any() == (power > 0)
+        job = estimate_gcode_time(lines, PROFILE)
+        perimeter = 2 * (xmax - xmin + ymax - ymin)
+        assert job.burn_length == pytest.approx(perimeter if power > 0 else 0.0, abs=0.01)
 
 
 @pytest.mark.parametrize("line,reason", [

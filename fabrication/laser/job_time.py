@@ -36,8 +36,8 @@ class JobTime:
     """Seconds the job takes on GRBL, with the break-down.
 
     total_seconds: whole program. line_seconds (n_lines,): cumulative seconds at the end
-    of each line (for an ETA while streaming). burn_seconds / travel_seconds: beam-on and
-    beam-off motion. burn_length / travel_length: mm. naive_seconds: the length / feed
+    of each line (for an ETA while streaming). burn_seconds / travel_seconds: motion with
+    the beam able to fire (M3/M4, S > 0, not G0) and all other motion. burn_length / travel_length: mm. naive_seconds: the length / feed
     figure common senders show (G1 at F, G0 at the profile's rapid rate). blocks: planner
     blocks after arc splitting.
     """
@@ -200,10 +200,11 @@ def estimate_moves_time(moves: GcodeMoves, profile: LaserProfile) -> JobTime:
     per_line = np.bincount(moves.line, weights=per_move, minlength=n_lines) + moves.line_dwell
     chord = np.hypot(*(segments[:, 1] - segments[:, 0]).T)
     move_length = np.bincount(owner, weights=chord, minlength=len(moves))
-    burn = moves.kind != 0
+    cutting = moves.kind != 0
     feed = np.nan_to_num(moves.feed, nan=profile.rapid_rate)
-    naive = float((move_length[burn] / np.maximum(feed[burn], 1e-9)).sum() * 60.0
-                  + move_length[~burn].sum() / profile.rapid_rate * 60.0)
+    naive = float((move_length[cutting] / np.maximum(feed[cutting], 1e-9)).sum() * 60.0
+                  + move_length[~cutting].sum() / profile.rapid_rate * 60.0)
+    burn = moves.laser_on  # G1 with the laser off (M5 or S0, e.g. framing) is travel
     return JobTime(
         total_seconds=float(per_line.sum()), line_seconds=np.cumsum(per_line),
         burn_seconds=float(per_move[burn].sum()), travel_seconds=float(per_move[~burn].sum()),

@@ -102,7 +102,8 @@ def _scene(moves: GcodeMoves, job: JobTime, profile: LaserProfile, name: str) ->
             f"length / feed: {format_duration(job.naive_seconds)} (common senders)",
             f"burn {burn_len:.0f} mm, travel {travel_len:.0f} mm",
             f"{moves.n_lines} lines, {job.blocks} planner blocks",
-            f"burn area {bounds[2] - bounds[0]:.1f} x {bounds[3] - bounds[1]:.1f} mm",
+            f"{'burn area' if burn else 'moves (no burn)'} {bounds[2] - bounds[0]:.1f} x "
+            f"{bounds[3] - bounds[1]:.1f} mm",
             f"bed {profile.bed_width:g} x {profile.bed_height:g} mm",
             "", "colour: burn order (first -> last)", "dashed grey: travel, laser off",
             "green ring: start, cross: (0, 0)"]
