@@ -34,14 +34,36 @@ from machines.planner_model import Block, BlockBuilder, Kinematics, block_durati
 VERSION = "1.1h"
 BUILD_DATE = "20190825"
 
-# Defaults of a typical 400 x 400 mm diode laser (GRBL 1.1h defaults where a laser has none).
-DEFAULT_SETTINGS: dict[int, float] = {
+# GRBL 1.1h defaults for what a laser profile does not describe.
+_FIRMWARE_DEFAULTS: dict[int, float] = {
     0: 10, 1: 25, 2: 0, 3: 0, 4: 0, 5: 0, 6: 0, 10: 1, 11: 0.010, 12: 0.002, 13: 0,
     20: 0, 21: 0, 22: 0, 23: 0, 24: 25.0, 25: 500.0, 26: 250, 27: 1.0,
     30: 1000, 31: 0, 32: 1,
     100: 80.0, 101: 80.0, 102: 250.0, 110: 6000.0, 111: 6000.0, 112: 500.0,
     120: 500.0, 121: 500.0, 122: 10.0, 130: 400.0, 131: 400.0, 132: 0.0,
 }
+
+
+def settings_from_profile(profile) -> dict[int, float]:
+    """`$$` settings of the machine a `LaserProfile` describes (firmware defaults elsewhere)."""
+    return {**_FIRMWARE_DEFAULTS, 11: profile.junction_deviation, 12: profile.arc_tolerance,
+            30: profile.max_power, 32: float(profile.laser_mode), 100: profile.steps_per_mm_x,
+            101: profile.steps_per_mm_y, 110: profile.max_rate_x, 111: profile.max_rate_y,
+            120: profile.acceleration_x, 121: profile.acceleration_y, 130: profile.bed_width,
+            131: profile.bed_height}
+
+
+def _default_settings() -> dict[int, float]:
+    # The emulated machine is the default laser profile's machine (profiles are data).
+    try:
+        from machines.laser_profile import load_laser_profile
+
+        return settings_from_profile(load_laser_profile())
+    except Exception:  # noqa: BLE001 - a broken profile file must not break the emulator
+        return dict(_FIRMWARE_DEFAULTS)
+
+
+DEFAULT_SETTINGS: dict[int, float] = _default_settings()
 _INT_SETTINGS = {0, 1, 2, 3, 4, 5, 6, 10, 13, 20, 21, 22, 23, 26, 32}
 
 

@@ -1,8 +1,9 @@
-"""`sim://[?speed=N&rx=128&blocks=15&laser=1&travel=400x400]`: a GRBL emulator as a serial port.
+"""`sim://[?speed=N&profile=FILE.toml&rx=128&blocks=15&laser=1&travel=400x400]`: GRBL as a serial port.
 
 The URL opens a `GrblEmulator` on a real pseudo-terminal and talks to it through an
 ordinary `serial.Serial` on that pty, so the host side is the same code path as a USB
-adapter. `speed` is the time scale (default 10: ten times faster than a real machine).
+adapter. `speed` is the time scale (default 10: ten times faster than a real machine);
+`profile` a laser profile TOML whose machine to emulate (bed, $30, rates, accelerations).
 """
 
 from __future__ import annotations
@@ -36,14 +37,25 @@ def parse_sim_url(url: str) -> EmulatorOptions:
                 blocks = int(value)
             elif key == "laser":
                 settings[32] = float(int(value))
+            elif key == "profile":
+                from machines.emulator import settings_from_profile
+                from machines.laser_profile import load_laser_profile
+
+                try:
+                    settings = {**settings_from_profile(load_laser_profile(value)), **settings}
+                except Exception as error:  # noqa: BLE001 - InputError and friends, reported as one line
+                    raise ValueError(f"sim:// profile: {error}") from None
             elif key == "travel":
                 width, height = (float(v) for v in value.lower().split("x"))
                 settings[130], settings[131] = width, height
             else:
                 raise KeyError(key)
         except KeyError:
-            raise ValueError(f"unknown sim:// parameter {key!r}; use speed, rx, blocks, laser, travel") from None
-        except ValueError:
+            raise ValueError(f"unknown sim:// parameter {key!r}; use speed, rx, blocks, laser, travel, "
+                             "profile") from None
+        except ValueError as error:
+            if str(error).startswith("sim://"):
+                raise
             raise ValueError(f"bad value {value!r} for sim:// parameter {key!r}") from None
     return EmulatorOptions(time_scale=speed, rx_buffer=rx, planner_blocks=blocks, settings=settings)
 
