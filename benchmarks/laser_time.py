@@ -94,11 +94,11 @@ def main() -> None:
     for feed in (1500, 3000, 6000):
         row(f"spiral of 0.05 mm segments, F{feed}", spiral(feed))
     drawing, how = vectorized_drawing()
-    for feed in (1500, 3000):
+    for size, feed in ((60, 1500), (60, 3000), (20, 6000)):
         for arcs in (False, True):
-            tp = plan_toolpath(drawing, PROFILE, ToolpathOptions(placement=PlacementOptions(size=60), arcs=arcs))
+            tp = plan_toolpath(drawing, PROFILE, ToolpathOptions(placement=PlacementOptions(size=size), arcs=arcs))
             lines = gcode_lines(tp, PROFILE, GcodeOptions(feed=float(feed)))
-            row(f"vectorized trefoil ({how}) 60 mm, {'arcs' if arcs else 'lines'}, F{feed}", lines)
+            row(f"vectorized trefoil ({how}) {size} mm, {'arcs' if arcs else 'lines'}, F{feed}", lines)
 
     print()
     print("Fig. 14 comparison (same machine model):")

@@ -46,6 +46,8 @@ def vectorized_lines(tmp_path_factory):
     for arcs in (False, True):
         tp = plan_toolpath(drawing, PROFILE, ToolpathOptions(placement=PlacementOptions(size=60), arcs=arcs))
         out[arcs] = gcode_lines(tp, PROFILE, GcodeOptions(feed=3000.0, passes=2))
+    small = plan_toolpath(drawing, PROFILE, ToolpathOptions(placement=PlacementOptions(size=20)))
+    out["small"] = gcode_lines(small, PROFILE, GcodeOptions(feed=6000.0))
     return out
 
 
@@ -82,6 +84,12 @@ def test_spiral_of_short_segments(feed):
 @pytest.mark.parametrize("arcs", [False, True])
 def test_vectorized_drawing(vectorized_lines, arcs):
     _compare(vectorized_lines[arcs], f"vectorized trefoil, {'arcs' if arcs else 'lines'}, F3000, 2 passes")
+
+
+def test_small_fast_vectorized_drawing(vectorized_lines):
+    # 20 mm at F6000: corners and look-ahead, not the feed, set the pace
+    job, sim = _compare(vectorized_lines["small"], "vectorized trefoil 20 mm, lines, F6000")
+    assert job.naive_seconds < 0.8 * sim
 
 
 def test_forced_stops_are_modelled():
