@@ -7,6 +7,7 @@ import serial
 
 from machines.emulator import EmulatorOptions, GrblEmulator
 from machines.ports import open_port
+from onestroke.errors import MachineError
 
 
 class Link:
@@ -162,3 +163,15 @@ def test_sim_url_opens_an_emulator_through_pyserial():
         assert port.emulator is not None and port.time_scale == 20.0
     finally:
         port.close()
+
+
+def test_sim_url_emulates_a_laser_profile(tmp_path):
+    profile = tmp_path / "small.toml"
+    profile.write_text('name = "small"\n[bed]\nsize = "300x200mm"\n[laser]\nmax_power = 255\n')
+    port = open_port(f"sim://?speed=20&profile={profile}")
+    try:
+        assert port.emulator.settings[30] == 255 and port.emulator.settings[130] == 300
+    finally:
+        port.close()
+    with pytest.raises(MachineError, match="does not exist"):
+        open_port(f"sim://?profile={tmp_path / 'missing.toml'}")
