@@ -437,7 +437,8 @@ def _validate(stroke: Stroke, closed: bool, width: float, designed: list, spikes
             need = ei.radius + ej.radius + 3 * w
             if np.linalg.norm(ei.point - ej.point) < need:
                 raise Rejected(f"{ei.kind} and {ej.kind} too close")
-    dont_care = [shapely.Point(*e.point) for e in events if e.kind in ("touch", "near-touch")]
+    # the whole ink-merge zone of a touch: the output's two passes share one blob of ink there
+    dont_care = [shapely.Point(*e.point).buffer(e.radius) for e in events if e.kind in ("touch", "near-touch")]
     dont_care += [shapely.LineString([b, t]) for b, t, _ in spikes]
     dont_care += list(inter.retraces)
     return events, inter.crossings, dont_care

@@ -161,7 +161,7 @@ def glyph_ground_truth(glyph: Glyph, width: float) -> GroundTruth | None:
         for q in ends:
             if np.linalg.norm(e.point - q) < e.radius + 3 * width:
                 return None
-    dont_care = [shapely.Point(*p) for p in inter.touches] + list(inter.retraces)
+    dont_care = [shapely.Point(*p).buffer(2 * width) for p in inter.touches] + list(inter.retraces)
     dont_care += _sharp_turns(poly, closed, width)
     if len(inter.crossings) and dont_care:
         from benchmarks.metrics import MATCH_DISTANCE, dont_care_mask

@@ -50,6 +50,39 @@ from benchmarks.render import render, to_uint8  # noqa: E402
 DEFAULT_COUNTS = {"plain": 42, "touch": 40, "hershey": 40}
 PSNR_CAP = 60.0  # dB; an identical render has infinite PSNR, averaged as this
 TASKS: list = []  # (set name, GroundTruth), inherited by the forked workers
+PLOT_DIR: list = []  # [Path] when --plot is given
+
+
+def overlay(gt, output, gray: np.ndarray, path: Path) -> None:
+    """The output over the (lightened) input, coloured by drawing order (red -> violet per
+    stroke, a black ring at each stroke's start); blue circles: ground-truth crossings; green
+    circles: touches; red squares: output intersections."""
+    import colorsys
+
+    from PIL import Image, ImageDraw
+
+    from benchmarks.metrics import drawing_polylines, polyline_intersections
+
+    im = Image.fromarray(to_uint8(0.6 + 0.4 * gray)).convert("RGB")
+    draw = ImageDraw.Draw(im)
+    for stroke in output.strokes:
+        pts = stroke.sample_evenly(2.0)
+        n = max(len(pts) - 1, 1)
+        for k in range(len(pts) - 1):
+            r, g, b = colorsys.hsv_to_rgb(0.8 * k / n, 1.0, 0.85)
+            draw.line([tuple(pts[k]), tuple(pts[k + 1])], fill=(int(r * 255), int(g * 255), int(b * 255)), width=2)
+        x, y = pts[0]
+        draw.ellipse((x - 7, y - 7, x + 7, y + 7), outline=(0, 0, 0), width=2)
+    for x, y in gt.intersections:
+        draw.ellipse((x - 6, y - 6, x + 6, y + 6), outline=(0, 0, 255), width=2)
+    for e in gt.events:
+        if e.kind in ("touch", "near-touch"):
+            x, y = e.point
+            draw.ellipse((x - 10, y - 10, x + 10, y + 10), outline=(0, 170, 0), width=2)
+    polys, closed = drawing_polylines(output)
+    for x, y in polyline_intersections(polys, closed).crossings:
+        draw.rectangle((x - 4, y - 4, x + 4, y + 4), outline=(255, 0, 0), width=2)
+    im.save(path)
 
 
 # -- one drawing, in a child process --------------------------------------------------------
@@ -100,6 +133,8 @@ def _run_one(index: int, classifier: str, oracle: bool, conn) -> None:
                 method += " (not reset: includes set-up)"
             output, report = result.drawing, result.report
         scores = evaluate(gt, output, gray)
+        if PLOT_DIR and not scores.correct:
+            overlay(gt, output, gray, PLOT_DIR[0] / f"{set_name}-{classifier}-{gt.name}.png")
         row.update(seconds=seconds, peak_mb=peak, memory_method=method, strokes=scores.stroke_count,
                    ssim=scores.ssim, psnr=scores.psnr, length_ratio=scores.length_ratio,
                    out_intersections=scores.out_intersections, matched=scores.matched,
@@ -294,6 +329,8 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--jobs", type=int, default=1, help="drawings in parallel (timing is cleanest with 1)")
     ap.add_argument("--csv", type=Path, default=None, help="write one row per drawing here")
+    ap.add_argument("--plot", type=Path, default=None, metavar="DIR",
+                    help="write an overlay PNG of every drawing that is not one stroke in the correct order")
     ap.add_argument("--timeout", type=float, default=120.0, help="seconds per drawing before it counts as failed")
     ap.add_argument("--whole-process", type=int, nargs="?", const=5, default=None, metavar="N",
                     help="instead: time `onestroke vectorize` as a subprocess on N drawings (default 5)")
@@ -302,6 +339,9 @@ def main(argv: list[str] | None = None) -> int:
     args = ap.parse_args(argv)
 
     t_start = time.perf_counter()
+    if args.plot:
+        args.plot.mkdir(parents=True, exist_ok=True)
+        PLOT_DIR.append(args.plot)
     sets = ["plain", "touch", "hershey"] if args.set == "all" else [args.set]
     for name in sets:
         count = args.count if args.count is not None else DEFAULT_COUNTS[name]
