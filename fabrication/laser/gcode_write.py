@@ -2,7 +2,8 @@
 
 Program shape (see docs/laser.md): comment lines, `G21`, `G90`, `M4S0` once (dynamic power:
 the beam scales with speed and is off when still), `M8` if air assist; per stroke a `G0` to
-its start, then `G1`/`G2`/`G3` moves with `S` and `F` on the first; `M5`, `M9` at the end,
+its start, then `G1`/`G2`/`G3` moves with `S` and `F` on the first (the motion word only
+where it changes: it is modal); `M5`, `M9` at the end,
 then an optional `G0X0Y0`. No M3/M4/M5/M8 between strokes: each of them makes GRBL drain
 its planner to a full stop. Numbers carry at most 3 decimals without trailing zeros, words
 are not separated by spaces (they waste GRBL's 128-byte receive buffer), lines end in `\\n`.
@@ -77,10 +78,14 @@ def _path_lines(path: BurnPath, position: tuple[str, str], first_words: str) -> 
         offsets = path.centres - path.points[:-1]
         i_words, j_words = _fmt_many(np.nan_to_num(offsets[:, 0])), _fmt_many(np.nan_to_num(offsets[:, 1]))
     kinds = path.kinds.tolist()
+    mode = 0
     for k in range(len(kinds)):
         x, y, kind = xs[k + 1], ys[k + 1], kinds[k]
-        words = "G%d" % kind
-        # an axis word is left out when its value does not change (GRBL keeps it modal)
+        # the motion word is modal in GRBL: written only when it changes, which saves 2 of
+        # ~16 bytes a line on the serial link, the limit on dense jobs
+        words = "G%d" % kind if kind != mode else ""
+        mode = kind
+        # an axis word is left out when its value does not change (also modal)
         if x != xs[k]:
             words += "X" + x
         if y != ys[k]:
