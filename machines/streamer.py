@@ -473,7 +473,8 @@ class GrblStreamer:
                         if check and number:
                             check_errors.append((number, f"{text}: {describe_error(reply.code)}"))
                         else:
-                            raise stop(f"line {number} {text!r} was refused: {describe_error(reply.code)}",
+                            where = f"line {number}" if number else "resume preamble line"
+                            raise stop(f"{where} {text!r} was refused: {describe_error(reply.code)}",
                                        failed=number)
                     acked += 1
                     last_line = number or last_line

@@ -308,3 +308,23 @@ def test_emulator_command_serves_a_pty_and_logs_executed_lines(tmp_path):
         out, err = process.communicate(timeout=10)
     assert process.returncode == 0 and "planner-limited" in out
     assert log.read_text().splitlines() == cleaned(text) + [DRAIN_LINE]
+
+
+def test_resume_from_the_reported_line_finishes_the_job(tmp_path, emulator):
+    text = job_text(600)
+    emu = emulator(faults=Faults(error_at=300))
+    result, errors = run_cli(tmp_path, emu, text)
+    assert result.exit_code == 1 and "--from-line 300" in errors[0]
+    fresh = emulator()
+    result, errors = run_cli(tmp_path, fresh, text, "--from-line", "300")
+    assert result.exit_code == 0, result.output
+    assert "resuming" in result.stderr
+    full = cleaned(text)
+    preamble = fresh.executed[:len(fresh.executed) - len(full[299:]) - 1]
+    assert preamble[0] == "M5" and preamble[-2:] == ["M4S600", "G1"]
+    assert any(line.startswith("G53G0X") for line in preamble)
+    assert fresh.executed[len(preamble):] == full[299:] + [DRAIN_LINE]
+    # Where line 300 starts, the beam was off until the laser mode was restored.
+    assert fresh.spindle_history[0][0] == "M5" or fresh.spindle_history[0][1] == 0
+    result, errors = run_cli(tmp_path, emulator(), text, "--from-line", "99999")
+    assert result.exit_code == 2 and "--from-line 99999" in errors[0]

@@ -21,7 +21,8 @@ from fabrication.cli.common import console, done, warn
 from machines.gcode_program import Program, analyze_program, load_program, program_from_text
 from machines.job_check import check_job
 from machines.ports import open_port
-from machines.streamer import GrblStreamer, MachineInfo, StreamProgress
+from machines.resume import resume_program
+from machines.streamer import GrblStreamer, MachineInfo, StreamError, StreamProgress
 from onestroke.errors import InputError, MachineError
 
 BAUD_RATES = (9600, 19200, 38400, 57600, 115200, 230400, 250000, 500000, 1000000)
@@ -86,6 +87,15 @@ def _frame_program(stats, info: MachineInfo) -> Program:
     return program_from_text("\n".join(lines), source="frame")
 
 
+def _with_resume_hint(error: StreamError, program: Program) -> StreamError:
+    """The same error, telling which --from-line picks up after the last acknowledged line."""
+    later = [number for number, _ in program.lines if number > error.last_acked_line]
+    if not error.last_acked_line or not later:
+        return error
+    hint = f"; to resume: --from-line {later[0]} (lines just after it may already have run)"
+    return type(error)(str(error) + hint, last_acked_line=error.last_acked_line, failed_line=error.failed_line)
+
+
 @contextlib.contextmanager
 def _key_controls(streamer: GrblStreamer, enabled: bool):
     """Keys while streaming on a terminal: space/p pause, r resume, +/- feed, >/< power, q abort."""
@@ -123,13 +133,19 @@ def _key_controls(streamer: GrblStreamer, enabled: bool):
 
 
 def run_stream(gcode_path, *, port: str, baud: int = 115200, check: bool = False, frame: bool = False,
-               profile: str | os.PathLike | None = None) -> None:
+               profile: str | os.PathLike | None = None, from_line: int | None = None) -> None:
     """Connect to `port`, check the job against the machine, stream it with a progress bar
     and print a summary. `check` streams in GRBL's check mode ($C, nothing moves); `frame`
     only traces the job's bounding box with the beam off. `profile`: a laser profile TOML
-    to compare with the machine's settings. Raises OnestrokeError on any failure."""
+    to compare with the machine's settings. `from_line`: resume at this file line (after a
+    failure), moving there with the beam off first. Raises OnestrokeError on any failure."""
     path = Path(gcode_path)
     program = load_program(path)
+    if from_line is not None:
+        # The job's own start is the machine origin unless it moves there itself.
+        program = resume_program(program, from_line)
+        warn(f"resuming {path.name} at line {from_line}: lines before it are skipped; the head first moves "
+             "there with the beam off - check that the workpiece has not moved")
     if baud not in BAUD_RATES:
         raise InputError(f"--baud {baud} is not a serial rate GRBL uses; use one of "
                          f"{', '.join(map(str, BAUD_RATES))} (GRBL 1.1 default: 115200)")
@@ -185,7 +201,10 @@ def run_stream(gcode_path, *, port: str, baud: int = 115200, check: bool = False
             if interactive:
                 console.print("keys: space pause, r resume, +/- feed, </> power, q or Ctrl-C abort")
             with _key_controls(streamer, interactive):
-                result = streamer.stream(program, check=check, on_progress=on_progress)
+                try:
+                    result = streamer.stream(program, check=check, on_progress=on_progress)
+                except StreamError as error:
+                    raise _with_resume_hint(error, program) from None
         for message in result.warnings:
             warn(message)
         if check:
@@ -215,9 +234,12 @@ def run_stream(gcode_path, *, port: str, baud: int = 115200, check: bool = False
 @click.option("--frame", is_flag=True, help="Only trace the job's bounding box with the beam off.")
 @click.option("--profile", type=click.Path(path_type=Path), default=None,
               help="Laser profile TOML to compare with the machine's settings.")
-def stream(gcode: Path, port: str, baud: int, check: bool, frame: bool, profile: Path | None) -> None:
+@click.option("--from-line", type=int, default=None,
+              help="Resume at this file line after a failure (the head moves there with the beam off).")
+def stream(gcode: Path, port: str, baud: int, check: bool, frame: bool, profile: Path | None,
+           from_line: int | None) -> None:
     """Stream GCODE to a GRBL laser over USB serial (pause, resume and abort leave the beam off)."""
-    run_stream(gcode, port=port, baud=baud, check=check, frame=frame, profile=profile)
+    run_stream(gcode, port=port, baud=baud, check=check, frame=frame, profile=profile, from_line=from_line)
 
 
 @click.command("emulator")
