@@ -15,8 +15,11 @@ Kinds (`PLAIN_KINDS` have no touches, `TOUCH_KINDS` have at least one):
 - shallow: plus 1-2 designed crossings at 5-20 degrees;
 - transversal: plus 1-2 designed crossings at 30-90 degrees;
 - spike: plus 1-3 straight out-and-back spikes (Y-junctions);
-- touch, touch-closed: two passes of the line meet tangentially at one point and separate
-  again on their own sides (curvatures of opposite sign, exact tangency);
+- touch, touch-closed, touch-same: two passes of the line meet tangentially at one point and
+  separate again on their own sides (curvatures of opposite sign, exact tangency); in touch
+  and touch-closed the passes run in opposite directions (the line comes back alongside
+  itself: a wrong turn there still gives one stroke, with a loop run backwards), in
+  touch-same in the same direction (a wrong turn splits the line in two);
 - near-touch: the same with the centre lines 0.5-0.95 widths apart: the ink merges
   although the line never meets itself.
 
@@ -45,11 +48,11 @@ from vectorize.stroke import Stroke
 CANVAS = 1000
 MARGIN = 30  # px between the ink and the canvas edge
 PLAIN_KINDS = ("open", "closed", "loops", "shallow", "transversal", "spike")
-TOUCH_KINDS = ("touch", "touch-closed", "touch", "near-touch")
+TOUCH_KINDS = ("touch", "touch-closed", "touch-same", "near-touch")
 ALL_KINDS = tuple(dict.fromkeys(PLAIN_KINDS + TOUCH_KINDS))
 MAX_ATTEMPTS = 600
 # realistic single-line drawings cross themselves: fewer crossings than this are redrawn
-MIN_CROSSINGS = {"open": 2, "closed": 2, "loops": 2, "spike": 1, "touch": 1, "touch-closed": 1,
+MIN_CROSSINGS = {"open": 2, "closed": 2, "loops": 2, "spike": 1, "touch": 1, "touch-closed": 1, "touch-same": 1,
                  "near-touch": 1}
 
 
@@ -192,7 +195,7 @@ def _random_points(rng: np.random.Generator, n: int, box: float, avoid: Sequence
 
 # -- designed features --------------------------------------------------------------------------
 
-def _meeting(rng: np.random.Generator, box: float, kind: str, width: float):
+def _meeting(rng: np.random.Generator, box: float, kind: str, width: float, opposite: bool | None = None):
     """Waypoints around one designed meeting of two passes.
 
     Returns (first_pass, loop, second_pass, event_point, angle): first_pass and
@@ -204,7 +207,7 @@ def _meeting(rng: np.random.Generator, box: float, kind: str, width: float):
     normal = _rot(u1, np.pi / 2)
     a = rng.uniform(0.12, 0.2) * box
     b = rng.uniform(0.12, 0.2) * box
-    reverse = rng.random() < 0.5
+    reverse = rng.random() < 0.5 if opposite is None else opposite
     if kind in ("shallow", "transversal"):
         lo, hi = (5.0, 20.0) if kind == "shallow" else (30.0, 90.0)
         angle = rng.uniform(lo, hi)
@@ -286,13 +289,18 @@ def _build(kind: str, rng: np.random.Generator, width: float, box: float) -> tup
                 pts[k].spike = (direction, length)
         return pts, closed, designed
     meeting_kind = {"shallow": "shallow", "transversal": "transversal", "touch": "touch",
-                    "touch-closed": "touch", "near-touch": "near-touch"}[kind]
+                    "touch-closed": "touch", "touch-same": "touch", "near-touch": "near-touch"}[kind]
+    # touch, touch-closed, near-touch: the line comes back alongside itself (passes in
+    # opposite directions), so the crossing pairing still gives ONE stroke with a loop run
+    # backwards; only the image tells the two apart. touch-same: passes in the same
+    # direction, where the crossing pairing splits the line in two and a retry recovers.
+    opposite = None if meeting_kind not in ("touch", "near-touch") else kind != "touch-same"
     count = int(rng.integers(1, 3)) if kind in ("shallow", "transversal") else 1
     seq: list[_Waypoint] = []
     if not closed:
         seq += _random_points(rng, int(rng.integers(1, 3)), box)
     for _ in range(count):
-        p1, loop, p2, event, angle = _meeting(rng, box, meeting_kind, width)
+        p1, loop, p2, event, angle = _meeting(rng, box, meeting_kind, width, opposite)
         seq += p1 + loop + p2
         designed.append((meeting_kind, event, angle))
         if count > 1:
