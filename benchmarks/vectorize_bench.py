@@ -278,35 +278,43 @@ def print_tables(rows: list[dict]) -> None:
 
 # -- whole process ----------------------------------------------------------------------------
 
-def whole_process(gts: list, timeout: float) -> None:
+def whole_process(gts: list, timeout: float, classifier: str) -> None:
+    """Time `onestroke vectorize IN.png -o OUT.svg` as a subprocess (interpreter start-up,
+    imports, model load, PNG read, SVG write included)."""
+    from PIL import Image
+
+    from vectorize.svg_read import read_svg
+
     exe = shutil.which("onestroke")
     base = [exe] if exe else [sys.executable, "-c", "from fabrication.cli import main; main()"]
-    times = []
+    extra = [] if classifier in ("auto", "both") else ["--classifier", classifier]
+    times, failed = [], 0
     with tempfile.TemporaryDirectory(prefix="onestroke-bench-") as tmp:
         for gt in gts:
-            from PIL import Image
-
             src = Path(tmp) / f"{gt.name}.png"
             out = Path(tmp) / f"{gt.name}.svg"
             Image.fromarray(to_uint8(render(gt.drawing))).save(src)
             start = time.perf_counter()
             try:
-                proc = subprocess.run(base + ["vectorize", str(src), "-o", str(out)], capture_output=True,
+                proc = subprocess.run(base + ["vectorize", str(src), "-o", str(out)] + extra, capture_output=True,
                                       text=True, timeout=timeout)
                 code = proc.returncode
                 msg = (proc.stdout + proc.stderr).strip().splitlines()[-1:] or [""]
             except subprocess.TimeoutExpired:
                 code, msg = "timeout", [""]
             elapsed = time.perf_counter() - start
-            strokes = "-"
-            if out.exists():
-                from vectorize.svg_read import read_svg
-
-                strokes = len(read_svg(str(out)).strokes)
-            times.append(elapsed)
-            print(f"  {gt.name:<28} {elapsed:6.2f} s  exit {code}  strokes {strokes}  {msg[0][:80]}")
-    print(f"whole-process `onestroke vectorize IN.png -o OUT.svg`: median {statistics.median(times):.2f} s, "
-          f"max {max(times):.2f} s over {len(times)} drawings")
+            strokes = len(read_svg(str(out)).strokes) if out.exists() else "-"
+            if code == 0:
+                times.append(elapsed)
+            else:
+                failed += 1
+            print(f"  {gt.name:<28} {elapsed:6.2f} s  exit {code}  strokes {strokes}  {msg[0][-90:]}")
+    cmd = " ".join(["onestroke vectorize IN.png -o OUT.svg"] + extra)
+    if times:
+        print(f"whole-process `{cmd}`: median {statistics.median(times):.2f} s, max {max(times):.2f} s over "
+              f"{len(times)} successful runs; {failed} failed")
+    else:
+        print(f"whole-process `{cmd}`: all {failed} runs failed")
 
 
 # -- main -------------------------------------------------------------------------------------
@@ -355,7 +363,7 @@ def main(argv: list[str] | None = None) -> int:
 
     if args.whole_process is not None:
         picks = [gt for _, gt in TASKS[:: max(1, len(TASKS) // args.whole_process)]][: args.whole_process]
-        whole_process(picks, args.timeout)
+        whole_process(picks, args.timeout, args.classifier)
         return 0
 
     jobs: list[tuple[int, str]] = []
