@@ -81,7 +81,7 @@ def test_job_runs_every_line_once_in_order_without_overflow_near_planner_time(em
 
 def test_send_response_is_slower_on_dense_work(emulator):
     scale = 4.0
-    text = job_text(600, step=0.15, feed=3600)
+    text = job_text(800, step=0.25, feed=3000)  # the benchmark's job, shorter
     times = {}
     for mode in (False, True):
         emu = emulator(time_scale=scale)
@@ -90,7 +90,7 @@ def test_send_response_is_slower_on_dense_work(emulator):
         times[mode] = result.elapsed * scale / emu.stats().planner_limited_time
     print(f"\nratio to planner-limited time: character counting {times[False]:.3f}, "
           f"send-response {times[True]:.3f}")
-    assert times[True] > times[False] * 1.05
+    assert times[True] > times[False] * 1.1
 
 
 def test_pause_and_resume_lose_and_repeat_nothing(emulator):
