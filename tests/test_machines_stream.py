@@ -102,7 +102,8 @@ def test_pause_and_resume_lose_and_repeat_nothing(emulator):
     done = {}
     thread = threading.Thread(target=lambda: done.setdefault("result", streamer.stream(program_from_text(text))))
     thread.start()
-    while len(emu.executed) < 300:
+    deadline = time.monotonic() + 20
+    while len(emu.executed) < 300 and time.monotonic() < deadline:
         time.sleep(0.01)
     streamer.pause()
     assert streamer.wait_status(lambda s: s.full_state == "Hold:0", 3.0) is not None
