@@ -1,0 +1,84 @@
+"""The shipped CNN that tells crossings from touchings, run with onnxruntime only.
+
+All junctions of a drawing go through the network in ONE batched call, each as its 8
+dihedral copies (rotations by 90 degrees and flips are exact symmetries of the question):
+p_crossing is the mean probability over the copies, confidence the share of copies that
+vote with the majority. No randomness is involved, so results are reproducible.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+from collections.abc import Sequence
+from pathlib import Path
+
+import numpy as np
+
+from onestroke.errors import VectorizeError
+from vectorize.intersections import Junction, JunctionVerdict
+from vectorize.junction_crop import CropSpec, crop_junctions, dihedral_copies
+
+DEFAULT_MODEL = Path(__file__).parent / "models" / "crossing_cnn.onnx"
+
+
+class CnnClassifier:
+    """Crossing-vs-touching classifier backed by an ONNX model (default: the shipped one).
+
+    The model's metadata (``<model>.json``: crop geometry, sha256) is read on creation and,
+    unless `check_hash` is False, the file's hash must match it.
+    """
+
+    name = "cnn"
+
+    def __init__(self, model_path: str | os.PathLike | None = None, *, check_hash: bool = True) -> None:
+        self.model_path = Path(model_path) if model_path is not None else DEFAULT_MODEL
+        if not self.model_path.is_file():
+            raise VectorizeError(f"classifier model {str(self.model_path)!r} is missing; "
+                                 "reinstall onestroke or use --classifier geometric")
+        meta_path = self.model_path.with_suffix(".json")
+        self.meta = json.loads(meta_path.read_text()) if meta_path.is_file() else {}
+        self.spec = CropSpec(**self.meta["crop"]) if "crop" in self.meta else CropSpec()
+        if check_hash and self.meta.get("sha256"):
+            digest = hashlib.sha256(self.model_path.read_bytes()).hexdigest()
+            if digest != self.meta["sha256"]:
+                raise VectorizeError(f"classifier model {str(self.model_path)!r} does not match its "
+                                     "metadata (sha256 differs): the file is damaged")
+        self._session = None
+
+    @property
+    def session(self):
+        """The onnxruntime session, created on first use (CPU, deterministic threads)."""
+        if self._session is None:
+            import onnxruntime
+
+            options = onnxruntime.SessionOptions()
+            options.intra_op_num_threads = 1
+            options.inter_op_num_threads = 1
+            self._session = onnxruntime.InferenceSession(str(self.model_path), options,
+                                                         providers=["CPUExecutionProvider"])
+        return self._session
+
+    def predict_crops(self, crops: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """crops (N, 2, S, S) float32 -> (mean p_crossing (N,), vote share (N,)) over 8 copies."""
+        crops = np.asarray(crops, dtype=np.float32)
+        n = len(crops)
+        if n == 0:
+            return np.zeros(0), np.zeros(0)
+        copies = dihedral_copies(crops).reshape(8 * n, *crops.shape[1:])
+        p = self.session.run(["p_crossing"], {"crops": copies})[0].reshape(8, n).astype(np.float64)
+        mean = p.mean(axis=0)
+        votes = (p >= 0.5).mean(axis=0)
+        share = np.where(mean >= 0.5, votes, 1.0 - votes)
+        return mean, np.maximum(share, 0.5)
+
+    def classify(self, gray: np.ndarray, junctions: Sequence[Junction],
+                 stroke_width: float) -> list[JunctionVerdict]:
+        """One verdict per junction; gray (H, W) float32 in [0, 1], 1 = paper."""
+        if not junctions:
+            return []
+        centers = np.array([j.center for j in junctions], dtype=float)
+        crops = crop_junctions(gray, centers, stroke_width, self.spec)
+        mean, share = self.predict_crops(crops)
+        return [JunctionVerdict(p_crossing=float(m), confidence=float(s)) for m, s in zip(mean, share)]
