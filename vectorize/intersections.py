@@ -9,6 +9,7 @@ classifier that follows `IntersectionClassifier` plugs in without touching the t
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Protocol
@@ -131,8 +132,13 @@ class GeometricClassifier:
         return verdicts
 
 
+@functools.lru_cache(maxsize=None)
 def make_classifier(name: str) -> IntersectionClassifier:
-    """The classifier called `name`: "cnn" (shipped ONNX model) or "geometric"."""
+    """The classifier called `name`: "cnn" (shipped ONNX model) or "geometric".
+
+    Cached: loading and hash-checking the model and starting onnxruntime cost more than
+    classifying a drawing, and the classifiers hold no state that a run changes.
+    """
     if name == "geometric":
         return GeometricClassifier()
     if name == "cnn":
