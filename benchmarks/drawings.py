@@ -24,7 +24,8 @@ Kinds (`PLAIN_KINDS` have no touches, `TOUCH_KINDS` have at least one):
   although the line never meets itself.
 
 Every sample is checked and regenerated until it is unambiguous for a human while staying
-hard: no three passes through one spot, no crossing shallower than 5 degrees, no tight bends
+hard: no three passes through one spot, no crossing shallower than 5 degrees, no spike whose base
+also leads straight to a free end (either branch could be the retraced one), no tight bends
 (radius of curvature >= 0.75 width), no place where two passes come within one width of
 each other (ink merges) that is not a designed crossing/touch/near-touch, and the ink-merge
 zone of every such event at least 3 widths away from any other event and from the ends.
@@ -41,7 +42,7 @@ from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components
 from scipy.spatial import cKDTree
 
-from benchmarks.metrics import polyline_intersections
+from benchmarks.metrics import ambiguous_junctions, polyline_intersections
 from vectorize.drawing import Drawing
 from vectorize.stroke import Stroke
 
@@ -344,6 +345,8 @@ def _validate(stroke: Stroke, closed: bool, width: float, designed: list, spikes
     if not _curvature_ok(stroke, spike_segments, 0.75 * w):
         raise Rejected("tight bend")
     poly = stroke.flatten(0.05)
+    if spikes and ambiguous_junctions(poly):
+        raise Rejected("a spike next to a free end: which branch is retraced is ambiguous")
     inter = polyline_intersections([poly], [closed])
     if len(inter.multiple):
         raise Rejected("three passes meet")

@@ -200,6 +200,32 @@ def polyline_intersections(polylines: Sequence[np.ndarray], closed: Sequence[boo
                          as_pts(multiple))
 
 
+def ambiguous_junctions(polyline: np.ndarray) -> int:
+    """Junctions where the drawing order cannot be read from the ink.
+
+    The polyline is noded and merged with shapely into the graph a vectorizer sees (retraced
+    parts collapse into one edge). At a junction of odd degree (a Y: one pass plus a part
+    drawn out and back) the retraced branch is the one ending free; when two or more
+    branches end free there, any of them could have been the retraced one.
+    """
+    merged = shapely.line_merge(shapely.union_all(shapely.LineString(polyline)))
+    parts = shapely.get_parts(merged)
+    if len(parts) == 0:
+        return 0
+    ends = np.array([[p.coords[0], p.coords[-1]] for p in parts]).reshape(-1, 2)
+    _keys, inverse, counts = np.unique(np.round(ends, 4), axis=0, return_inverse=True, return_counts=True)
+    idx = inverse.reshape(-1, 2)
+    free_edges = np.zeros(len(counts), dtype=int)
+    for a, b in idx:
+        if a != b:
+            if counts[b] == 1:
+                free_edges[a] += 1
+            if counts[a] == 1:
+                free_edges[b] += 1
+    odd = (counts >= 3) & (counts % 2 == 1)
+    return int(np.count_nonzero(odd & (free_edges >= 2)))
+
+
 def drawing_polylines(drawing: Drawing, tolerance: float = FLATTEN_TOLERANCE) -> tuple[list[np.ndarray], list[bool]]:
     """Flattened strokes and whether each is closed."""
     polys = [s.flatten(tolerance) for s in drawing.strokes]
