@@ -272,13 +272,12 @@ class GrblStreamer:
         if welcome.version.startswith("0."):
             raise MachineError(f"{self.name} runs GRBL {welcome.version}; onestroke speaks GRBL 1.1 (status "
                                "reports and real-time commands differ): update the firmware to 1.1")
-        options = self._collect("$I")
-        for reply in options:
+        for reply in self._optional("$I"):  # without [OPT:...] the GRBL 1.1 sizes hold
             if isinstance(reply, Message) and reply.kind == "OPT":
                 self.planner_blocks, self.rx_buffer = parse_options(reply.text)
         settings = {r.number: r.value for r in self._collect("$$") if isinstance(r, Setting)}
         offsets = {}
-        for reply in self._collect("$#"):
+        for reply in self._optional("$#"):
             if isinstance(reply, Message) and reply.kind.startswith("G") and reply.kind[1:3].isdigit():
                 try:
                     offsets[reply.kind] = tuple(float(v) for v in reply.text.split(":")[0].split(","))
@@ -294,6 +293,15 @@ class GrblStreamer:
         alarm = self._alarm_locked or (status is not None and status.state == "Alarm")
         return MachineInfo(welcome.version, self.rx_buffer, self.planner_blocks, settings, offsets,
                            tuple(position), alarm)
+
+    def _optional(self, line: str) -> list[Reply]:
+        """Replies to an informational command, or none if this firmware refuses it."""
+        try:
+            return self._collect(line)
+        except MachineError as error:
+            if "refused" not in str(error):
+                raise
+            return []
 
     def _drain_replies(self) -> list[Reply]:
         drained = []

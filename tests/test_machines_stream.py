@@ -126,7 +126,7 @@ def test_pause_and_resume_lose_and_repeat_nothing(emulator):
 
 
 def test_eeprom_writers_go_one_at_a_time_and_lose_nothing(emulator):
-    emu = emulator(time_scale=2.0)
+    emu = emulator(time_scale=5.0)
     lines = job_text(300).splitlines()
     text = "\n".join(["$110=6000", "$111=6000"] + lines[:100] + ["G10L2P1X0Y0", "G28.1"] + lines[100:200]
                      + ["G10L20P1X0Y0"] + lines[200:]) + "\n"
