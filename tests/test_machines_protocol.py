@@ -146,3 +146,20 @@ def test_program_analysis_and_job_check():
     assert any("bed" in p.message and p.fatal for p in check_job(stats, {**ok, 130: 30, 131: 10}))
     with pytest.raises(InputError, match="line 1 has 90 characters"):
         program_from_text("G1X" + "1" * 87)
+
+
+def test_resume_program_restores_state_and_refuses_offset_changes():
+    from machines.resume import resume_program
+
+    program = program_from_text("G21\nG91\nM8\nM4 S700\nG1 X5 Y5 F1200\nG1 X5\n(c)\nG1 Y-2\n")
+    resumed = resume_program(program, 8)
+    # Beam off, go where line 8 starts (machine coordinates), then restore units, relative
+    # mode, feed, air assist, laser mode and power, and the motion mode.
+    assert [text for _, text in resumed.lines] == [
+        "M5", "G21", "G90", "G17", "G53G0X10.000Y5.000", "G21", "G91", "G94", "F1200", "M8", "M4S700", "G1",
+        "G1Y-2"]
+    assert [n for n, _ in resumed.lines if n] == [8]
+    with pytest.raises(InputError, match="--from-line 7"):
+        resume_program(program, 7)  # a comment line
+    with pytest.raises(InputError, match="work offsets"):
+        resume_program(program_from_text("G92X0Y0\nG1X1F100\n"), 2)
