@@ -174,8 +174,13 @@ def _png_input(folder):
 
 @pytest.mark.parametrize("classifier", ["geometric", "cnn"])
 def test_png_end_to_end(classifier, tmp_path, monkeypatch):
-    if classifier == "cnn" and importlib.util.find_spec("vectorize.cnn_classifier") is None:
-        pytest.skip("the CNN crossing classifier is not in the package yet")
+    if classifier == "cnn":
+        if importlib.util.find_spec("vectorize.cnn_classifier") is None:
+            pytest.skip("the CNN crossing classifier is not in the package yet")
+        from vectorize.cnn_classifier import DEFAULT_MODEL
+
+        if not DEFAULT_MODEL.is_file():
+            pytest.skip("the trained crossing model is not shipped yet")
     monkeypatch.chdir(tmp_path)
     png = _png_input(tmp_path)
     result = CliRunner().invoke(main, ["embroider", str(png), "-o", "loop.pes", "--style", "zigzag",
