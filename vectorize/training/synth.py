@@ -7,7 +7,7 @@ junction centre and a stroke-width estimate jittered the way the medial-axis gra
 jitters them. Labels: 1 = crossing, 0 = touching.
 
 Curves are defined by their curvature along arc length (a smooth, decaying profile, so
-that a strongly bent curve turns through at most ~115 degrees instead of spiralling),
+that a strongly bent curve turns through at most ~130 degrees instead of spiralling),
 which covers the cubic Bézier strokes of the paper (Fig. 6) and the gentler arcs of real
 drawings.
 
@@ -56,9 +56,9 @@ def _curve(rng: np.random.Generator, origin: np.ndarray, heading: float, kappa0:
     length = 30.0 * w
     s = np.arange(-length, length + step, step)
     ell = rng.uniform(8.0, 40.0) * w
-    # Cap the total turning per side (|kappa0| l sqrt(pi) / 2) at ~115 degrees.
+    # Cap the total turning per side (|kappa0| l sqrt(pi) / 2) at ~130 degrees.
     if abs(kappa0) > 1e-9:
-        ell = min(ell, 2.0 / (abs(kappa0) * np.sqrt(np.pi) / 2.0))
+        ell = min(ell, 2.3 / (abs(kappa0) * np.sqrt(np.pi) / 2.0))
     kappa1 = rng.uniform(-0.3, 0.3) * abs(kappa0)
     kappa = (kappa0 + kappa1 * s / ell) * np.exp(-((s / ell) ** 2))
     i0 = len(s) // 2
