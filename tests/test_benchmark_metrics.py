@@ -229,3 +229,18 @@ def test_hershey_glyph_ground_truth():
     stroke, poly, _closed = glyph_stroke(Glyph("t", "t", "t", "M 0 0 L 0 100 L 50 100"))
     assert poly[1, 1] < poly[0, 1]
     assert evaluate(gt, gt.drawing).correct
+
+
+def test_one_command_runs_and_prints_the_table(tmp_path, capsys):
+    from benchmarks import vectorize_bench
+
+    csv_path = tmp_path / "rows.csv"
+    vectorize_bench.TASKS.clear()
+    assert vectorize_bench.main(["--ground-truth-as-output", "--set", "plain", "--count", "2", "--classifier", "geometric",
+                                 "--csv", str(csv_path)]) == 0
+    out = capsys.readouterr().out
+    assert "correct %" in out and "peak MB" in out
+    row = next(line for line in out.splitlines() if line.startswith("plain "))
+    assert "100.0" in row
+    assert len(csv_path.read_text().splitlines()) == 3
+    vectorize_bench.TASKS.clear()
