@@ -75,7 +75,7 @@ def train(*, seed: int, samples: int, epochs: int, batch: int, lr: float, worker
             loss.backward()
             optimizer.step()
             schedule.step()
-            loss_sum += float(loss) * len(idx)
+            loss_sum += float(loss.detach()) * len(idx)
             correct += int(((logits > 0).float() == yb).sum())
             total += len(idx)
         log(f"epoch {epoch + 1}/{epochs}: loss {loss_sum / total:.4f}, train accuracy {correct / total:.4f}, "
