@@ -11,6 +11,7 @@ from __future__ import annotations
 import hashlib
 import json
 import os
+import threading
 from collections.abc import Sequence
 from pathlib import Path
 
@@ -21,6 +22,11 @@ from vectorize.intersections import Junction, JunctionVerdict
 from vectorize.junction_crop import CropSpec, crop_junctions, dihedral_copies
 
 DEFAULT_MODEL = Path(__file__).parent / "models" / "crossing_cnn.onnx"
+
+# One onnxruntime session per model file and process: the pipeline makes a classifier per
+# vectorize call, and building a session costs more than classifying a whole drawing.
+_SESSIONS: dict[tuple[str, str], object] = {}
+_SESSIONS_LOCK = threading.Lock()
 
 
 class CnnClassifier:
@@ -51,13 +57,19 @@ class CnnClassifier:
     def session(self):
         """The onnxruntime session, created on first use (CPU, deterministic threads)."""
         if self._session is None:
-            import onnxruntime
+            key = (str(self.model_path.resolve()), self.meta.get("sha256", ""))
+            with _SESSIONS_LOCK:
+                if key not in _SESSIONS:
+                    import onnxruntime
 
-            options = onnxruntime.SessionOptions()
-            options.intra_op_num_threads = 1
-            options.inter_op_num_threads = 1
-            self._session = onnxruntime.InferenceSession(str(self.model_path), options,
-                                                         providers=["CPUExecutionProvider"])
+                    options = onnxruntime.SessionOptions()
+                    # One thread: the same float sums in the same order on every run, and
+                    # a batch of a few dozen crops gains little from more.
+                    options.intra_op_num_threads = 1
+                    options.inter_op_num_threads = 1
+                    _SESSIONS[key] = onnxruntime.InferenceSession(
+                        str(self.model_path), options, providers=["CPUExecutionProvider"])
+                self._session = _SESSIONS[key]
         return self._session
 
     def predict_crops(self, crops: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
