@@ -100,6 +100,17 @@ def main() -> None:
             lines = gcode_lines(tp, PROFILE, GcodeOptions(feed=float(feed)))
             row(f"vectorized trefoil ({how}) {size} mm, {'arcs' if arcs else 'lines'}, F{feed}", lines)
 
+    from vectorize import VectorizeOptions, vectorize_file
+
+    for png in sorted((ROOT / "examples").glob("*.png")):
+        try:
+            example = vectorize_file(png, VectorizeOptions()).drawing
+        except Exception as error:  # report and go on: the vectorizer is not under test here
+            print(f"{png.name}: not vectorized ({error})")
+            continue
+        tp = plan_toolpath(example, PROFILE, ToolpathOptions(placement=PlacementOptions(size=60)))
+        row(f"examples/{png.name} 60 mm, F3000", gcode_lines(tp, PROFILE, GcodeOptions(feed=3000.0)))
+
     print()
     print("Fig. 14 comparison (same machine model):")
     for size, feed, raster_feed, interval in ((60, 1500, 1500, 0.1), (60, 3000, 3000, 0.1),

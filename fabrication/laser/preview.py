@@ -97,7 +97,7 @@ def _scene(moves: GcodeMoves, job: JobTime, profile: LaserProfile, name: str) ->
     else:
         bounds = (0.0, 0.0, profile.bed_width, profile.bed_height)
     burn_len, travel_len = job.burn_length, job.travel_length
-    text = [name[:38],
+    text = [name if len(name) <= 34 else name[:31] + "...",
             f"time (GRBL planner): {format_duration(job.total_seconds)}",
             f"length / feed: {format_duration(job.naive_seconds)} (common senders)",
             f"burn {burn_len:.0f} mm, travel {travel_len:.0f} mm",
