@@ -75,6 +75,8 @@ BAD = [
     (["--size", "-3mm"], "--size"),
     (["--tolerance", "0.001mm"], "tolerance"),
     (["--profile", "/nonexistent/p.toml"], "does not exist"),
+    (["--raster-interval", "0.001mm"], "raster interval"),
+    (["--raster-feed", "0"], "--raster-feed"),
 ]
 
 

@@ -127,10 +127,12 @@ def laser(source: str, output: str, size: str | None, width: str | None, height:
         f"profile: {profile.name}",
     )
     lines = [comment_line(c) for c in comments] + lines
+    frame_lines = framing_lines(toolpath.bounds, profile, power=frame_fraction) if frame_file else None
+    # everything that can refuse the input runs before the first file is written
+    raster = raster_time(toolpath, profile, interval=interval, feed=raster_feed_mm)
     write_gcode(output, lines)
     if frame_file:
-        write_gcode(frame_file, framing_lines(toolpath.bounds, profile, power=frame_fraction))
-    raster = raster_time(toolpath, profile, interval=interval, feed=raster_feed_mm)
+        write_gcode(frame_file, frame_lines)
     if preview_path is not None:
         from fabrication.laser.preview import render_gcode_preview
 
