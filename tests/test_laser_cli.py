@@ -103,9 +103,16 @@ def test_bad_inputs_and_outputs(svg, tmp_path):
         ([svg, "-o", tmp_path / "a.png"], ".gcode"),
         ([svg, "-o", tmp_path / "a.gcode", "--preview", tmp_path / "p.jpg"], "preview"),
         ([svg, "-o", tmp_path / "a.gcode", "--profile", broken_profile], "acceleration"),
+        ([svg, "-o", tmp_path / "a.gcode", "--preview", tmp_path / "a.gcode.svg", "--frame"], None),
+        ([svg, "-o", tmp_path / "b.gcode", "--preview", svg], "must all differ"),
     ]
     for args, message in cases:
         result = run(*args)
+        if message is None:  # a valid run in the middle of the table: clean up after it
+            assert result.exit_code == 0, result.output
+            for made in ("a.gcode", "a.gcode.svg", "a.frame.gcode"):
+                (tmp_path / made).unlink()
+            continue
         assert result.exit_code == 2, (args, result.output)
         assert message in result.stderr, (args, result.stderr)
         assert len(result.stderr.strip().splitlines()) == 1

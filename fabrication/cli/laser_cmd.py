@@ -83,6 +83,10 @@ def laser(source: str, output: str, size: str | None, width: str | None, height:
     frame_file = frame_path_for(output) if frame else None
     if frame_file:
         check_writable(frame_file)
+    outputs = [Path(p).resolve() for p in (output, preview_path, frame_file, source) if p is not None]
+    if len(set(outputs)) < len(outputs):
+        twice = next(str(p) for p in outputs if outputs.count(p) > 1)
+        raise InputError(f"input, output, preview and frame files must all differ ({twice!r} is given twice)")
     feed_mm = parse_speed(feed, what="--feed")
     if not feed_mm > 0:
         raise InputError(f"--feed {feed!r} must be greater than 0 mm/min")
