@@ -191,3 +191,25 @@ def test_png_end_to_end(classifier, tmp_path, monkeypatch):
     assert len([k for k in plan.kinds if k != STITCH]) <= 2  # one curve: no trims in between
     with Image.open(tmp_path / "loop_preview.png") as image:
         assert image.size == (1000, 1000)
+
+
+def test_bundled_example_png_end_to_end(tmp_path, monkeypatch):
+    from pathlib import Path
+
+    example = Path(__file__).parents[1] / "examples" / "hershey-HersheySans1-ampersand.png"
+    if not example.is_file():
+        pytest.skip("examples/ has no ampersand drawing")
+    from vectorize.cnn_classifier import DEFAULT_MODEL
+
+    if not DEFAULT_MODEL.is_file():
+        pytest.skip("the trained crossing model is not shipped yet")
+    monkeypatch.chdir(tmp_path)
+    result = CliRunner().invoke(main, ["embroider", str(example), "-o", "amp.dst", "--style", "arrows",
+                                       "--preview", "amp.png"])
+    assert result.exit_code == 0, result.output
+    plan = read_embroidery(tmp_path / "amp.dst").plan
+    first = int(np.argmax(plan.kinds == STITCH))
+    assert (plan.kinds[first:] == STITCH).all()  # one curve: sewn without a single jump or trim
+    assert (plan.kinds == STITCH).sum() > 300
+    with Image.open(tmp_path / "amp.png") as image:
+        assert image.size == (1000, 1000)
