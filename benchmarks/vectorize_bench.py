@@ -319,6 +319,13 @@ def whole_process(gts: list, timeout: float, classifier: str) -> None:
 
 # -- main -------------------------------------------------------------------------------------
 
+def _load() -> str:
+    try:
+        return " ".join(f"{x:.1f}" for x in os.getloadavg())
+    except OSError:
+        return "?"
+
+
 def _git_commit() -> str:
     try:
         return subprocess.run(["git", "-C", str(ROOT), "rev-parse", "--short", "HEAD"], capture_output=True,
@@ -359,7 +366,8 @@ def main(argv: list[str] | None = None) -> int:
 
     print(f"onestroke vectorizer benchmark  {time.strftime('%Y-%m-%d %H:%M:%S %Z')}  commit {_git_commit()}  "
           f"python {platform.python_version()}  {os.cpu_count()} CPUs")
-    print(f"sets {', '.join(sets)}; seed {args.seed}; {len(TASKS)} drawings made in {t_gen:.1f} s")
+    print(f"sets {', '.join(sets)}; seed {args.seed}; {len(TASKS)} drawings made in {t_gen:.1f} s; "
+          f"load average {_load()} (timings are inflated when it exceeds the {os.cpu_count()} CPUs)")
 
     if args.whole_process is not None:
         picks = [gt for _, gt in TASKS[:: max(1, len(TASKS) // args.whole_process)]][: args.whole_process]
@@ -424,7 +432,7 @@ def main(argv: list[str] | None = None) -> int:
             writer.writeheader()
             writer.writerows(rows)
         print(f"per-drawing rows: {args.csv}")
-    print(f"\ntotal benchmark time {time.perf_counter() - t_start:.0f} s")
+    print(f"\ntotal benchmark time {time.perf_counter() - t_start:.0f} s; load average now {_load()}")
     return 0
 
 
