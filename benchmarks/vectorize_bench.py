@@ -247,6 +247,42 @@ def _fmt_header() -> str:
     return "  ".join(head.ljust(width) if not fmt else head.rjust(width) for _k, head, width, fmt in COLUMNS)
 
 
+# the issue's acceptance numbers: (label, key, comparison, target)
+ACCEPTANCE = [
+    ("one stroke in correct order %", "correct", ">=", 90.0), ("mean stroke count", "strokes", "<=", 1.15),
+    ("SSIM", "ssim", ">=", 0.985), ("PSNR dB", "psnr", ">=", 28.0), ("length ratio %", "length", "<=", 1.5),
+    ("undetected %", "undetected", "<=", 10.0), ("hallucinated %", "hallucinated", "<=", 10.0),
+    ("median s", "median_s", "<=", 1.5), ("peak MB", "peak_mb", "<=", 600.0),
+]
+
+
+def _print_acceptance(rows: list[dict]) -> None:
+    """The measured numbers next to the issue's targets (only for the rows that were run)."""
+    main = [r for r in rows if r["set"] in ("plain", "hershey") and r["classifier"] == "cnn"]
+    lines = []
+    if {r["set"] for r in main} == {"plain", "hershey"}:
+        s = _summary(main)
+        for label, key, op, target in ACCEPTANCE:
+            v = s[key]
+            ok = (v >= target) if op == ">=" else (v <= target)
+            lines.append(f"  plain+hershey, cnn: {label:<30} {v:9.3f}  target {op} {target:g}  "
+                         f"{'met' if ok and not math.isnan(v) else 'NOT MET'}")
+    touch = {c: _summary([r for r in rows if r["set"] == "touch" and r["classifier"] == c])
+             for c in ("cnn", "geometric") if any(r["set"] == "touch" and r["classifier"] == c for r in rows)}
+    if "cnn" in touch:
+        v = touch["cnn"]["correct"]
+        lines.append(f"  touch, cnn: one stroke in correct order %     {v:9.1f}  target >= 85  "
+                     f"{'met' if v >= 85 else 'NOT MET'}")
+    if len(touch) == 2:
+        gap = touch["cnn"]["correct"] - touch["geometric"]["correct"]
+        lines.append(f"  touch: cnn minus geometric (points)           {gap:9.1f}  target: clearly > 0  "
+                     f"{'met' if gap >= 10 else 'NOT MET (less than 10 points)'}")
+    if lines:
+        print()
+        print("acceptance (issue targets; time and memory as measured here):")
+        print("\n".join(lines))
+
+
 def print_tables(rows: list[dict]) -> None:
     groups: dict = {}
     for r in rows:
@@ -258,6 +294,7 @@ def print_tables(rows: list[dict]) -> None:
         main = [r for r in rows if r["set"] in ("plain", "hershey") and r["classifier"] == "cnn"]
         if main:
             print(_fmt_row({"set": "plain+h", "classifier": "cnn", **_summary(main)}))
+    _print_acceptance(rows)
     print()
     print("by drawing kind:")
     print(f"{'set':<8}  {'classifier':<10}  {'kind':<17}  {'n':>3}  {'fail':>4}  {'correct %':>9}  "
