@@ -41,7 +41,7 @@ def test_circle_is_one_closed_stroke():
     stroke = result.drawing.strokes[0]
     assert stroke.is_closed
     assert stroke.length == pytest.approx(2 * np.pi * 120, rel=0.01)
-    assert _distance_to(stroke.sample_evenly(2.0), truth).max() < 0.75
+    assert _distance_to(stroke.sample_evenly(2.0), truth).max() < 1.0
     assert result.drawing.stroke_width == pytest.approx(6.0, abs=1.2)
 
 
@@ -53,7 +53,8 @@ def test_figure_eight_goes_straight_through_its_crossing(classifier):
     assert result.report.intersections == 1
     stroke = result.drawing.strokes[0]
     assert stroke.is_closed
-    assert _distance_to(stroke.sample_evenly(2.0), truth).max() < 1.0
+    # Within a fifth of the stroke width everywhere, the crossing included.
+    assert _distance_to(stroke.sample_evenly(2.0), truth).max() < 1.2
     # Straight through: no sharp turn anywhere, the crossing included.
     assert _max_turn_degrees(stroke) < 20.0
 

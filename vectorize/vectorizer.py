@@ -144,7 +144,9 @@ def run_pipeline(image: np.ndarray, options: VectorizeOptions, *,
     ordering, tried = order_strokes(graph, simple, ranked, costs, stroke_width=w, search=not options.multi)
     clock.lap("traversal")
 
-    sigma = float(np.clip(0.04 * w, 0.1, 0.4))
+    # Smoothing allowance: the medial axis wobbles by ~0.07 px per px of stroke width (pixel
+    # grid, anti-aliasing); fitting tighter follows that wobble, looser cuts corners.
+    sigma = float(np.clip(0.065 * w, 0.15, 0.8))
     strokes = []
     for traced, closed in _trace(graph, simple, ordering, junctions, verdicts, w):
         if len(traced) < 2:
