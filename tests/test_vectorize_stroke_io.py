@@ -100,3 +100,12 @@ def test_closed_path_survives_round_trip(tmp_path):
     parsed = read_svg(path).strokes[0]
     assert parsed.is_closed
     assert cKDTree(ring.sample_evenly(1)).query(parsed.sample_evenly(1))[0].max() < 1e-2
+
+
+def test_bounds_are_exact():
+    stroke = wavy()
+    dense = stroke.points_at(np.linspace(0, 1, 400_001))
+    expected = (*dense.min(axis=0), *dense.max(axis=0))
+    assert np.allclose(stroke.bounds(), expected, atol=1e-6)
+    line = Stroke.from_polyline(np.array([[0.0, 5.0], [10.0, 5.0]]))
+    assert np.allclose(line.bounds(), (0, 5, 10, 5))

@@ -89,9 +89,30 @@ class Stroke:
         return float(self._table[1][-1])
 
     def bounds(self) -> tuple[float, float, float, float]:
-        """(xmin, ymin, xmax, ymax) of the curve itself (not of its control polygon)."""
-        pts = self.points_at(self._table[0])
-        return (*pts.min(axis=0), *pts.max(axis=0))
+        """(xmin, ymin, xmax, ymax) of the curve itself (not of its control polygon).
+
+        Exact: the end points of every segment and its interior extremes, where the
+        derivative (a quadratic per axis) vanishes.
+        """
+        p0, p1, p2, p3 = (self.control[:, i] for i in range(4))
+        a = -p0 + 3 * p1 - 3 * p2 + p3  # B'(t) / 3 = a t^2 + 2 b t + c, per segment and axis
+        b = p0 - 2 * p1 + p2
+        c = p1 - p0
+        disc = b * b - a * c
+        root = np.sqrt(np.maximum(disc, 0.0))
+        with np.errstate(divide="ignore", invalid="ignore"):
+            linear = np.abs(a) < 1e-12
+            t = np.stack([np.where(linear, -c / (2 * b), (-b + root) / a),
+                          np.where(linear, np.nan, (-b - root) / a)], axis=-1)
+        inside = (t > 0) & (t < 1) & (disc[..., None] >= 0)
+        t = np.where(inside, t, 0.0)
+        u = 1 - t
+        values = (u**3 * p0[..., None] + 3 * u * u * t * p1[..., None]
+                  + 3 * u * t * t * p2[..., None] + t**3 * p3[..., None])
+        values = np.where(inside, values, p0[..., None])
+        lo = np.minimum(np.minimum(p0, p3).min(axis=0), values.min(axis=(0, 2)))
+        hi = np.maximum(np.maximum(p0, p3).max(axis=0), values.max(axis=(0, 2)))
+        return float(lo[0]), float(lo[1]), float(hi[0]), float(hi[1])
 
     # -- evaluation --------------------------------------------------------------------
     def _split_parameter(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
