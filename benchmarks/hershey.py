@@ -4,8 +4,9 @@ Each `<glyph d="...">` of ../shared/data/hershey/*.svg drawn with ONE move-to is
 single-line drawing (font units, y up). We flip y, scale it to fit the 1000 px canvas with a
 margin, give it a seeded width of 3-8 px, and derive its ground truth from its exact
 polyline: crossings (intersections), touches (a pass meeting another without crossing; not
-intersections), retraces (a part drawn out and back over itself, i.e. a spike) and sharp
-narrow turns (ink of the two legs merges; like a spike, no intersection there).
+intersections), retraces (a part drawn out and back over itself, i.e. a spike), sharp
+narrow turns and near-retraces (two passes within one width with no crossing between them:
+their ink merges; like a spike, no intersection there).
 
 Glyphs whose drawing order cannot be read from the ink are left out: a junction where two
 or more branches end free, one of which was drawn out and back (a T or Y letter: any of
@@ -27,7 +28,7 @@ import shapely
 import svgelements
 
 from benchmarks.drawings import CANVAS, Event, GroundTruth
-from benchmarks.metrics import ambiguous_junctions, polyline_intersections
+from benchmarks.metrics import ambiguous_junctions, merged_without_crossing, polyline_intersections
 from vectorize.drawing import Drawing
 from vectorize.stroke import Stroke
 
@@ -168,6 +169,7 @@ def glyph_ground_truth(glyph: Glyph, width: float) -> GroundTruth | None:
                 return None
     dont_care = [shapely.Point(*p).buffer(2 * width) for p in inter.touches] + list(inter.retraces)
     dont_care += _sharp_turns(poly, closed, width)
+    dont_care += merged_without_crossing(stroke, closed, width, inter.crossings)
     if len(inter.crossings) and dont_care:
         from benchmarks.metrics import MATCH_DISTANCE, dont_care_mask
 

@@ -226,6 +226,43 @@ def ambiguous_junctions(polyline: np.ndarray) -> int:
     return int(np.count_nonzero(odd & (free_edges >= 2)))
 
 
+def merged_without_crossing(stroke: Stroke, closed: bool, width: float, crossings: np.ndarray) -> list:
+    """Places where two passes of `stroke` run within one width of each other (their ink
+    merges) and that hold no crossing: near-retraces, narrow wedges, a pass grazing another.
+
+    Returns shapely MultiPoints of the centre-line samples involved (sampled every width/4;
+    passes count as different when more than 3 widths apart along the line).
+    """
+    w = float(width)
+    spacing = w / 4
+    s = np.linspace(0, stroke.length, max(2, int(np.ceil(stroke.length / spacing))) + 1)
+    if closed:
+        s = s[:-1]
+    pts = stroke.points_at_lengths(s)
+    pairs = cKDTree(pts).query_pairs(w, output_type="ndarray")
+    if len(pairs) == 0:
+        return []
+    sep = np.abs(s[pairs[:, 0]] - s[pairs[:, 1]])
+    if closed:
+        sep = np.minimum(sep, stroke.length - sep)
+    pairs = pairs[sep > 3 * w]
+    if len(pairs) == 0:
+        return []
+    idx = np.unique(pairs)
+    cp = pts[idx]
+    near = cKDTree(cp).query_pairs(2.0 * spacing, output_type="ndarray")
+    graph = coo_matrix((np.ones(len(near)), (near[:, 0], near[:, 1])), shape=(len(cp), len(cp)))
+    ncl, label = connected_components(graph, directed=False)
+    crossings = np.asarray(crossings, dtype=float).reshape(-1, 2)
+    zones = []
+    for c in range(ncl):
+        cluster = cp[label == c]
+        if len(crossings) and np.min(np.linalg.norm(cluster[:, None] - crossings[None], axis=2)) <= w:
+            continue
+        zones.append(shapely.MultiPoint(cluster))
+    return zones
+
+
 def drawing_polylines(drawing: Drawing, tolerance: float = FLATTEN_TOLERANCE) -> tuple[list[np.ndarray], list[bool]]:
     """Flattened strokes and whether each is closed."""
     polys = [s.flatten(tolerance) for s in drawing.strokes]
