@@ -354,6 +354,51 @@ def whole_process(gts: list, timeout: float, classifier: str) -> None:
         print(f"whole-process `{cmd}`: all {failed} runs failed")
 
 
+# -- classifier at ground-truth junctions ------------------------------------------------------
+
+def _pass_lengths(stroke, point: np.ndarray, gap: float) -> tuple[float, float]:
+    """Arc lengths of the two passes of `stroke` nearest to `point`."""
+    s = np.linspace(0.0, stroke.length, max(2, int(stroke.length * 2)))
+    d = np.linalg.norm(stroke.points_at_lengths(s) - point, axis=1)
+    first = s[np.argmin(d)]
+    second = s[np.argmin(np.where(np.abs(s - first) > gap, d, np.inf))]
+    return float(first), float(second)
+
+
+def junction_check(classifiers: list[str]) -> None:
+    """Each classifier on crops centred at the ground-truth crossings, touches and
+    near-touches of the generated sets, with branch directions measured on the ground truth
+    3 widths out: how well it does when the pipeline's junction is exactly right."""
+    from vectorize.intersections import Junction, make_classifier
+
+    labels = {}
+    for name, gt in TASKS:
+        if name == "hershey":
+            continue
+        gray = render(gt.drawing).astype(np.float32)
+        junctions, kinds = [], []
+        for e in gt.events:
+            if e.kind not in ("crossing", "touch", "near-touch"):
+                continue
+            s1, s2 = _pass_lengths(gt.stroke, e.point, 6 * gt.width)
+            out = 3 * gt.width
+            ends = gt.stroke.points_at_lengths(np.array([s1 - out, s1 + out, s2 - out, s2 + out]))
+            dirs = ends - e.point
+            dirs /= np.linalg.norm(dirs, axis=1, keepdims=True)
+            junctions.append(Junction(center=np.asarray(e.point, dtype=float), directions=dirs, width=gt.width))
+            kinds.append(e.kind if e.kind != "crossing" else ("crossing <20 deg" if e.angle < 20 else
+                                                                "crossing >=20 deg"))
+        for c in classifiers:
+            verdicts = make_classifier(c).classify(gray, junctions, gt.width)
+            for kind, v in zip(kinds, verdicts):
+                ok = v.is_crossing == kind.startswith("crossing")
+                labels.setdefault((c, kind), []).append(ok)
+    print("classifier verdicts at ground-truth junctions (crop centred on the true point, branch "
+          "directions 3 widths out on the true curve):")
+    for (c, kind), oks in sorted(labels.items()):
+        print(f"  {c:<10} {kind:<18} {sum(oks):>4}/{len(oks):<4} correct  {100.0 * sum(oks) / len(oks):5.1f} %")
+
+
 # -- main -------------------------------------------------------------------------------------
 
 def _load() -> str:
@@ -386,6 +431,8 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--timeout", type=float, default=120.0, help="seconds per drawing before it counts as failed")
     ap.add_argument("--whole-process", type=int, nargs="?", const=5, default=None, metavar="N",
                     help="instead: time `onestroke vectorize` as a subprocess on N drawings (default 5)")
+    ap.add_argument("--junction-check", action="store_true",
+                    help="instead: the classifiers on crops at the ground-truth crossings and touches")
     ap.add_argument("--ground-truth-as-output", action="store_true",
                     help="score the ground truth against itself (checks the machinery; no vectorizer)")
     args = ap.parse_args(argv)
@@ -409,6 +456,10 @@ def main(argv: list[str] | None = None) -> int:
     if args.whole_process is not None:
         picks = [gt for _, gt in TASKS[:: max(1, len(TASKS) // args.whole_process)]][: args.whole_process]
         whole_process(picks, args.timeout, args.classifier)
+        return 0
+
+    if args.junction_check:
+        junction_check(["cnn", "geometric"] if args.classifier in ("auto", "both") else [args.classifier])
         return 0
 
     jobs: list[tuple[int, str]] = []
