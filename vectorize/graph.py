@@ -54,12 +54,15 @@ class Branch:
 @dataclass
 class MedialGraph:
     """Nodes (positions, radii) and branches; `incident[n]` lists the branch ids at node n
-    (a loop branch from n to n is listed twice)."""
+    (a loop branch from n to n is listed twice). `spans[n]`: for a node merged from two
+    junctions, half the length of the branch that joined them (its ink is shared by both
+    strokes, so their directions only show beyond it)."""
 
     positions: dict[int, np.ndarray] = field(default_factory=dict)
     radii: dict[int, float] = field(default_factory=dict)
     branches: dict[int, Branch] = field(default_factory=dict)
     incident: dict[int, list[int]] = field(default_factory=dict)
+    spans: dict[int, float] = field(default_factory=dict)
     _next_node: int = 0
     _next_branch: int = 0
 
@@ -116,5 +119,6 @@ class MedialGraph:
     def copy(self) -> "MedialGraph":
         graph = MedialGraph(dict(self.positions), dict(self.radii),
                             {k: Branch(b.a, b.b, b.points, b.radii, b.sins) for k, b in self.branches.items()},
-                            {k: list(v) for k, v in self.incident.items()}, self._next_node, self._next_branch)
+                            {k: list(v) for k, v in self.incident.items()}, dict(self.spans),
+                            self._next_node, self._next_branch)
         return graph

@@ -52,8 +52,21 @@ def slot_direction(graph: MedialGraph, slot: Slot, reach: float) -> np.ndarray:
 
 
 def directions(graph: MedialGraph, node: int, reach: float) -> np.ndarray:
-    """(D, 2) unit tangents of all slots at `node`, in `slots` order."""
-    return np.array([slot_direction(graph, s, reach) for s in slots(graph, node)])
+    """(D, 2) unit tangents of all slots at `node`, in `slots` order.
+
+    Measured `reach` px beyond the ink the node's strokes share (a merged crossing's or
+    touch's joining branch), and further while two branches still leave together: at a
+    shallow crossing or a long tangential contact they separate only slowly.
+    """
+    node_slots = slots(graph, node)
+    reach += graph.spans.get(node, 0.0)
+    for factor in (1.0, 1.6, 2.4, 3.6):
+        dirs = np.array([slot_direction(graph, s, reach * factor) for s in node_slots])
+        cos = dirs @ dirs.T
+        np.fill_diagonal(cos, -1.0)
+        if len(dirs) < 2 or cos.max() < np.cos(np.radians(8.0)):
+            break
+    return dirs
 
 
 def foot_slot(dirs: np.ndarray) -> int:
@@ -95,6 +108,7 @@ def _merge(graph: MedialGraph, a: int, b: int, bid: int) -> int:
     mid = int(np.searchsorted(arc, arc[-1] / 2.0))
     mid = min(max(mid, 0), len(arc) - 1)
     node = graph.add_node(join.points[mid], float(join.radii.max()))
+    graph.spans[node] = float(arc[-1] / 2.0)
     # Each remaining branch keeps its geometry: it now starts at the middle node and runs
     # along the half of the joining branch that leads to its old junction.
     for old, half_points, half_radii, half_sins in (
@@ -118,8 +132,12 @@ def _merge(graph: MedialGraph, a: int, b: int, bid: int) -> int:
     return node
 
 
-def simplify(graph: MedialGraph, *, stroke_width: float, multi: bool) -> Simplified:
-    """Merge crossing halves into degree-4 nodes in place and classify the other nodes."""
+def simplify(graph: MedialGraph, *, stroke_width: float, multi: bool, ends: int = 2) -> Simplified:
+    """Merge crossing halves into degree-4 nodes in place and classify the other nodes.
+
+    ends: free ends the single line is taken to have (2 open, 0 closed); free ends beyond
+    those may be read as spikes drawn out and back.
+    """
     reach = 2.5 * stroke_width
     merged = 0
 
@@ -143,15 +161,20 @@ def simplify(graph: MedialGraph, *, stroke_width: float, multi: bool) -> Simplif
         return stub[0] if stub is not None and stub[1] > np.cos(np.radians(55.0)) else None
 
     # T-shaped spikes are only plausible while the drawing has more free ends than the
-    # two a single line can have: take the straightest T's first, until two ends remain.
+    # line can have (`ends`): take the straightest T's first, until that many remain.
     t_spikes: set[int] = set()
     if not multi:
         t_spikes = set(graph.incident)  # let spike_slot test the T shape of every node
         leaves = len(graph.nodes_of_degree(1))
         v_spikes = [n for n in graph.nodes_of_degree(3) if _v_spike(graph, n, reach)]
+        def crossing_half(node: int) -> bool:
+            # Another junction within a stroke width: two halves of one crossing.
+            return any(graph.branches[bid].length < stroke_width and graph.degree(graph.branches[bid].other(node)) == 3
+                       for bid in graph.incident[node] if graph.branches[bid].other(node) != node)
+
         shaped = sorted(((_t_stub(graph, n, reach, stroke_width)[1], n) for n in graph.nodes_of_degree(3)
-                         if n not in v_spikes and spike_slot(n) is not None), reverse=True)
-        room = max(0, leaves - len(v_spikes) - 2)
+                         if n not in v_spikes and not crossing_half(n) and spike_slot(n) is not None), reverse=True)
+        room = max(0, leaves - len(v_spikes) - ends)
         t_spikes = {n for _, n in shaped[:room]}
 
     def candidates() -> list[int]:

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import time
+from typing import NamedTuple
 
 import numpy as np
 
@@ -109,6 +110,32 @@ def _orient(stroke: Stroke, closed: bool) -> Stroke:
     return stroke
 
 
+class _Solution(NamedTuple):
+    graph: MedialGraph
+    simple: Simplified
+    junctions: dict
+    verdicts: dict
+    ordering: Ordering
+    tried: int
+
+
+def _order(graph: MedialGraph, ink, options: VectorizeOptions, ends: int, clock: _Clock) -> _Solution:
+    """Simplify (in place), classify the crossings and traverse, for one count of free ends."""
+    w = ink.stroke_width
+    simple = simplify(graph, stroke_width=w, multi=options.multi, ends=ends)
+    clock.lap("simplification")
+    junction_list = _junctions(graph, simple.crossings, w)
+    junctions = dict(zip(simple.crossings, junction_list))
+    verdict_list = make_classifier(options.classifier).classify(ink.gray, junction_list, w) if junction_list else []
+    verdicts = dict(zip(simple.crossings, verdict_list))
+    clock.lap("classification")
+    ranked = {n: ranked_pairings(junctions[n], verdicts[n]) for n in simple.crossings}
+    costs = {n: _pairing_costs(verdicts[n]) for n in simple.crossings}
+    ordering, tried = order_strokes(graph, simple, ranked, costs, stroke_width=w, search=not options.multi)
+    clock.lap("traversal")
+    return _Solution(graph, simple, junctions, verdicts, ordering, tried)
+
+
 def run_pipeline(image: np.ndarray, options: VectorizeOptions, *,
                  frame: InputFrame | None = None) -> VectorizeResult:
     """Vectorize `image`; the drawing comes out in `frame` (default: the image's pixels)."""
@@ -126,23 +153,17 @@ def run_pipeline(image: np.ndarray, options: VectorizeOptions, *,
     trim_free_ends(graph, stroke_width=w)
     clock.lap("pruning")
     stages = {"ink": ink, "rings": rings, "pruned": graph.copy()} if options.keep_stages else None
-    simple = simplify(graph, stroke_width=w, multi=options.multi)
-    clock.lap("simplification")
-
-    junction_list = _junctions(graph, simple.crossings, w)
-    junctions = dict(zip(simple.crossings, junction_list))
-    if junction_list:
-        classifier = make_classifier(options.classifier)
-        verdict_list = classifier.classify(ink.gray, junction_list, w)
-    else:
-        verdict_list = []
-    verdicts = dict(zip(simple.crossings, verdict_list))
-    clock.lap("classification")
-
-    ranked = {n: ranked_pairings(junctions[n], verdicts[n]) for n in simple.crossings}
-    costs = {n: _pairing_costs(verdicts[n]) for n in simple.crossings}
-    ordering, tried = order_strokes(graph, simple, ranked, costs, stroke_width=w, search=not options.multi)
-    clock.lap("traversal")
+    # A single line has two free ends, or none when it closes: free ends beyond those are
+    # spikes drawn out and back. Try the open reading first, the closed one if it fails.
+    readings = (2,) if options.multi else (2, 0)
+    best = None
+    for ends in readings:
+        attempt = _order(graph.copy() if len(readings) > 1 else graph, ink, options, ends, clock)
+        if best is None or len(attempt.ordering.strokes) < len(best.ordering.strokes):
+            best = attempt
+        if len(best.ordering.strokes) <= 1:
+            break
+    graph, simple, junctions, verdicts, ordering, tried = best
 
     # Smoothing allowance: the medial axis wobbles by ~0.07 px per px of stroke width (pixel
     # grid, anti-aliasing); fitting tighter follows that wobble, looser cuts corners.
