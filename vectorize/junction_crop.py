@@ -46,30 +46,59 @@ class CropSpec:
         return asdict(self)
 
 
-def _prefilter(gray: np.ndarray, ratio: float) -> tuple[np.ndarray, float]:
-    """Anti-alias `gray` for sampling at `ratio` image px per crop px.
+def _reduce(img: np.ndarray, f: int, sigma: float) -> np.ndarray:
+    """Block-mean by f (image size a multiple of f), then Gaussian blur (white outside)."""
+    if f >= 2:
+        img = img.reshape(img.shape[0] // f, f, img.shape[1] // f, f).mean(axis=(1, 3))
+    if sigma > 0.0:
+        img = ndimage.gaussian_filter(img, sigma=sigma, mode="constant", cval=1.0)
+    return img.astype(np.float32, copy=False)
 
-    Returns the filtered image and the factor f by which it was block-reduced (a pixel
-    (i, j) of the result covers pixels [f i, f i + f) of the input).
+
+def _sample_filtered(gray: np.ndarray, xs: np.ndarray, ys: np.ndarray, ratio: float) -> np.ndarray:
+    """Bilinear samples of `gray` anti-aliased for `ratio` image px per sample spacing.
+
+    xs, ys: (N, M) sample positions in image px (x right, y down) for N junctions. The
+    image is block-reduced by f = floor(ratio) on a grid anchored at pixel (0, 0), then
+    blurred with sigma = ratio / f / 2 (if > 1 px); outside the image is white paper.
+    Filtering runs on a window around each junction's samples, or on the whole image when
+    that is smaller: both give the same values, because windows are aligned to the block
+    grid and padded past the blur kernel's reach.
     """
     f = max(1, int(np.floor(ratio)))
-    img = gray
-    if f >= 2:
-        h, w = img.shape
-        ph, pw = (-h) % f, (-w) % f
-        # White padding: outside the image is paper.
-        img = np.pad(img, ((0, ph), (0, pw)), constant_values=1.0)
-        img = img.reshape(img.shape[0] // f, f, img.shape[1] // f, f).mean(axis=(1, 3))
     residual = ratio / f
-    if residual > 1.0:
-        img = ndimage.gaussian_filter(img, sigma=0.5 * residual, mode="constant", cval=1.0)
-    return img.astype(np.float32, copy=False), float(f)
-
-
-def _sample(img: np.ndarray, f: float, xs: np.ndarray, ys: np.ndarray) -> np.ndarray:
-    """Bilinear samples of a (possibly f-reduced) image at image-px coordinates."""
-    coords = np.stack([(ys + 0.5) / f - 0.5, (xs + 0.5) / f - 0.5])
-    return ndimage.map_coordinates(img, coords, order=1, mode="constant", cval=1.0)
+    sigma = 0.5 * residual if residual > 1.0 else 0.0
+    reach = (int(4.0 * sigma + 0.5) if sigma > 0 else 0) + 2  # scipy's kernel radius + bilinear
+    rx, ry = (xs + 0.5) / f - 0.5, (ys + 0.5) / f - 0.5  # positions in reduced pixels
+    lo_x = np.floor(rx.min(axis=1)).astype(int) - reach
+    hi_x = np.ceil(rx.max(axis=1)).astype(int) + reach + 1
+    lo_y = np.floor(ry.min(axis=1)).astype(int) - reach
+    hi_y = np.ceil(ry.max(axis=1)).astype(int) + reach + 1
+    h, w = gray.shape
+    whole_area = (-(-h // f) + 2 * reach) * (-(-w // f) + 2 * reach)
+    if np.sum((hi_x - lo_x) * (hi_y - lo_y)) >= whole_area:
+        lo_x[:], lo_y[:] = -reach, -reach
+        hi_x[:], hi_y[:] = -(-w // f) + reach, -(-h // f) + reach
+        windows = [(0, 0, 0, 0)]  # one shared window: the whole (padded) image
+    else:
+        windows = list(zip(lo_x, hi_x, lo_y, hi_y))
+    out = np.empty(xs.shape, dtype=np.float32)
+    cache: dict = {}
+    for i in range(len(xs)):
+        x0, x1, y0, y1 = int(lo_x[i]), int(hi_x[i]), int(lo_y[i]), int(hi_y[i])
+        key = windows[0] if len(windows) == 1 else (x0, x1, y0, y1)
+        if key not in cache:
+            # The window in image px, white where it leaves the image.
+            win = np.ones(((y1 - y0) * f, (x1 - x0) * f), dtype=np.float32)
+            sy0, sy1 = max(y0 * f, 0), min(y1 * f, h)
+            sx0, sx1 = max(x0 * f, 0), min(x1 * f, w)
+            if sy1 > sy0 and sx1 > sx0:
+                win[sy0 - y0 * f:sy1 - y0 * f, sx0 - x0 * f:sx1 - x0 * f] = gray[sy0:sy1, sx0:sx1]
+            cache = {key: _reduce(win, f, sigma)}  # keep only the current window
+        img = cache[key]
+        coords = np.stack([ry[i] - y0, rx[i] - x0])
+        out[i] = ndimage.map_coordinates(img, coords, order=1, mode="constant", cval=1.0)
+    return out
 
 
 def _unit_grid(size: int) -> tuple[np.ndarray, np.ndarray]:
@@ -83,13 +112,12 @@ def principal_angles(gray: np.ndarray, centers: np.ndarray, stroke_width: float,
     """Angle (rad) of the ink's principal axis around each centre; (N, 2) -> (N,)."""
     n_axis = 33
     span = 6.0 * spec.axis_sigma * stroke_width
-    ratio = span / n_axis
-    img, f = _prefilter(gray, ratio)
     gx, gy = _unit_grid(n_axis)
     ox, oy = gx * span, gy * span
     xs = centers[:, 0, None, None] + ox
     ys = centers[:, 1, None, None] + oy
-    vals = _sample(img, f, xs.ravel(), ys.ravel()).reshape(xs.shape)
+    n = len(centers)
+    vals = _sample_filtered(gray, xs.reshape(n, -1), ys.reshape(n, -1), span / n_axis).reshape(xs.shape)
     paper = np.percentile(vals, 90, axis=(1, 2))[:, None, None]
     ink = np.clip(paper - vals, 0.0, None)
     weight = ink * np.exp(-(ox**2 + oy**2) / (2.0 * (spec.axis_sigma * stroke_width) ** 2))
@@ -130,12 +158,11 @@ def crop_junctions(gray: np.ndarray, centers: np.ndarray, stroke_width: float,
     gx, gy = _unit_grid(s)
     for ch, span in enumerate((spec.near_span, spec.far_span)):
         side = span * stroke_width
-        img, f = _prefilter(gray, side / s)
         # Rotate the crop frame so its x axis runs along the principal axis.
         ox, oy = gx * side, gy * side
         xs = centers[:, 0, None, None] + c * ox - si * oy
         ys = centers[:, 1, None, None] + si * ox + c * oy
-        out[:, ch] = _sample(img, f, xs.ravel(), ys.ravel()).reshape(n, s, s)
+        out[:, ch] = _sample_filtered(gray, xs.reshape(n, -1), ys.reshape(n, -1), side / s).reshape(n, s, s)
     # Normalise contrast per junction (pen, pencil, grey scans): paper level from the far
     # crop, ink level from the near crop, where the junction's own ink always is.
     paper = np.percentile(out[:, 1], 75, axis=(1, 2))
