@@ -84,6 +84,7 @@ class Simplified:
     """Result of simplification: the node kinds the traversal needs.
 
     y_feet: Y-junction node -> slot index of its foot; y_tips: the free ends of those feet;
+    retraced: the Y-junctions whose spike runs back over itself (T-shaped, not V-shaped);
     crossings: degree-4 nodes; merged: pairs merged; unresolved: nodes where three or more
     strokes seem to meet (degree >= 5, or degree 3 that is neither Y, end nor crossing half).
     """
@@ -94,6 +95,7 @@ class Simplified:
     merged: int
     unresolved: tuple
     t_ends: tuple
+    retraced: frozenset = frozenset()
 
 
 def _min_radius(branch: Branch) -> float:
@@ -236,7 +238,7 @@ def simplify(graph: MedialGraph, *, stroke_width: float, multi: bool, ends: int 
         if not progress:
             break
 
-    y_feet, y_tips, t_ends, unresolved = {}, set(), [], []
+    y_feet, y_tips, t_ends, unresolved, retraced = {}, set(), [], [], set()
     for node in sorted(graph.incident):
         degree = graph.degree(node)
         if degree == 3:
@@ -245,6 +247,8 @@ def simplify(graph: MedialGraph, *, stroke_width: float, multi: bool, ends: int 
             spike = spike_slot(node)
             if spike is not None:
                 y_feet[node] = spike
+                if not _v_spike(graph, node, reach):
+                    retraced.add(node)  # a T: the spike runs back over itself
                 y_tips.add(graph.branches[node_slots[spike][0]].other(node))
             elif _is_t_shape(dirs):
                 # A stroke ending on another line: an end of the drawing (paper 3.3, 4.5).
@@ -258,7 +262,8 @@ def simplify(graph: MedialGraph, *, stroke_width: float, multi: bool, ends: int 
         elif degree >= 5:
             unresolved.append(node)
     crossings = tuple(sorted(graph.nodes_of_degree(4)))
-    return Simplified(y_feet, frozenset(y_tips), crossings, merged, tuple(unresolved), tuple(t_ends))
+    return Simplified(y_feet, frozenset(y_tips), crossings, merged, tuple(unresolved), tuple(t_ends),
+                      frozenset(retraced))
 
 
 def _is_t_shape(dirs: np.ndarray) -> bool:

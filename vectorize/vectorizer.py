@@ -65,7 +65,11 @@ def _pairing_costs(verdict: JunctionVerdict) -> tuple[float, float, float]:
 def _trace(graph: MedialGraph, simple: Simplified, ordering: Ordering, junctions: dict,
            verdicts: dict, stroke_width: float) -> list[tuple[list[TracedPoint], bool]]:
     """Turn branch passes into point lists flagged for filtering (paper 3.4)."""
-    foot_branches = {slots(graph, n)[f][0] for n, f in simple.y_feet.items()}
+    # V-spikes: the foot is where both sides' inks merge, its points are uncertain; the
+    # sides run straight to the tip. Retraced (T) spikes: the foot is the spike itself,
+    # its points are good, and the line turns sharply at both of its ends.
+    foot_branches = {slots(graph, n)[f][0] for n, f in simple.y_feet.items() if n not in simple.retraced}
+    sharp_points = [graph.positions[n] for n in simple.retraced]
     crossing_of = dict(zip(simple.crossings, ordering.choice))
     # Uncertain zone around each degree-4 node: where the two strokes' inks still overlap.
     zones = []
@@ -90,10 +94,13 @@ def _trace(graph: MedialGraph, simple: Simplified, ordering: Ordering, junctions
             on_foot = step.branch in foot_branches
             for k, xy in enumerate(points):
                 last = k == len(points) - 1
-                tip = on_foot and last and far_node in simple.y_tips
+                tip = last and far_node in simple.y_tips
                 keep = (not on_foot) or tip
                 traced.append(TracedPoint(xy, keep, tip))
         xy = np.array([t.xy for t in traced])
+        for base in sharp_points:
+            for i in np.flatnonzero(np.all(xy == base, axis=1)):
+                traced[i] = TracedPoint(traced[i].xy, traced[i].keep, True)
         for center, reach, crossing in zones:
             dist = np.linalg.norm(xy - center, axis=1)
             for i in np.flatnonzero(dist < reach):
