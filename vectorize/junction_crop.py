@@ -134,7 +134,8 @@ def crop_junctions(gray: np.ndarray, centers: np.ndarray, stroke_width: float,
     Parameters
     ----------
     gray : (H, W) float in [0, 1], 1 = paper, 0 = ink (not thresholded).
-    centers : (N, 2) junction positions, x right, y down, in px of `gray`.
+    centers : (N, 2) junction positions, x right, y down, in px of `gray`; pixel (row i,
+        column j) has its centre at (x, y) = (j, i), as in scikit-image and the medial axis.
     stroke_width : the drawing's stroke width in px (> 0).
     spec : crop geometry; must match the one the model was trained with.
 
