@@ -159,11 +159,12 @@ def simplify(graph: MedialGraph, *, stroke_width: float, multi: bool, ends: int 
         if multi or node not in t_spikes:
             return None
         stub = _t_stub(graph, node, reach, stroke_width)
-        # The line the spike leaves from runs on roughly straight (turns under 55 degrees).
-        return stub[0] if stub is not None and stub[1] > np.cos(np.radians(55.0)) else None
+        return stub[0] if stub is not None else None
 
-    # T-shaped spikes are only plausible while the drawing has more free ends than the
-    # line can have (`ends`): take the straightest T's first, until that many remain.
+    # Spikes off a line (a T: the line runs on straight past the stub; or a serif: the
+    # line turns into one arm and retraces the other) are only plausible while the drawing
+    # has more free ends than the line can have (`ends`): take the straightest first,
+    # until that many remain.
     t_spikes: set[int] = set()
     if not multi:
         t_spikes = set(graph.incident)  # let spike_slot test the T shape of every node
