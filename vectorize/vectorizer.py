@@ -80,7 +80,10 @@ def _trace(graph: MedialGraph, simple: Simplified, ordering: Ordering, junctions
         half_angle = np.arccos(np.clip(cos, -1.0, 1.0)) / 2.0
         angle = np.pi / 2 - half_angle  # half the angle between the two crossing lines
         reach = stroke_width / (2.0 * max(np.sin(max(angle, 1e-3)), 1e-3))
-        reach = float(np.clip(reach, graph.radii[node], 6.0 * stroke_width))
+        # The shared ink of a merged node (its span) is uncertain too: both strokes' points
+        # there lie on one averaged centre line.
+        reach = max(reach, graph.spans.get(node, 0.0) + 0.5 * stroke_width)
+        reach = float(np.clip(reach, graph.radii[node], 12.0 * stroke_width))
         zones.append((graph.positions[node], reach, verdicts[node].is_crossing))
     result = []
     for passes, closed in zip(ordering.strokes, ordering.closed):
