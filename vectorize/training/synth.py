@@ -212,7 +212,9 @@ def _render_sample(rng: np.random.Generator, spec: CropSpec) -> tuple[np.ndarray
         gray = np.round(gray * 255.0) / 255.0
 
     w_est = w * float(np.exp(rng.normal(0.0, 0.07)))
-    crop = crop_junctions(gray.astype(np.float32), (center + jitter)[None], w_est, spec)[0]
+    # Rendering put pixel (i, j)'s centre at (j + 0.5, i + 0.5); the crop (like the medial
+    # axis) puts it at (j, i).
+    crop = crop_junctions(gray.astype(np.float32), (center + jitter - 0.5)[None], w_est, spec)[0]
     return crop, int(crossing), subtype, float(angle), w
 
 
