@@ -15,6 +15,7 @@ from machines.grbl_codes import describe_error
 from machines.grbl_protocol import MAX_LINE_CHARS, clean_line
 from machines.planner_model import BlockBuilder, Kinematics, block_durations
 from onestroke.errors import InputError
+from onestroke.textfile import read_text
 
 
 @dataclass(frozen=True)
@@ -49,17 +50,7 @@ def program_from_text(text: str, *, source: str = "<text>") -> Program:
 def load_program(path: str | os.PathLike) -> Program:
     """Read a G-code file (UTF-8 text) into a `Program`; InputError if unreadable."""
     name = str(path)
-    try:
-        with open(path, encoding="utf-8") as handle:
-            text = handle.read()
-    except FileNotFoundError:
-        raise InputError(f"G-code file {name!r} does not exist") from None
-    except IsADirectoryError:
-        raise InputError(f"G-code input {name!r} is a directory; give a .gcode file") from None
-    except UnicodeDecodeError:
-        raise InputError(f"G-code file {name!r} is not text; give a .gcode/.nc file") from None
-    except OSError as error:
-        raise InputError(f"cannot read G-code file {name!r}: {error.strerror}") from None
+    text = read_text(path, what="G-code file", expect="a .gcode/.nc file")
     program = program_from_text(text, source=name)
     if not program.lines:
         raise InputError(f"G-code file {name!r} has no G-code lines")

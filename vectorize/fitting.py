@@ -168,6 +168,7 @@ def fit_stroke(traced: list[TracedPoint], *, closed: bool, sigma: float, stroke_
         keep &= np.abs(arc - arc[i]) > stroke_width
     cuts = [0] + [int(i) for i in np.flatnonzero(split) if 0 < i < len(xy) - 1] + [len(xy) - 1]
     pieces = []
+    previous = None
     for lo, hi in zip(cuts[:-1], cuts[1:]):
         mask = keep[lo:hi + 1].copy()
         if not closed:
@@ -177,8 +178,14 @@ def fit_stroke(traced: list[TracedPoint], *, closed: bool, sigma: float, stroke_
         piece = xy[lo:hi + 1][mask]
         if len(piece) < 2:
             piece = xy[[lo, hi]]
-        control = fit_piece(piece, closed=closed and len(cuts) == 2, sigma=sigma,
-                            anchor=not (corner[lo] or corner[hi]))
+        if previous is not None and len(piece) == len(previous) and np.array_equal(piece, previous[::-1]):
+            # The way back from a retraced spike: exactly the way out, reversed, so the
+            # two passes lie on each other instead of crossing back and forth.
+            control = pieces[-1][::-1, ::-1]
+        else:
+            control = fit_piece(piece, closed=closed and len(cuts) == 2, sigma=sigma,
+                                anchor=not (corner[lo] or corner[hi]))
+        previous = piece
         pieces.append(np.array(control))  # writable: the joints move its ends
     # Join the pieces: at corners where their sides meet, elsewhere where they end.
     joints = list(zip(range(len(pieces) - 1), range(1, len(pieces)), cuts[1:-1]))

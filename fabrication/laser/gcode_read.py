@@ -17,6 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from onestroke.errors import InputError
+from onestroke.textfile import read_text
 
 _COMMENT = re.compile(r"\([^)]*\)|;.*$")
 _WORD = re.compile(r"([A-Z])\s*([-+]?(?:\d+\.?\d*|\.\d+))")
@@ -174,17 +175,7 @@ def _centre_from_radius(x0, y0, x1, y1, r, clockwise):
 
 def read_gcode_file(path: str | os.PathLike) -> list[str]:
     """Lines of a G-code file (without endings); InputError if it cannot be read."""
-    try:
-        with open(path, encoding="utf-8", errors="strict") as handle:
-            return handle.read().splitlines()
-    except FileNotFoundError:
-        raise InputError(f"G-code file {str(path)!r} does not exist") from None
-    except IsADirectoryError:
-        raise InputError(f"G-code input {str(path)!r} is a directory") from None
-    except UnicodeDecodeError:
-        raise InputError(f"G-code file {str(path)!r} is not text (UTF-8)") from None
-    except OSError as error:
-        raise InputError(f"cannot read G-code file {str(path)!r}: {error.strerror}") from None
+    return read_text(path, what="G-code file", expect="a .gcode/.nc file").splitlines()
 
 
 # -- strict validation -------------------------------------------------------------------
