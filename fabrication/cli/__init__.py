@@ -38,26 +38,16 @@ def main() -> None:
 
 
 def _register() -> None:
-    # One import and one add_command per command module; each module owns its command.
+    # Each command lives in its own module; registered here in the order --help lists them.
+    from fabrication.cli.embroider_cmd import embroider
+    from fabrication.cli.laser_cmd import laser
+    from fabrication.cli.ports_cmd import ports
+    from fabrication.cli.preview_cmd import preview
+    from fabrication.cli.stream_cmd import emulator, stream
     from fabrication.cli.vectorize_cmd import vectorize
 
-    main.add_command(vectorize)
-    from fabrication.cli.laser_cmd import laser
-
-    main.add_command(laser)
-    from fabrication.cli.stream_cmd import emulator, stream
-
-    main.add_command(stream)
-    main.add_command(emulator)
-    from fabrication.cli.ports_cmd import ports
-
-    main.add_command(ports)
-    from fabrication.cli.embroider_cmd import embroider
-
-    main.add_command(embroider)
-    from fabrication.cli.preview_cmd import preview
-
-    main.add_command(preview)
+    for command in (vectorize, embroider, laser, stream, preview, ports, emulator):
+        main.add_command(command)
 
 
 _register()
