@@ -141,3 +141,25 @@ def test_filled_outline_svg_is_vectorized_to_its_centre_line(tmp_path):
     error = cKDTree(dense).query(result.drawing.strokes[0].sample_evenly(2.0))[0]
     assert error.max() < 1.0
     assert result.drawing.stroke_width == pytest.approx(8.0, abs=1.0)
+
+
+@pytest.mark.parametrize("mode", ["I;16", "RGBA", "LA", "P", "RGB-jpeg"])
+def test_image_modes_all_read_as_the_same_drawing(tmp_path, mode):
+    from vectorize import VectorizeOptions, vectorize_file
+
+    gray = render_polylines([figure_eight()])
+    if mode == "I;16":
+        image = Image.fromarray(gray.astype(np.uint16) * 257)
+    elif mode == "RGBA":  # ink as opacity over a transparent page
+        rgba = np.zeros(gray.shape + (4,), np.uint8)
+        rgba[..., 3] = 255 - gray
+        image = Image.fromarray(rgba, "RGBA")
+    elif mode == "RGB-jpeg":
+        image = Image.fromarray(gray).convert("RGB")
+    else:
+        image = Image.fromarray(gray).convert(mode)
+    path = tmp_path / ("d.jpg" if mode == "RGB-jpeg" else "d.png")
+    image.save(path)
+    result = vectorize_file(path, VectorizeOptions(classifier="geometric"))
+    assert result.report.strokes == 1 and result.report.intersections == 1
+    assert result.drawing.strokes[0].length == pytest.approx(1070, rel=0.02)

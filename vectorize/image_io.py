@@ -34,13 +34,18 @@ def load_image(path: str | os.PathLike, *, max_size: int | None = None):
                 image.load()
                 original = (image.width, image.height)
                 factor = max(1, int(max(original) // (2 * max_size))) if max_size else 1
-                if factor > 1:
-                    image = image.reduce(factor) if image.mode in ("L", "RGB", "RGBA") else image
+                if image.mode.startswith("I") or image.mode == "F":
+                    # 16/32-bit gray: keep the depth (converting to RGB would clip it at 255).
+                    data = np.asarray(image, dtype=np.float64)
+                    top = 65535.0 if image.mode.startswith("I;16") or data.max() > 255 else 255.0
+                    if image.mode == "F" and data.max() <= 1.0:
+                        top = 1.0
+                    image = Image.fromarray(np.clip(np.round(data / top * 255.0), 0, 255).astype(np.uint8))
                 if image.mode in ("RGBA", "LA") or (image.mode == "P" and "transparency" in image.info):
                     image = image.convert("RGBA")
                 elif image.mode not in ("L", "RGB"):
                     image = image.convert("RGB")
-                if factor > 1 and image.mode not in ("L", "RGB", "RGBA"):
+                if factor > 1:
                     image = image.reduce(factor)
                 array = np.asarray(image)
                 scale = 1.0 / factor
