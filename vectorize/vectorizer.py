@@ -54,6 +54,22 @@ def _junctions(graph: MedialGraph, nodes, stroke_width: float) -> list[Junction]
     return result
 
 
+def _with_geometry(image: JunctionVerdict, geometry: JunctionVerdict) -> JunctionVerdict:
+    """The CNN's verdict with the branch geometry as independent evidence (log-odds add).
+
+    Where touching would mean sharp turns (a steep crossing, perhaps with a hook nearby that
+    confuses the image) geometry is decisive; at a touch or a shallow crossing both
+    pairings are smooth, geometry says ~0.5 and the image decides alone.
+    """
+    def logit(p: float) -> float:
+        p = min(max(p, 1e-4), 1 - 1e-4)
+        return float(np.log(p / (1 - p)))
+
+    p = float(1.0 / (1.0 + np.exp(-(logit(image.p_crossing) + logit(geometry.p_crossing)))))
+    agree = (p >= 0.5) == image.is_crossing
+    return JunctionVerdict(p_crossing=p, confidence=image.confidence if agree else max(p, 1 - p))
+
+
 def _pairing_costs(verdict: JunctionVerdict) -> tuple[float, float, float]:
     """-log plausibility of the three ranked pairings, relative to the first."""
     p = float(np.clip(verdict.p_crossing, 0.02, 0.98))
@@ -137,6 +153,9 @@ def _order(graph: MedialGraph, ink, options: VectorizeOptions, ends: int, clock:
     junction_list = _junctions(graph, simple.crossings, w)
     junctions = dict(zip(simple.crossings, junction_list))
     verdict_list = make_classifier(options.classifier).classify(ink.gray, junction_list, w) if junction_list else []
+    if options.classifier == "cnn" and junction_list:
+        geometry = make_classifier("geometric").classify(ink.gray, junction_list, w)
+        verdict_list = [_with_geometry(v, g) for v, g in zip(verdict_list, geometry)]
     verdicts = dict(zip(simple.crossings, verdict_list))
     clock.lap("classification")
     ranked = {n: ranked_pairings(junctions[n], verdicts[n]) for n in simple.crossings}
