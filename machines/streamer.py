@@ -131,6 +131,7 @@ class GrblStreamer:
         self._alarm_locked = False
         self._last_query = 0.0
         self._abort = threading.Event()
+        self._paused = False  # a hold the user asked for (pause) is not a stall
         self.rx_buffer = DEFAULT_RX_BUFFER
         self.planner_blocks = DEFAULT_PLANNER_BLOCKS
         self.warnings: list[str] = []
@@ -349,12 +350,14 @@ class GrblStreamer:
 
     def pause(self) -> None:
         """Feed hold (`!`): decelerate to a stop; the beam goes off in laser mode (M4)."""
+        self._paused = True
         self._write(FEED_HOLD)
 
     def resume(self, timeout: float = 10.0) -> None:
         """Cycle start (`~`) once the hold is complete (GRBL ignores `~` while decelerating)."""
         self.wait_status(lambda s: s.full_state != "Hold:1", timeout)
         self._write(CYCLE_START)
+        self._paused = False
 
     def abort(self) -> None:
         """Ask the running `stream` to stop safely (from another thread); it raises StreamInterrupted."""
@@ -529,8 +532,19 @@ class GrblStreamer:
         if status is None or time.monotonic() - seen > max(2.0, limit):
             raise stop(f"{self.name} stopped answering (no status report for {time.monotonic() - seen:.1f} s)",
                        failed=lines[inflight[0][0]][0])
+        if status.state == "Alarm":
+            # An ALARM whose message did not reach us: nothing will run until $X / $H.
+            raise stop(f"{self.name} is in ALARM and answers nothing; unlock with $X or home with $H",
+                       failed=lines[inflight[0][0]][0])
+        if status.state in ("Run", "Jog", "Home") or (status.state == "Hold" and self._paused):
+            return False  # running a long move, homing, or paused by the user: not stuck
         if status.state != "Idle":
-            return False  # running a long move, in a hold, homing...: not stuck
+            # A hold nobody asked for, a door, sleep: give it the hold timeout, then stop
+            # rather than wait forever.
+            if silent_for < limit + self.options.hold_timeout:
+                return False
+            raise stop(f"{self.name} stays in {status.full_state} with line {lines[inflight[0][0]][0]} "
+                       "unanswered", failed=lines[inflight[0][0]][0])
         number, text = lines[inflight[0][0]]
         queued = status.planner_free is not None and status.planner_free < self.planner_blocks
         if queued or (status.planner_free is None and not resumed):
