@@ -144,10 +144,18 @@ class GrblStreamer:
 
     def _read_loop(self) -> None:
         buffer = b""
+        empty_reads = 0
         while self._running:
             try:
                 data = self.port.read(self.port.in_waiting or 1)
+                empty_reads = 0
             except (serial.SerialException, OSError, TypeError, AttributeError) as error:
+                # "readiness to read but returned no data" also happens for a moment on a
+                # pseudo-terminal whose other side is busy reopening; a real unplug repeats.
+                if "returned no data" in str(error) and empty_reads < 10 and self._running:
+                    empty_reads += 1
+                    time.sleep(0.02)
+                    continue
                 if self._running:
                     self._replies.put(_Disconnected(error))
                 return
