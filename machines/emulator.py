@@ -250,6 +250,10 @@ class GrblEmulator:
         for thread in self._threads:
             if thread is not threading.current_thread():
                 thread.join(timeout=2.0)
+        self._close_fds()
+
+    def _close_fds(self) -> None:
+        """Close both ends of the pty (once; later calls do nothing)."""
         for fd in (self._fd, self._slave_fd):
             if fd is not None:
                 try:
@@ -718,13 +722,7 @@ class GrblEmulator:
             self._stopping = True
             self._cond.notify_all()
         with self._write_lock:
-            for fd in (self._fd, self._slave_fd):
-                if fd is not None:
-                    try:
-                        os.close(fd)
-                    except OSError:
-                        pass
-            self._fd = self._slave_fd = None
+            self._close_fds()
 
     def _do_reset(self) -> None:
         with self._cond:

@@ -18,6 +18,7 @@ import numpy as np
 from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
 
 from fabrication.cli.common import console, done, warn
+from fabrication.laser.job_time import format_duration
 from machines.gcode_program import Program, analyze_program, load_program, program_from_text
 from machines.job_check import check_job
 from machines.ports import open_port
@@ -30,13 +31,8 @@ FRAME_FEED = 3000.0  # mm/min: slow enough to follow by eye
 
 
 def _format_seconds(seconds: float) -> str:
-    seconds = max(0.0, float(seconds))
-    if seconds < 60:
-        return f"{seconds:.1f} s"
-    whole = int(round(seconds))
-    hours, rest = divmod(whole, 3600)
-    minutes, secs = divmod(rest, 60)
-    return f"{hours}:{minutes:02d}:{secs:02d}" if hours else f"{minutes}:{secs:02d}"
+    # An ETA can dip below zero when the machine runs ahead of the model.
+    return format_duration(max(0.0, float(seconds)))
 
 
 def _line_seconds(path: Path, program: Program, info: MachineInfo, fallback: np.ndarray) -> np.ndarray:
