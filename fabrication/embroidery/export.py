@@ -5,7 +5,8 @@ round them) of a plan that already respects the format's stitch limit, and we do
 encoder's remaining job ourselves, in numpy: split jumps longer than the format's jump
 record and land a jump on the first needle point where the format wants one. Then
 pyembroidery writes with `encode: False`: no stitch can become a jump, every format reads
-back exactly, and its pure-Python encoder (a third of the write time) is skipped.
+back exactly, and its pure-Python encoder (a third of the write time) is skipped. The
+.pes/.pec thumbnails are drawn by `pec_thumbnail` (same bytes, vectorised).
 Per-format numbers and writer settings (PES version, JEF trims) come from the profile.
 """
 
@@ -17,6 +18,7 @@ import os
 import numpy as np
 import pyembroidery
 
+from fabrication.embroidery.pec_thumbnail import fast_pec_thumbnails
 from fabrication.embroidery.plan import JUMP, STITCH, TRIM, StitchPlan
 from machines.hoops import EmbroideryFormat, format_for_path
 from onestroke.atomic import atomic_write_bytes
@@ -92,8 +94,10 @@ def embroidery_bytes(plan: StitchPlan, fmt: EmbroideryFormat, *, pes_version: in
         settings["pes version"] = pes_version
     check_plan_fits_format(plan, fmt)
     writer = getattr(pyembroidery, f"write_{fmt.extension}")
+    pattern = to_pattern(plan, fmt)
     buffer = io.BytesIO()
-    writer(to_pattern(plan, fmt), buffer, settings)
+    with fast_pec_thumbnails():  # identical bytes, 40 % less .pes write time
+        writer(pattern, buffer, settings)
     return buffer.getvalue()
 
 
