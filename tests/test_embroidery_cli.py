@@ -159,6 +159,11 @@ def test_unused_options_are_warned_about(inputs, tmp_path, monkeypatch):
     assert result.exit_code == 0 and "--repeats has no effect with --style running" in result.stderr
     result = run(["embroider", "{in}/d.svg", "-o", "z.pes", "--style", "zigzag", "--stitch-width", "0.6mm"], inputs)
     assert result.exit_code == 0 and "hardly shows" in result.stderr
+    # --width is the design's width; a tiny one next to --style zigzag gets a hint.
+    result = run(["embroider", "{in}/d.svg", "-o", "w.pes", "--style", "zigzag", "--width", "3mm"], inputs)
+    assert result.exit_code == 0 and "the zigzag's own width is --stitch-width" in result.stderr
+    result = run(["embroider", "{in}/d.svg", "-o", "w.pes", "--style", "zigzag", "--width", "60mm"], inputs)
+    assert result.exit_code == 0 and "--stitch-width" not in result.stderr
 
 
 def _png_input(folder):

@@ -16,6 +16,10 @@ def warn(message: str) -> None:
     """A one-line warning (soft wrap: long messages stay on one line in logs)."""
     console.print(f"[yellow]warning:[/yellow] {message}", soft_wrap=True)
 
+# A design side this small (mm) given with --width/--height in a zigzag or arrows job is
+# worth a hint that --stitch-width is the stitch's width.
+SMALL_DESIGN_MM = 15.0
+
 # CLI option -> field name in the style options; which styles use it (for warnings).
 _STYLE_FIELDS = {
     "stitch_length": ("stitch_length", "--stitch-length"),
@@ -141,6 +145,12 @@ def embroider(source: str, output: str, style: str, size: str | None, width: str
                         trim_seconds=profile.trim_seconds)
     for flag in unused:
         warn(f"{flag} has no effect with --style {style}")
+    if style in ("zigzag", "arrows") and stitch_width is None:
+        # `--width 3mm` next to --style zigzag most likely meant the zigzag, not the design.
+        for flag, side in (("--width", placement.width), ("--height", placement.height)):
+            if side is not None and side < SMALL_DESIGN_MM:
+                warn(f"{flag} {side:g} mm sizes the whole design; the {style}'s own width is "
+                     f"--stitch-width")
 
     if source.lower().endswith(".json"):
         from vectorize.svg_write import drawing_from_json
