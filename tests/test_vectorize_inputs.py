@@ -163,3 +163,52 @@ def test_image_modes_all_read_as_the_same_drawing(tmp_path, mode):
     result = vectorize_file(path, VectorizeOptions(classifier="geometric"))
     assert result.report.strokes == 1 and result.report.intersections == 1
     assert result.drawing.strokes[0].length == pytest.approx(1070, rel=0.02)
+
+
+def shaded_scan(drawing: np.ndarray, seed: int = 0) -> np.ndarray:
+    """`drawing` as an unevenly lit scan: paper 0.68-0.98 across the page, gray ink,
+    grain, JPEG. A global threshold cuts such a page in half."""
+    import io
+
+    gray = drawing.astype(np.float64) / 255.0
+    h, w = gray.shape
+    yy, xx = np.mgrid[0:h, 0:w] / max(h, w)
+    paper = 0.83 + 0.15 * np.cos(2.5 * xx + 1.3 * yy)
+    page = 0.2 + (paper - 0.2) * gray + np.random.default_rng(seed).normal(0, 0.03, gray.shape)
+    buffer = io.BytesIO()
+    Image.fromarray(np.clip(np.round(page * 255), 0, 255).astype(np.uint8)).save(buffer, "JPEG", quality=70)
+    return np.asarray(Image.open(buffer))
+
+
+def test_unevenly_lit_scan_is_flattened_before_thresholding():
+    from skimage.filters import threshold_li
+
+    from vectorize import VectorizeOptions, vectorize_image
+    from vectorize.binarize import flatten_paper
+
+    clean = render_polylines([figure_eight()], width=4.0)
+    scan = shaded_scan(clean)
+    raw = scan.astype(np.float32) / 255
+    assert (raw < threshold_li(raw)).mean() > 0.2  # unflattened, the threshold splits the paper
+    result = vectorize_image(scan, VectorizeOptions(seed=0))
+    assert result.report.strokes == 1 and result.report.intersections == 1
+    reference = vectorize_image(clean, VectorizeOptions(seed=0)).drawing.strokes[0]
+    assert abs(result.drawing.strokes[0].length - reference.length) < 0.02 * reference.length
+    # Evenly lit white paper is left as it is.
+    white = clean.astype(np.float32) / 255
+    assert np.abs(flatten_paper(white) - white).max() < 1e-6
+
+
+def test_noise_is_refused_quickly_with_a_hint(tmp_path, write_png):
+    import time
+
+    speckle = np.where(np.random.default_rng(3).random((600, 600)) < 0.3, 0, 255).astype(np.uint8)
+    out = tmp_path / "out.svg"
+    start = time.perf_counter()
+    result = run_cli("vectorize", write_png(speckle), "-o", out)
+    assert time.perf_counter() - start < 30
+    assert result.exit_code == 2, result.output
+    message = result.output.strip()
+    assert message.startswith("error:") and len(message.splitlines()) == 1
+    assert "noise" in message and "--threshold" in message
+    assert not out.exists()

@@ -1,4 +1,5 @@
-"""Preprocessing (paper 3.1): gray working image, optional blur, Li threshold, ink components."""
+"""Preprocessing (paper 3.1): gray working image, optional blur, paper flattening, Li threshold,
+ink components."""
 
 from __future__ import annotations
 
@@ -12,6 +13,8 @@ from skimage.transform import rescale
 from onestroke.errors import InputError
 
 MIN_SIDE = 16
+# Paper darker than this (after shading) is not paper: the division stops there.
+MIN_PAPER = 0.3
 
 
 @dataclass(frozen=True, eq=False)
@@ -68,6 +71,22 @@ def working_gray(image: np.ndarray, *, max_size: int, blur: float) -> tuple[np.n
     if blur > 0:
         gray = gaussian(gray, sigma=blur, preserve_range=True).astype(np.float32)
     return gray, scale
+
+
+def flatten_paper(gray: np.ndarray) -> np.ndarray:
+    """`gray` (H, W) divided by its local paper level, so that paper is ~1 everywhere:
+    (H, W) float32 in [0, 1].
+
+    Scans and photos of drawings are lit unevenly; one global threshold then cuts through
+    the paper's gradient instead of between paper and ink. The paper level is a grey
+    closing (lines darker than the paper vanish) over a window an eighth of the image's
+    longest side, box-smoothed. On evenly lit paper this changes nothing; ink blobs wider
+    than the window would be taken for paper, and no line drawing has those.
+    """
+    size = max(31, int(round(max(gray.shape) / 8)))
+    paper = ndimage.grey_closing(gray, size=(size, size), mode="nearest")
+    paper = ndimage.uniform_filter(paper.astype(np.float64), size=size, mode="nearest")
+    return np.clip(gray / np.maximum(paper, MIN_PAPER), 0.0, 1.0).astype(np.float32)
 
 
 def ink_threshold(gray: np.ndarray, threshold: float | None) -> float:
@@ -133,6 +152,7 @@ def binarize(image: np.ndarray, *, max_size: int, blur: float, threshold: float 
              multi: bool) -> InkImage:
     """Run the whole preprocessing stage."""
     gray, scale = working_gray(image, max_size=max_size, blur=blur)
+    gray = flatten_paper(gray)
     ink, level, width, dropped = extract_ink(gray, threshold=threshold, multi=multi)
     # Whiten everything that is not kept ink (other pieces) and blacken filled holes, so
     # that the sub-pixel outline of the gray image matches the kept ink exactly.

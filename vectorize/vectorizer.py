@@ -7,6 +7,7 @@ from typing import NamedTuple
 
 import numpy as np
 
+from onestroke.errors import InputError
 from vectorize.binarize import binarize
 from vectorize.drawing import Drawing
 from vectorize.fitting import TracedPoint, fit_stroke
@@ -22,6 +23,10 @@ from vectorize.traversal import Ordering, order_strokes
 
 # Vanishing-angle thresholds (notes: 0.95 single-line, 0.90 multi-line).
 PRUNE_SINGLE, PRUNE_MULTI = 0.95, 0.90
+# No line drawing in a working image of <= max_size px has this many closed outlines or
+# medial-axis branch points (a dense 2000 px scribble: ~500 crossings); noise has tens of
+# thousands, and simplifying those takes hours.
+MAX_OUTLINES, MAX_BRANCH_POINTS = 5000, 4000
 # Share of plausibility of the smoother touching pairing when the classifier says "touch".
 SMOOTHER_TOUCH = 0.85
 
@@ -165,6 +170,14 @@ def _order(graph: MedialGraph, ink, options: VectorizeOptions, ends: int, clock:
     return _Solution(graph, simple, junctions, verdicts, ordering, tried)
 
 
+def _refuse_noise(count: int, what: str, limit: int, threshold: float) -> None:
+    """Raise `InputError` when the ink has more `what` than any line drawing has: the
+    threshold cut through paper texture or noise (and the search would take hours)."""
+    if count > limit:
+        raise InputError(f"the ink has {count} {what}: that is paper texture or noise, not a line "
+                         f"drawing; try a --threshold below {threshold:.2f}, or --blur 1")
+
+
 def run_pipeline(image: np.ndarray, options: VectorizeOptions, *,
                  frame: InputFrame | None = None) -> VectorizeResult:
     """Vectorize `image`; the drawing comes out in `frame` (default: the image's pixels)."""
@@ -176,11 +189,14 @@ def run_pipeline(image: np.ndarray, options: VectorizeOptions, *,
     spacing = float(np.clip(w / 8.0, 0.3, 1.0))
     rings = outline_rings(ink.gray, ink.threshold, spacing)
     clock.lap("outline")
+    _refuse_noise(len(rings) + ink.dropped, "outlines (pieces and holes)", MAX_OUTLINES, ink.threshold)
     graph = medial_axis(rings, ink.gray, ink.threshold)
     clock.lap("medial axis")
     prune(graph, threshold=PRUNE_MULTI if options.multi else PRUNE_SINGLE, stroke_width=w)
     trim_free_ends(graph, stroke_width=w)
     clock.lap("pruning")
+    branch_points = sum(1 for incident in graph.incident.values() if len(incident) >= 3)
+    _refuse_noise(branch_points, "branch points", MAX_BRANCH_POINTS, ink.threshold)
     stages = {"ink": ink, "rings": rings, "pruned": graph.copy()} if options.keep_stages else None
     # A single line has two free ends, or none when it closes: free ends beyond those are
     # spikes drawn out and back. Try the open reading first, the closed one if it fails.
