@@ -18,7 +18,8 @@ from onestroke.errors import InputError
               help="Output file: .svg (one path per stroke) or .json (control points).")
 @click.option("--multi", is_flag=True, help="Multi-stroke drawing: keep every ink piece, several strokes.")
 @click.option("--threshold", type=float, default=None,
-              help="Ink threshold, gray level in (0, 1); default: Li's method.")
+              help="Ink threshold: gray level in (0, 1), paper = 1 after shading correction; "
+                   "default: Li's method.")
 @click.option("--blur", type=float, default=0.0, show_default=True,
               help="Gaussian blur sigma in px before thresholding (helps pencil scans).")
 @click.option("--classifier", type=click.Choice(["cnn", "geometric"]), default="cnn", show_default=True,
