@@ -74,6 +74,19 @@ def test_alpha_loop_is_one_open_stroke_through_the_crossing(classifier):
     assert stroke.length == pytest.approx(np.linalg.norm(np.diff(truth, axis=0), axis=1).sum(), rel=0.02)
 
 
+@pytest.mark.parametrize("width", [1.2, 25.0, 40.0])
+def test_thin_and_marker_thick_lines_keep_their_ends(width):
+    """A 1.2 px pen line and a marker 25-40 px wide (tails 3-5 widths long): the ragged outline
+    of thick ink grows many spurs; pruning them must not eat the tails."""
+    truth = alpha_loop()
+    result = vectorize_image(render_polylines([truth], width=width), VectorizeOptions(seed=0))
+    assert result.report.strokes == 1 and result.report.intersections == 1
+    stroke = result.drawing.strokes[0]
+    assert stroke.length == pytest.approx(np.linalg.norm(np.diff(truth, axis=0), axis=1).sum(), rel=0.02)
+    for end in (truth[0], truth[-1]):
+        assert min(np.linalg.norm(e - end) for e in (stroke.start, stroke.end)) < max(4.0, width / 4)
+
+
 def test_v_spike_is_one_stroke_out_and_back():
     truth = v_spike()
     result = vectorize_image(render_polylines([truth]), GEOMETRIC)

@@ -13,13 +13,20 @@ import numpy as np
 
 from vectorize.graph import MedialGraph
 
+# A leaf that runs on more than this many stroke widths beyond its junction's disc, mostly
+# as a tube, is a stroke's end, whatever its mean object angle. Thick strokes need this:
+# their ragged outlines grow a spur every pixel or two, and once those are pruned the
+# spurs and the round cap that merge into the end dilute its significance below the
+# threshold, which then ate 5-width tails whole.
+TUBE_REACH, TUBE_SIGNIFICANCE = 1.5, 0.5
+
 
 def prune(graph: MedialGraph, *, threshold: float, stroke_width: float) -> int:
     """Remove noise leaf branches in place; returns how many branches were removed.
 
     A leaf branch (one end of degree 1, the other a junction) goes when its vanishing-angle
     significance is below `threshold`, or when it hardly leaves the junction's disc (its
-    length is under the junction radius plus a quarter stroke width).
+    length is under the junction radius plus a quarter stroke width). Long tubes stay.
     """
     removed = 0
     while True:
@@ -29,7 +36,10 @@ def prune(graph: MedialGraph, *, threshold: float, stroke_width: float) -> int:
             if branch.a == branch.b or (da == 1) == (db == 1):
                 continue  # loops, whole isolated strokes, and inner branches stay
             junction = branch.b if da == 1 else branch.a
-            short = branch.length < graph.radii[junction] + 0.25 * stroke_width
+            reach = branch.length - graph.radii[junction]  # how far it leaves the junction's disc
+            if reach > TUBE_REACH * stroke_width and branch.significance > TUBE_SIGNIFICANCE:
+                continue  # a stroke's real end (see TUBE_REACH)
+            short = reach < 0.25 * stroke_width
             if short or branch.significance < threshold:
                 doomed.append((branch.significance, bid))
         if not doomed:
