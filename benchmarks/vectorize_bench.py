@@ -6,6 +6,7 @@
     python benchmarks/vectorize_bench.py --csv /tmp/bench.csv  # plus one row per drawing
     python benchmarks/vectorize_bench.py --whole-process 5     # time `onestroke vectorize` as a subprocess
     python benchmarks/vectorize_bench.py --ground-truth-as-output   # check the metrics machinery
+    python benchmarks/vectorize_bench.py --set plain --condition scan  # scan-like input (conditions.py)
 
 Sets: "plain" (generated, no touches), "touch" (generated, with tangential touches and
 near-touches), "hershey" (single-stroke font glyphs). Classifier "auto" runs the CNN on
@@ -42,6 +43,7 @@ if str(ROOT) not in sys.path:
 
 import numpy as np  # noqa: E402
 
+from benchmarks.conditions import CONDITIONS, condition_image  # noqa: E402
 from benchmarks.drawings import generate_set  # noqa: E402
 from benchmarks.hershey import hershey_set  # noqa: E402
 from benchmarks.metrics import ORDER_THRESHOLD, evaluate  # noqa: E402
@@ -51,6 +53,7 @@ DEFAULT_COUNTS = {"plain": 42, "touch": 40, "hershey": 40}
 PSNR_CAP = 60.0  # dB; an identical render has infinite PSNR, averaged as this
 TASKS: list = []  # (set name, GroundTruth), inherited by the forked workers
 PLOT_DIR: list = []  # [Path] when --plot is given
+CONDITION: list = ["clean"]  # how the rendered page is degraded (benchmarks/conditions.py)
 
 
 def overlay(gt, output, gray: np.ndarray, path: Path) -> None:
@@ -116,7 +119,7 @@ def _run_one(index: int, classifier: str, oracle: bool, conn) -> None:
            "error": ""}
     try:
         gray = render(gt.drawing)
-        image = to_uint8(gray)
+        image, back = condition_image(gt.drawing, gray, CONDITION[0], np.random.default_rng(index))
         if oracle:
             output, seconds, peak, method, report = gt.drawing, 0.0, float("nan"), "none", None
         else:
@@ -132,6 +135,12 @@ def _run_one(index: int, classifier: str, oracle: bool, conn) -> None:
             if not reset:
                 method += " (not reset: includes set-up)"
             output, report = result.drawing, result.report
+            if back != 1.0:
+                from vectorize.drawing import Drawing
+
+                matrix = np.array([[back, 0.0, 0.0], [0.0, back, 0.0]])
+                output = Drawing(tuple(s.transformed(matrix) for s in output.strokes),
+                                 gt.drawing.width, gt.drawing.height, "px")
         scores = evaluate(gt, output, gray)
         if PLOT_DIR and not scores.correct:
             overlay(gt, output, gray, PLOT_DIR[0] / f"{set_name}-{classifier}-{gt.name}.png")
@@ -424,6 +433,8 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--count", type=int, default=None, help="drawings per set (default: plain 42, touch 40, "
                                                             "hershey 40)")
     ap.add_argument("--seed", type=int, default=0)
+    ap.add_argument("--condition", default="clean", choices=CONDITIONS,
+                    help="degrade each rendered page like a real input (see benchmarks/conditions.py)")
     ap.add_argument("--jobs", type=int, default=1, help="drawings in parallel (timing is cleanest with 1)")
     ap.add_argument("--csv", type=Path, default=None, help="write one row per drawing here")
     ap.add_argument("--plot", type=Path, default=None, metavar="DIR",
@@ -438,6 +449,7 @@ def main(argv: list[str] | None = None) -> int:
     args = ap.parse_args(argv)
 
     t_start = time.perf_counter()
+    CONDITION[0] = args.condition
     if args.plot:
         args.plot.mkdir(parents=True, exist_ok=True)
         PLOT_DIR.append(args.plot)
@@ -450,7 +462,7 @@ def main(argv: list[str] | None = None) -> int:
 
     print(f"onestroke vectorizer benchmark  {time.strftime('%Y-%m-%d %H:%M:%S %Z')}  commit {_git_commit()}  "
           f"python {platform.python_version()}  {os.cpu_count()} CPUs")
-    print(f"sets {', '.join(sets)}; seed {args.seed}; {len(TASKS)} drawings made in {t_gen:.1f} s; "
+    print(f"sets {', '.join(sets)}; condition {args.condition}; seed {args.seed}; {len(TASKS)} drawings made in {t_gen:.1f} s; "
           f"load average {_load()} (timings are inflated when it exceeds the {os.cpu_count()} CPUs)")
 
     if args.whole_process is not None:

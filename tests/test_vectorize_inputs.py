@@ -212,3 +212,22 @@ def test_noise_is_refused_quickly_with_a_hint(tmp_path, write_png):
     assert message.startswith("error:") and len(message.splitlines()) == 1
     assert "noise" in message and "--threshold" in message
     assert not out.exists()
+
+
+def test_dark_frame_around_a_photographed_sheet_is_ignored():
+    from vectorize import VectorizeOptions, vectorize_image
+
+    sheet = shaded_scan(render_polylines([figure_eight()], width=4.0))
+    photo = np.full((sheet.shape[0] + 120, sheet.shape[1] + 120), 45, dtype=np.uint8)  # the table
+    photo[60:-60, 60:-60] = sheet
+    result = vectorize_image(photo, VectorizeOptions(seed=0))
+    assert result.report.strokes == 1 and result.report.intersections == 1
+    assert any("dark frame" in w for w in result.report.warnings)
+    stroke = result.drawing.strokes[0]
+    assert stroke.is_closed
+    assert np.allclose(stroke.bounds()[:2], np.array([50.0, 100.0]) + 60, atol=4)
+    # A thin line that runs off the image edge is a line, not a frame.
+    cropped = render_polylines([figure_eight()], width=4.0)[:, 60:340]
+    result = vectorize_image(cropped, VectorizeOptions(seed=0))
+    assert not any("dark frame" in w for w in result.report.warnings)
+    assert result.report.strokes >= 1

@@ -15,6 +15,9 @@ from onestroke.errors import InputError
 MIN_SIDE = 16
 # Paper darker than this (after shading) is not paper: the division stops there.
 MIN_PAPER = 0.3
+# Ink touching the image edge with an inscribed radius above this fraction of the longest
+# side (25 px of 1000: a band 50 px thick) is a frame around the drawing, not a line.
+FRAME_RADIUS = 0.025
 
 
 @dataclass(frozen=True, eq=False)
@@ -24,7 +27,8 @@ class InkImage:
     gray: (H, W) float32 in [0, 1], 1 = paper (downscaled, blurred, other pieces whitened);
     ink: (H, W) bool of the kept ink with small holes filled; threshold: the gray level of
     the ink boundary; scale: working px per input px; stroke_width: estimated ink width in
-    px; dropped: ink pieces left out (single-line mode).
+    px; dropped: ink pieces left out (single-line mode); frame: a dark frame along the image
+    edge was ignored (see `frame_labels`).
     """
 
     gray: np.ndarray
@@ -33,6 +37,7 @@ class InkImage:
     scale: float
     stroke_width: float
     dropped: int
+    frame: bool = False
 
 
 def to_gray(image: np.ndarray) -> np.ndarray:
@@ -112,8 +117,23 @@ def estimate_stroke_width(ink: np.ndarray) -> float:
     return float(max(1.0, 2.0 * np.median(values) - 0.5))
 
 
-def extract_ink(gray: np.ndarray, *, threshold: float | None, multi: bool) -> tuple[np.ndarray, float, float, int]:
-    """The ink mask to vectorize, its threshold, the stroke width and the dropped-piece count.
+def frame_labels(labels: np.ndarray, count: int) -> np.ndarray:
+    """Labels of dark frame pieces: ink that touches the image edge and is thicker than any
+    line (inscribed radius over `FRAME_RADIUS` of the longest side), such as the table
+    around a photographed sheet or a scanner lid's shadow. (n,) int."""
+    edge = np.unique(np.concatenate([labels[0], labels[-1], labels[:, 0], labels[:, -1]]))
+    edge = edge[edge > 0]
+    if edge.size == 0:
+        return edge
+    depth = ndimage.distance_transform_edt(np.isin(labels, edge))
+    radii = ndimage.maximum(depth, labels, edge)
+    return edge[np.asarray(radii) > FRAME_RADIUS * max(labels.shape)]
+
+
+def extract_ink(gray: np.ndarray, *, threshold: float | None,
+                multi: bool) -> tuple[np.ndarray, float, float, int, bool]:
+    """The ink mask to vectorize, its threshold, the stroke width, the dropped-piece count
+    and whether a frame was ignored.
 
     Specks (pieces smaller than a stroke-width square) are noise and vanish silently. In
     single-line mode only the largest piece is kept; the others are counted as dropped.
@@ -125,9 +145,14 @@ def extract_ink(gray: np.ndarray, *, threshold: float | None, multi: bool) -> tu
         raise InputError("no ink found: no pixel is darker than the threshold")
     if ink.mean() > 0.6:
         raise InputError(f"the image is {ink.mean():.0%} ink: it looks inverted or is not a line drawing")
-    width = estimate_stroke_width(ink)
     labels, count = ndimage.label(ink, structure=np.ones((3, 3)))
-    areas = np.bincount(labels.ravel())[1:]
+    frame = frame_labels(labels, count)
+    framed = 0 < frame.size < count  # a frame with nothing inside it stays: it is all there is
+    if framed:
+        ink &= ~np.isin(labels, frame)
+        labels[~ink] = 0
+    width = estimate_stroke_width(ink)
+    areas = np.bincount(labels.ravel(), minlength=count + 1)[1:]
     speck = max(4.0, width * width)
     keep = areas >= speck
     if not keep.any():
@@ -145,7 +170,7 @@ def extract_ink(gray: np.ndarray, *, threshold: float | None, multi: bool) -> tu
     small = hole_areas < max(2.0, 0.5 * width * width)
     small[0] = False
     ink |= small[hole_labels]
-    return ink, level, width, dropped
+    return ink, level, width, dropped, framed
 
 
 def binarize(image: np.ndarray, *, max_size: int, blur: float, threshold: float | None,
@@ -153,11 +178,12 @@ def binarize(image: np.ndarray, *, max_size: int, blur: float, threshold: float 
     """Run the whole preprocessing stage."""
     gray, scale = working_gray(image, max_size=max_size, blur=blur)
     gray = flatten_paper(gray)
-    ink, level, width, dropped = extract_ink(gray, threshold=threshold, multi=multi)
+    ink, level, width, dropped, framed = extract_ink(gray, threshold=threshold, multi=multi)
     # Whiten everything that is not kept ink (other pieces) and blacken filled holes, so
     # that the sub-pixel outline of the gray image matches the kept ink exactly.
     near = ndimage.binary_dilation(ink, iterations=2)
     work = np.where(near, gray, 1.0).astype(np.float32)
     work[(work < level) & ~ink] = 1.0
     work[ink & (work >= level)] = 0.0
-    return InkImage(gray=work, ink=ink, threshold=level, scale=scale, stroke_width=width, dropped=dropped)
+    return InkImage(gray=work, ink=ink, threshold=level, scale=scale, stroke_width=width, dropped=dropped,
+                    frame=framed)

@@ -237,6 +237,8 @@ def run_pipeline(image: np.ndarray, options: VectorizeOptions, *,
     if ink.scale < 1.0 or frame.reduced_from is not None:
         w0, h0 = frame.reduced_from or (shape[1], shape[0])
         warnings.append(f"image is {w0}x{h0} px: downscaled to {ink.gray.shape[1]}x{ink.gray.shape[0]} to vectorize")
+    if ink.frame:
+        warnings.append("a dark frame along the image edge (table, scanner lid) was ignored")
     if ink.dropped:
         warnings.append(f"{ink.dropped} separate ink piece(s) dropped: a single-line drawing keeps only the largest"
                         " (use --multi to keep them all)")

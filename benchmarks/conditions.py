@@ -1,0 +1,68 @@
+"""Scan-like conditions for the vectorizer benchmark: the clean render, degraded the way
+real inputs are (seeded, one generator per drawing).
+
+- clean: the anti-aliased render as it is;
+- noisy: Gaussian noise, sigma 0.08 of full scale;
+- scan: slightly blurred, paper lit unevenly (0.68-0.98 across the page), gray ink (0.18),
+  grain, JPEG at quality 70;
+- pencil: light, grainy ink (at most 60 % dark, 45 % of it random grain);
+- specks: 60 dust specks 1.5-4 px across scattered over the page;
+- varwidth: pen pressure: the line width drifts smoothly between 0.5x and 1.5x;
+- half: the page scanned at half the resolution (the output is scaled back to compare).
+"""
+
+from __future__ import annotations
+
+import io
+
+import numpy as np
+from PIL import Image
+from scipy import ndimage
+
+from benchmarks.render import render, to_uint8
+
+CONDITIONS = ("clean", "noisy", "scan", "pencil", "specks", "varwidth", "half")
+
+
+def _jpeg(image: np.ndarray, quality: int) -> np.ndarray:
+    buffer = io.BytesIO()
+    Image.fromarray(image).save(buffer, "JPEG", quality=quality)
+    return np.asarray(Image.open(buffer))
+
+
+def condition_image(drawing, gray: np.ndarray, condition: str,
+                    rng: np.random.Generator) -> tuple[np.ndarray, float]:
+    """The uint8 image the vectorizer gets for `drawing` (rendered as `gray`, (H, W) in
+    [0, 1]) under `condition`, and the factor from its pixels back to the drawing's."""
+    h, w = gray.shape
+    if condition == "clean":
+        return to_uint8(gray), 1.0
+    if condition == "noisy":
+        return to_uint8(np.clip(gray + rng.normal(0.0, 0.08, gray.shape), 0, 1)), 1.0
+    if condition == "scan":
+        yy, xx = np.mgrid[0:h, 0:w] / max(h, w)
+        paper = 0.83 + 0.15 * np.cos(2.5 * xx + 1.3 * yy)
+        page = 0.18 + (paper - 0.18) * ndimage.gaussian_filter(gray, 0.8)
+        page = page + rng.normal(0.0, 0.03, gray.shape)
+        return _jpeg(to_uint8(np.clip(page, 0, 1)), 70), 1.0
+    if condition == "pencil":
+        cover = (1.0 - gray) * (0.55 + 0.45 * rng.uniform(0.0, 1.0, gray.shape))
+        return to_uint8(1.0 - 0.6 * cover), 1.0
+    if condition == "specks":
+        page = gray.copy()
+        yy, xx = np.ogrid[-3:4, -3:4]
+        for y, x in zip(rng.integers(3, h - 3, 60), rng.integers(3, w - 3, 60)):
+            disc = yy ** 2 + xx ** 2 <= rng.uniform(0.7, 2.0) ** 2
+            page[y - 3:y + 4, x - 3:x + 4][disc] = 0.0
+        return to_uint8(page), 1.0
+    if condition == "varwidth":
+        width = drawing.stroke_width
+        thin = render(drawing, stroke_width=max(1.5, 0.5 * width))
+        thick = render(drawing, stroke_width=1.5 * width)
+        field = ndimage.gaussian_filter(rng.normal(size=gray.shape), 60)
+        field = (field - field.min()) / (np.ptp(field) + 1e-12)
+        return to_uint8(thin * (1.0 - field) + thick * field), 1.0
+    if condition == "half":
+        small = Image.fromarray(to_uint8(gray)).resize((w // 2, h // 2), Image.LANCZOS)
+        return np.asarray(small), w / (w // 2)
+    raise ValueError(f"unknown condition {condition!r}; use one of {', '.join(CONDITIONS)}")
