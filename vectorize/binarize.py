@@ -15,6 +15,8 @@ from onestroke.errors import InputError
 MIN_SIDE = 16
 # Paper darker than this (after shading) is not paper: the division stops there.
 MIN_PAPER = 0.3
+# Paper grain is taken to reach this many standard deviations below the paper level.
+PAPER_SIGMAS = 4.5
 # Ink touching the image edge with an inscribed radius above this fraction of the longest
 # side (25 px of 1000: a band 50 px thick) is a frame around the drawing, not a line.
 FRAME_RADIUS = 0.025
@@ -94,8 +96,19 @@ def flatten_paper(gray: np.ndarray) -> np.ndarray:
     return np.clip(gray / np.maximum(paper, MIN_PAPER), 0.0, 1.0).astype(np.float32)
 
 
+def paper_noise_floor(gray: np.ndarray) -> float:
+    """The gray level below which paper grain almost never reaches: median - 4.5 sigma of
+    the paper, with sigma from the lower quartile (a line drawing is mostly paper; the
+    upper half may be clipped at white)."""
+    q25, median = np.percentile(gray, [25, 50])
+    sigma = (median - q25) / 0.6745
+    return float(median - PAPER_SIGMAS * sigma)
+
+
 def ink_threshold(gray: np.ndarray, threshold: float | None) -> float:
-    """The ink/paper gray level: the given one, or Li's minimum cross-entropy threshold."""
+    """The ink/paper gray level: the given one, or Li's minimum cross-entropy threshold,
+    kept below the paper's grain (Li's criterion can settle inside the grain of a noisy
+    scan when the ink is under 1 % of the page)."""
     lo, hi = float(gray.min()), float(gray.max())
     if hi - lo < 0.08:
         if hi < 0.5:
@@ -103,7 +116,8 @@ def ink_threshold(gray: np.ndarray, threshold: float | None) -> float:
         raise InputError("no ink found: the image is blank")
     if threshold is not None:
         return float(threshold)
-    return float(threshold_li(gray, tolerance=1e-4))
+    level = float(threshold_li(gray, tolerance=1e-4))
+    return min(level, max(paper_noise_floor(gray), lo + 0.5 * (level - lo)))
 
 
 def estimate_stroke_width(ink: np.ndarray) -> float:
