@@ -17,6 +17,7 @@ MIN_SIDE = 16
 MIN_PAPER = 0.3
 # Paper grain is taken to reach this many standard deviations below the paper level.
 PAPER_SIGMAS = 4.5
+MAX_PAPER_SIGMA = 0.1  # grain rougher than this is not paper (see paper_noise_floor)
 # Ink touching the image edge with an inscribed radius above this fraction of the longest
 # side (25 px of 1000: a band 50 px thick) is a frame around the drawing, not a line.
 FRAME_RADIUS = 0.025
@@ -96,12 +97,15 @@ def flatten_paper(gray: np.ndarray) -> np.ndarray:
     return np.clip(gray / np.maximum(paper, MIN_PAPER), 0.0, 1.0).astype(np.float32)
 
 
-def paper_noise_floor(gray: np.ndarray) -> float:
+def paper_noise_floor(gray: np.ndarray) -> float | None:
     """The gray level below which paper grain almost never reaches: median - 4.5 sigma of
     the paper, with sigma from the lower quartile (a line drawing is mostly paper; the
-    upper half may be clipped at white)."""
+    upper half may be clipped at white). None when the lower quartile is not paper grain
+    (more than a quarter of the image is dark: a frame, a heavy drawing)."""
     q25, median = np.percentile(gray, [25, 50])
     sigma = (median - q25) / 0.6745
+    if sigma > MAX_PAPER_SIGMA:
+        return None
     return float(median - PAPER_SIGMAS * sigma)
 
 
@@ -117,7 +121,10 @@ def ink_threshold(gray: np.ndarray, threshold: float | None) -> float:
     if threshold is not None:
         return float(threshold)
     level = float(threshold_li(gray, tolerance=1e-4))
-    return min(level, max(paper_noise_floor(gray), lo + 0.5 * (level - lo)))
+    floor = paper_noise_floor(gray)
+    if floor is None:
+        return level
+    return min(level, max(floor, lo + 0.5 * (level - lo)))
 
 
 def estimate_stroke_width(ink: np.ndarray) -> float:
