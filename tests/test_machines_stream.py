@@ -21,6 +21,13 @@ from machines.streamer import DRAIN_LINE, GrblStreamer, StreamOptions
 from onestroke.errors import MachineError
 
 
+def hear_ctrl_c():
+    """In a child about to exec: take Ctrl-C (SIGINT) again. A shell starts background
+    jobs with SIGINT ignored, and a child inherits that, so a test suite run in the
+    background would otherwise send its Ctrl-C to a process that cannot hear it."""
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+
+
 def job_text(n, *, step=0.5, feed=3000, seed=0):
     """A curvy single-stroke job of n G1 lines (no blank lines: file line k = program line k)."""
     lines = ["G21", "G90", "M4 S600", "G0 X100 Y100", f"F{feed}"]
@@ -252,7 +259,8 @@ def test_ctrl_c_halts_safely(tmp_path, emulator):
     path.write_text(job_text(3000))
     env = {**os.environ, "PYTHONUNBUFFERED": "1"}
     process = subprocess.Popen([sys.executable, "-c", "from fabrication.cli import main; main()", "stream",
-                                str(path), "--port", emu.device], stderr=subprocess.PIPE, text=True, env=env)
+                                str(path), "--port", emu.device], stderr=subprocess.PIPE, text=True, env=env,
+                               preexec_fn=hear_ctrl_c)
     deadline = time.monotonic() + 30
     while len(emu.executed) < 400 and time.monotonic() < deadline:
         time.sleep(0.02)
@@ -308,7 +316,7 @@ def test_emulator_command_serves_a_pty_and_logs_executed_lines(tmp_path):
     log = tmp_path / "executed.txt"
     process = subprocess.Popen([sys.executable, "-c", "from fabrication.cli import main; main()", "emulator",
                                 "--speed", "50", "--log", str(log)], stdout=subprocess.PIPE,
-                               stderr=subprocess.PIPE, text=True)
+                               stderr=subprocess.PIPE, text=True, preexec_fn=hear_ctrl_c)
     try:
         device = process.stdout.readline().strip()
         assert device.startswith("/dev/")
