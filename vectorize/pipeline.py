@@ -135,7 +135,9 @@ def _vectorize_svg(path: str, options: VectorizeOptions) -> VectorizeResult:
 
 def vectorize_image(image: np.ndarray, options: VectorizeOptions = VectorizeOptions(), *,
                     frame: InputFrame | None = None) -> VectorizeResult:
-    """Vectorize a raster image: (H, W) gray or (H, W, 3|4) colour, uint8 or float in [0, 1].
+    """Vectorize a raster image: (H, W) gray or (H, W, 3|4) colour, uint8, uint16 or float in
+    [0, 1] (1 = paper), or an (H, W) bool ink mask (True = ink; note that a PIL mode "1"
+    image as an array is the opposite, True = white: convert it to "L" first).
 
     The drawing comes out in the image's pixels (pixel i covers [i, i + 1)), or in `frame`.
     """
