@@ -8,7 +8,9 @@ real inputs are (seeded, one generator per drawing).
 - pencil: light, grainy ink (at most 60 % dark, 45 % of it random grain);
 - specks: 60 dust specks 1.5-4 px across scattered over the page;
 - varwidth: pen pressure: the line width drifts smoothly between 0.5x and 1.5x;
-- half: the page scanned at half the resolution (the output is scaled back to compare).
+- half: the page scanned at half the resolution (the output is scaled back to compare);
+- gaps: the pen skipped twice: two gaps 1.5 widths (+2 px) long at random places of the
+  line's middle 80 %.
 """
 
 from __future__ import annotations
@@ -21,7 +23,7 @@ from scipy import ndimage
 
 from benchmarks.render import render, to_uint8
 
-CONDITIONS = ("clean", "noisy", "scan", "pencil", "specks", "varwidth", "half")
+CONDITIONS = ("clean", "noisy", "scan", "pencil", "specks", "varwidth", "half", "gaps")
 
 
 def _jpeg(image: np.ndarray, quality: int) -> np.ndarray:
@@ -65,4 +67,13 @@ def condition_image(drawing, gray: np.ndarray, condition: str,
     if condition == "half":
         small = Image.fromarray(to_uint8(gray)).resize((w // 2, h // 2), Image.LANCZOS)
         return np.asarray(small), w / (w // 2)
+    if condition == "gaps":
+        page = gray.copy()
+        line = np.concatenate([s.sample_evenly(0.5) for s in drawing.strokes])
+        radius = 0.75 * drawing.stroke_width + 1.0
+        rows, cols = np.mgrid[0:h, 0:w]
+        for _ in range(2):
+            x, y = line[rng.integers(len(line) // 10, len(line) * 9 // 10)]
+            page[(cols + 0.5 - x) ** 2 + (rows + 0.5 - y) ** 2 <= radius ** 2] = 1.0
+        return to_uint8(page), 1.0
     raise ValueError(f"unknown condition {condition!r}; use one of {', '.join(CONDITIONS)}")

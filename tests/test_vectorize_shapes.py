@@ -148,3 +148,34 @@ def test_multi_mode_letters_keep_their_strokes(name, lines, lengths):
     assert len(found) == len(lengths)
     # A stroke ending on another line stops at that line's centre: up to half a width short.
     assert np.allclose(found, sorted(lengths), atol=6.0)
+
+
+def _erase_disc(image: np.ndarray, centre, radius: float) -> np.ndarray:
+    rows, cols = np.mgrid[0:image.shape[0], 0:image.shape[1]]
+    out = image.copy()
+    out[(cols + 0.5 - centre[0]) ** 2 + (rows + 0.5 - centre[1]) ** 2 <= radius ** 2] = 255
+    return out
+
+
+@pytest.mark.parametrize("where", [0.04, 0.5])  # on a tail (two pieces), on the loop (one piece)
+def test_pen_gaps_are_bridged_in_single_line_mode(where):
+    truth = alpha_loop()
+    image = _erase_disc(render_polylines([truth]), truth[int(where * len(truth))], 7.0)
+    result = vectorize_image(image, VectorizeOptions(seed=0))
+    assert result.report.strokes == 1 and result.report.gaps_bridged == 1
+    assert result.report.dropped_components == 0
+    stroke = result.drawing.strokes[0]
+    assert stroke.length == pytest.approx(np.linalg.norm(np.diff(truth, axis=0), axis=1).sum(), rel=0.03)
+    assert _distance_to(stroke.sample_evenly(2.0), truth).max() < 2.0
+
+
+def test_an_open_c_and_a_line_ending_beside_another_are_not_bridged():
+    t = np.linspace(np.radians(20), np.radians(340), 300)
+    c_shape = np.c_[200 + 120 * np.cos(t), 200 + 120 * np.sin(t)]  # ends 82 px apart, facing
+    result = vectorize_image(render_polylines([c_shape], width=12.0), VectorizeOptions(seed=0))
+    assert result.report.gaps_bridged == 0 and not result.drawing.strokes[0].is_closed
+    # A stroke that stops 12 px short of the side of another: it points at no end.
+    tee = [np.array([[60.0, 200.0], [340.0, 200.0]]), np.array([[200.0, 60.0], [200.0, 188.0]])]
+    result = vectorize_image(render_polylines(tee, width=6.0), VectorizeOptions(seed=0))
+    assert result.report.gaps_bridged == 0 and result.report.dropped_components == 1
+    assert result.report.strokes == 1

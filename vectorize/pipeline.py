@@ -55,6 +55,7 @@ class VectorizeReport:
 
     strokes: strokes produced; intersections: degree-4 nodes classified; y_junctions: sharp
     out-and-back features kept; dropped_components: ink pieces left out (single-line mode);
+    gaps_bridged: pen gaps joined across (single-line mode, `gaps.py`);
     high_degree_junctions: nodes where three or more strokes meet (not resolved);
     scale: working px per input px (< 1 when downscaled); seconds: wall time per stage.
     """
@@ -63,6 +64,7 @@ class VectorizeReport:
     intersections: int = 0
     y_junctions: int = 0
     dropped_components: int = 0
+    gaps_bridged: int = 0
     high_degree_junctions: int = 0
     retries: int = 0
     scale: float = 1.0

@@ -11,6 +11,7 @@ from onestroke.errors import InputError
 from vectorize.binarize import binarize
 from vectorize.drawing import Drawing
 from vectorize.fitting import TracedPoint, fit_stroke
+from vectorize.gaps import bridge_gaps, keep_largest_piece
 from vectorize.graph import MedialGraph
 from vectorize.intersections import Junction, JunctionVerdict, make_classifier, ranked_pairings
 from vectorize.medial_axis import medial_axis
@@ -182,8 +183,10 @@ def run_pipeline(image: np.ndarray, options: VectorizeOptions, *,
                  frame: InputFrame | None = None) -> VectorizeResult:
     """Vectorize `image`; the drawing comes out in `frame` (default: the image's pixels)."""
     clock = _Clock()
+    # Every piece of ink is kept here; in single-line mode the pieces of a line broken by
+    # pen gaps are bridged below, and only then is the largest kept.
     ink = binarize(image, max_size=options.max_size, blur=options.blur,
-                   threshold=options.threshold, multi=options.multi)
+                   threshold=options.threshold, multi=True)
     clock.lap("binarize")
     w = ink.stroke_width
     spacing = float(np.clip(w / 8.0, 0.3, 1.0))
@@ -197,6 +200,10 @@ def run_pipeline(image: np.ndarray, options: VectorizeOptions, *,
     clock.lap("pruning")
     branch_points = sum(1 for incident in graph.incident.values() if len(incident) >= 3)
     _refuse_noise(branch_points, "branch points", MAX_BRANCH_POINTS, ink.threshold)
+    bridged = dropped = 0
+    if not options.multi:
+        bridged = bridge_gaps(graph, stroke_width=w)
+        dropped = keep_largest_piece(graph)
     stages = {"ink": ink, "rings": rings, "pruned": graph.copy()} if options.keep_stages else None
     # A single line has two free ends, or none when it closes: free ends beyond those are
     # spikes drawn out and back. Try the open reading first, the closed one if it fails.
@@ -239,8 +246,8 @@ def run_pipeline(image: np.ndarray, options: VectorizeOptions, *,
         warnings.append(f"image is {w0}x{h0} px: downscaled to {ink.gray.shape[1]}x{ink.gray.shape[0]} to vectorize")
     if ink.frame:
         warnings.append("a dark frame along the image edge (table, scanner lid) was ignored")
-    if ink.dropped:
-        warnings.append(f"{ink.dropped} separate ink piece(s) dropped: a single-line drawing keeps only the largest"
+    if dropped:
+        warnings.append(f"{dropped} separate ink piece(s) dropped: a single-line drawing keeps only the largest"
                         " (use --multi to keep them all)")
     if simple.unresolved:
         warnings.append(f"{len(simple.unresolved)} junction(s) where three or more strokes seem to meet:"
@@ -249,7 +256,7 @@ def run_pipeline(image: np.ndarray, options: VectorizeOptions, *,
         warnings.append(f"the line could not be followed in one stroke: {len(strokes)} strokes")
     report = VectorizeReport(
         strokes=len(strokes), intersections=len(simple.crossings), y_junctions=len(simple.y_feet),
-        dropped_components=ink.dropped, high_degree_junctions=len(simple.unresolved), retries=tried - 1,
+        dropped_components=dropped, gaps_bridged=bridged, high_degree_junctions=len(simple.unresolved), retries=tried - 1,
         scale=scale, stroke_width=w / scale, warnings=tuple(warnings), seconds=clock.seconds)
     if stages is not None:
         stages.update(simplified=graph, simple=simple, junctions=junctions, verdicts=verdicts,
