@@ -27,11 +27,11 @@ FRAME_RADIUS = 0.025
 class InkImage:
     """The working image and its ink.
 
-    gray: (H, W) float32 in [0, 1], 1 = paper (downscaled, blurred, other pieces whitened);
+    gray: (H, W) float32 in [0, 1], 1 = paper (downscaled, blurred, shading divided out,
+    specks and frame whitened);
     ink: (H, W) bool of the kept ink with small holes filled; threshold: the gray level of
     the ink boundary; scale: working px per input px; stroke_width: estimated ink width in
-    px; dropped: ink pieces left out (single-line mode); frame: a dark frame along the image
-    edge was ignored (see `frame_labels`).
+    px; frame: a dark frame along the image edge was ignored (see `frame_labels`).
     """
 
     gray: np.ndarray
@@ -39,7 +39,6 @@ class InkImage:
     threshold: float
     scale: float
     stroke_width: float
-    dropped: int
     frame: bool = False
 
 
@@ -151,14 +150,14 @@ def frame_labels(labels: np.ndarray, count: int) -> np.ndarray:
     return edge[np.asarray(radii) > FRAME_RADIUS * max(labels.shape)]
 
 
-def extract_ink(gray: np.ndarray, *, threshold: float | None,
-                multi: bool) -> tuple[np.ndarray, float, float, int, bool]:
-    """The ink mask to vectorize, its threshold, the stroke width, the dropped-piece count
-    and whether a frame was ignored.
+def extract_ink(gray: np.ndarray, *, threshold: float | None) -> tuple[np.ndarray, float, float, bool]:
+    """The ink mask to vectorize, its threshold, the stroke width and whether a frame was
+    ignored.
 
-    Specks (pieces smaller than a stroke-width square) are noise and vanish silently. In
-    single-line mode only the largest piece is kept; the others are counted as dropped.
-    Small holes (pores inside ink blobs, pinholes where strokes nearly touch) are filled.
+    Specks (pieces smaller than a stroke-width square) are noise and vanish silently; every
+    other piece is kept (single-line mode bridges and selects pieces later, on the medial
+    axis: `gaps.py`). Small holes (pores inside ink blobs, pinholes where strokes nearly
+    touch) are filled.
     """
     level = ink_threshold(gray, threshold)
     ink = gray < level
@@ -178,33 +177,25 @@ def extract_ink(gray: np.ndarray, *, threshold: float | None,
     keep = areas >= speck
     if not keep.any():
         raise InputError("no ink found: only specks smaller than a stroke")
-    if multi:
-        kept_labels = np.flatnonzero(keep) + 1
-        dropped = 0
-    else:
-        kept_labels = np.array([int(np.argmax(areas)) + 1])
-        dropped = int(keep.sum()) - 1
-    ink = np.isin(labels, kept_labels)
+    ink = np.isin(labels, np.flatnonzero(keep) + 1)
     holes = ndimage.binary_fill_holes(ink) & ~ink
     hole_labels, _ = ndimage.label(holes)
     hole_areas = np.bincount(hole_labels.ravel())
     small = hole_areas < max(2.0, 0.5 * width * width)
     small[0] = False
     ink |= small[hole_labels]
-    return ink, level, width, dropped, framed
+    return ink, level, width, framed
 
 
-def binarize(image: np.ndarray, *, max_size: int, blur: float, threshold: float | None,
-             multi: bool) -> InkImage:
+def binarize(image: np.ndarray, *, max_size: int, blur: float, threshold: float | None) -> InkImage:
     """Run the whole preprocessing stage."""
     gray, scale = working_gray(image, max_size=max_size, blur=blur)
     gray = flatten_paper(gray)
-    ink, level, width, dropped, framed = extract_ink(gray, threshold=threshold, multi=multi)
-    # Whiten everything that is not kept ink (other pieces) and blacken filled holes, so
+    ink, level, width, framed = extract_ink(gray, threshold=threshold)
+    # Whiten everything that is not kept ink (specks, a frame) and blacken filled holes, so
     # that the sub-pixel outline of the gray image matches the kept ink exactly.
     near = ndimage.binary_dilation(ink, iterations=2)
     work = np.where(near, gray, 1.0).astype(np.float32)
     work[(work < level) & ~ink] = 1.0
     work[ink & (work >= level)] = 0.0
-    return InkImage(gray=work, ink=ink, threshold=level, scale=scale, stroke_width=width, dropped=dropped,
-                    frame=framed)
+    return InkImage(gray=work, ink=ink, threshold=level, scale=scale, stroke_width=width, frame=framed)

@@ -185,14 +185,13 @@ def run_pipeline(image: np.ndarray, options: VectorizeOptions, *,
     clock = _Clock()
     # Every piece of ink is kept here; in single-line mode the pieces of a line broken by
     # pen gaps are bridged below, and only then is the largest kept.
-    ink = binarize(image, max_size=options.max_size, blur=options.blur,
-                   threshold=options.threshold, multi=True)
+    ink = binarize(image, max_size=options.max_size, blur=options.blur, threshold=options.threshold)
     clock.lap("binarize")
     w = ink.stroke_width
     spacing = float(np.clip(w / 8.0, 0.3, 1.0))
     rings = outline_rings(ink.gray, ink.threshold, spacing)
     clock.lap("outline")
-    _refuse_noise(len(rings) + ink.dropped, "outlines (pieces and holes)", MAX_OUTLINES, ink.threshold)
+    _refuse_noise(len(rings), "outlines (pieces and holes)", MAX_OUTLINES, ink.threshold)
     graph = medial_axis(rings, ink.gray, ink.threshold)
     clock.lap("medial axis")
     prune(graph, threshold=PRUNE_MULTI if options.multi else PRUNE_SINGLE, stroke_width=w)
