@@ -19,7 +19,8 @@ from math import floor
 import numpy as np
 from pyembroidery import PecWriter
 
-_original_draw_scaled = PecWriter.draw_scaled
+# None if a later pyembroidery no longer has this function: then nothing is swapped.
+_original_draw_scaled = getattr(PecWriter, "draw_scaled", None)
 _swap_lock = threading.Lock()
 
 
@@ -72,6 +73,9 @@ def numpy_draw_scaled(extends, points, graphic: list, stride: int, buffer: int =
 @contextlib.contextmanager
 def fast_pec_thumbnails() -> Iterator[None]:
     """Within the block, pyembroidery's PEC writer draws thumbnails with `numpy_draw_scaled`."""
+    if _original_draw_scaled is None:
+        yield
+        return
     with _swap_lock:
         PecWriter.draw_scaled = numpy_draw_scaled
         try:
