@@ -67,3 +67,14 @@ def test_swap_is_undone_even_on_error():
             assert PecWriter.draw_scaled is numpy_draw_scaled
             raise RuntimeError("writer failed")
     assert PecWriter.draw_scaled is original
+
+
+def test_without_the_library_function_nothing_is_swapped(monkeypatch):
+    import fabrication.embroidery.pec_thumbnail as thumbnail
+
+    monkeypatch.setattr(thumbnail, "_original_draw_scaled", None)
+    before = PecWriter.draw_scaled
+    with fast_pec_thumbnails():
+        assert PecWriter.draw_scaled is before
+    plan = plan_embroidery(design(), PlanOptions(style=style_options("running")))
+    assert embroidery_bytes(plan, format_for_path("x.pes"))[:8] == b"#PES0060"
