@@ -42,7 +42,7 @@ from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components
 from scipy.spatial import cKDTree
 
-from benchmarks.metrics import ambiguous_junctions, polyline_intersections
+from benchmarks.metrics import ambiguous_junctions, close_passes, polyline_intersections
 from vectorize.drawing import Drawing
 from vectorize.stroke import Stroke
 
@@ -374,15 +374,7 @@ def _validate(stroke: Stroke, closed: bool, width: float, designed: list, spikes
 
     # contacts: two samples closer than one width that are more than 3 widths apart along the line
     spacing = w / 4
-    s = np.linspace(0, stroke.length, max(2, int(np.ceil(stroke.length / spacing))) + 1)
-    if closed:
-        s = s[:-1]
-    pts = stroke.points_at_lengths(s)
-    pairs = cKDTree(pts).query_pairs(w, output_type="ndarray")
-    sep = np.abs(s[pairs[:, 0]] - s[pairs[:, 1]])
-    if closed:
-        sep = np.minimum(sep, stroke.length - sep)
-    pairs = pairs[sep > 3 * w]
+    s, pts, pairs = close_passes(stroke, closed, w)
     # spikes: the retrace itself and the line passing its base are not contacts
     spike_ranges = []
     seg_len = np.array([Stroke(stroke.control[k:k + 1]).length for k in range(stroke.segment_count)])

@@ -226,26 +226,34 @@ def ambiguous_junctions(polyline: np.ndarray) -> int:
     return int(np.count_nonzero(odd & (free_edges >= 2)))
 
 
-def merged_without_crossing(stroke: Stroke, closed: bool, width: float, crossings: np.ndarray) -> list:
-    """Places where two passes of `stroke` run within one width of each other (their ink
-    merges) and that hold no crossing: near-retraces, narrow wedges, a pass grazing another.
+def close_passes(stroke: Stroke, closed: bool, width: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Where two passes of `stroke` come within one width of each other.
 
-    Returns shapely MultiPoints of the centre-line samples involved (sampled every width/4;
-    passes count as different when more than 3 widths apart along the line).
+    Returns the centre-line samples (every width/4): their arc lengths s (N,) and points
+    (N, 2), and the index pairs (P, 2) of samples closer than `width` that are more than 3
+    widths apart along the line (around it, for a closed one).
     """
     w = float(width)
-    spacing = w / 4
-    s = np.linspace(0, stroke.length, max(2, int(np.ceil(stroke.length / spacing))) + 1)
+    s = np.linspace(0, stroke.length, max(2, int(np.ceil(stroke.length / (w / 4)))) + 1)
     if closed:
         s = s[:-1]
     pts = stroke.points_at_lengths(s)
     pairs = cKDTree(pts).query_pairs(w, output_type="ndarray")
-    if len(pairs) == 0:
-        return []
     sep = np.abs(s[pairs[:, 0]] - s[pairs[:, 1]])
     if closed:
         sep = np.minimum(sep, stroke.length - sep)
-    pairs = pairs[sep > 3 * w]
+    return s, pts, pairs[sep > 3 * w]
+
+
+def merged_without_crossing(stroke: Stroke, closed: bool, width: float, crossings: np.ndarray) -> list:
+    """Places where two passes of `stroke` run within one width of each other (their ink
+    merges) and that hold no crossing: near-retraces, narrow wedges, a pass grazing another.
+
+    Returns shapely MultiPoints of the centre-line samples involved (`close_passes`).
+    """
+    w = float(width)
+    spacing = w / 4
+    _, pts, pairs = close_passes(stroke, closed, w)
     if len(pairs) == 0:
         return []
     idx = np.unique(pairs)
