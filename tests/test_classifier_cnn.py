@@ -84,11 +84,15 @@ def test_a_vectorize_run_never_imports_torch(tmp_path):
 
 def test_training_smoke_run(tmp_path):
     pytest.importorskip("torch")
-    from vectorize.training.train import main
+    from click.testing import CliRunner
+
+    from fabrication.cli import main
 
     out = tmp_path / "tiny.onnx"
-    assert main(["--seed", "3", "--samples", "256", "--epochs", "1", "--batch", "64", "--validation", "128",
-                 "--workers", "1", "--out", str(out)]) == 0
+    result = CliRunner().invoke(main, ["train-classifier", "--seed", "3", "--samples", "256", "--epochs", "1",
+                                       "--batch", "64", "--validation", "128", "--workers", "1", "--out", str(out)])
+    assert result.exit_code == 0, result.output
+    assert json.loads(result.stdout)["n"] == 128
     meta = json.loads(out.with_suffix(".json").read_text())
     assert meta["sha256"] == hashlib.sha256(out.read_bytes()).hexdigest()
     assert meta["validation"]["n"] == 128

@@ -1,6 +1,6 @@
 """Train the crossing-vs-touching CNN on synthetic crops and export it to ONNX.
 
-    python -m vectorize.training.train --seed 0 --out vectorize/models/crossing_cnn.onnx
+    onestroke train-classifier --seed 0 --out vectorize/models/crossing_cnn.onnx
 
 Reproducible from the seed on CPU (data, initialisation, batch order and augmentation all
 derive from it). Writes the ONNX model, its metadata JSON and the model card (Markdown)
@@ -10,12 +10,11 @@ Needs the `train` extra (PyTorch); the vectorizer itself only ever loads the ONN
 
 from __future__ import annotations
 
-import argparse
 import hashlib
 import json
 import os
-import sys
 import time
+from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
@@ -46,8 +45,9 @@ def _dihedral(x: torch.Tensor, code: torch.Tensor) -> torch.Tensor:
 
 
 def train(*, seed: int, samples: int, epochs: int, batch: int, lr: float, workers: int,
-          log=print) -> tuple[CrossingNet, dict]:
-    """Generate data and train; returns the network (eval mode) and training facts."""
+          log: Callable[[str], None] = lambda line: None) -> tuple[CrossingNet, dict]:
+    """Generate data and train; returns the network (eval mode) and training facts.
+    `log` receives one progress line per stage and epoch."""
     torch.manual_seed(seed)
     torch.set_num_threads(max(1, os.cpu_count() or 1))
     started = time.perf_counter()
@@ -136,44 +136,37 @@ stroke widths that the ink still bridges.
 """
 
 
-def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--seed", type=int, default=0)
-    parser.add_argument("--samples", type=int, default=36_000)
-    parser.add_argument("--epochs", type=int, default=8)
-    parser.add_argument("--batch", type=int, default=128)
-    parser.add_argument("--lr", type=float, default=4e-3)
-    parser.add_argument("--validation", type=int, default=5_000)
-    parser.add_argument("--workers", type=int, default=os.cpu_count() or 1)
-    parser.add_argument("--out", type=Path, default=Path(__file__).parents[1] / "models" / "crossing_cnn.onnx")
-    args = parser.parse_args(argv)
+DEFAULT_OUT = Path(__file__).parents[1] / "models" / "crossing_cnn.onnx"
 
+
+def train_and_export(*, seed: int = 0, samples: int = 36_000, epochs: int = 8, batch: int = 128,
+                     lr: float = 4e-3, validation: int = 5_000, workers: int = 1,
+                     out: Path = DEFAULT_OUT,
+                     log: Callable[[str], None] = lambda line: None) -> dict:
+    """Train, export `out` (.onnx) with its metadata (.json) and model card (.md), validate
+    on `validation` fresh crops of another seed; returns the metadata (validation included).
+    `log` receives the training's progress lines."""
     spec = CropSpec()
-    args.out.parent.mkdir(parents=True, exist_ok=True)
-    net, facts = train(seed=args.seed, samples=args.samples, epochs=args.epochs, batch=args.batch,
-                       lr=args.lr, workers=args.workers)
+    out = Path(out)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    net, facts = train(seed=seed, samples=samples, epochs=epochs, batch=batch, lr=lr, workers=workers,
+                       log=log)
     facts["cpu"] = f"{os.cpu_count()} CPU cores"
-    data = export_onnx(net, args.out, spec)
-    validation = evaluate_onnx(args.out, count=args.validation, seed=args.seed + VALIDATION_SEED_OFFSET,
-                               workers=args.workers)
-    command = "python -m vectorize.training.train " + " ".join(
-        f"--{k} {v}" for k, v in (("seed", args.seed), ("samples", args.samples), ("epochs", args.epochs),
-                                  ("batch", args.batch), ("lr", args.lr), ("validation", args.validation)))
+    data = export_onnx(net, out, spec)
+    measured = evaluate_onnx(out, count=validation, seed=seed + VALIDATION_SEED_OFFSET, workers=workers)
+    command = "onestroke train-classifier " + " ".join(
+        f"--{k} {v}" for k, v in (("seed", seed), ("samples", samples), ("epochs", epochs),
+                                  ("batch", batch), ("lr", lr), ("validation", validation)))
     meta = {
-        "seed": args.seed,
+        "seed": seed,
         "command": command,
         "crop": spec.to_dict(),
         "parameters": sum(p.numel() for p in net.parameters()),
         "bytes": len(data),
         "sha256": hashlib.sha256(data).hexdigest(),
         "training": facts,
-        "validation": validation,
+        "validation": measured,
     }
-    atomic_write_text(args.out.with_suffix(".json"), json.dumps(meta, indent=2) + "\n")
-    atomic_write_text(args.out.with_suffix(".md"), model_card(meta))
-    print(json.dumps(validation, indent=2))
-    return 0
-
-
-if __name__ == "__main__":
-    sys.exit(main())
+    atomic_write_text(out.with_suffix(".json"), json.dumps(meta, indent=2) + "\n")
+    atomic_write_text(out.with_suffix(".md"), model_card(meta))
+    return meta

@@ -1,15 +1,11 @@
 """Accuracy of an exported model on freshly generated crops, measured with onnxruntime.
 
-    python -m vectorize.training.validate --seed 1000 --count 5000
+    onestroke validate-classifier --seed 1000 --count 5000
 """
 
 from __future__ import annotations
 
-import argparse
-import json
 import os
-import sys
-from pathlib import Path
 
 import numpy as np
 
@@ -36,21 +32,3 @@ def evaluate_onnx(model_path: str | os.PathLike, *, count: int, seed: int, worke
         "per_class": {"crossing": share(data.label == 1), "touching": share(data.label == 0)},
         "per_subtype": {name: share(data.subtype == i) for i, name in enumerate(SUBTYPES)},
     }
-
-
-def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--seed", type=int, default=1000)
-    parser.add_argument("--count", type=int, default=5000)
-    parser.add_argument("--workers", type=int, default=os.cpu_count() or 1)
-    parser.add_argument("--model", type=Path, default=None)
-    args = parser.parse_args(argv)
-    from vectorize.cnn_classifier import DEFAULT_MODEL
-
-    print(json.dumps(evaluate_onnx(args.model or DEFAULT_MODEL, count=args.count, seed=args.seed,
-                                   workers=args.workers), indent=2))
-    return 0
-
-
-if __name__ == "__main__":
-    sys.exit(main())
