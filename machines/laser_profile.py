@@ -16,6 +16,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from onestroke.errors import InputError
+from onestroke.textfile import read_text
 from onestroke.units import parse_positive_length, parse_size_pair, parse_speed
 
 DEFAULT_PROFILE_PATH = Path(__file__).with_name("profiles") / "laser-default.toml"
@@ -158,15 +159,9 @@ def laser_profile_from_dict(data: dict, *, source: str = "profile") -> LaserProf
 def load_laser_profile(path: str | os.PathLike | None = None) -> LaserProfile:
     """Read a laser profile TOML file; `None` gives the shipped default profile."""
     path = Path(path) if path is not None else DEFAULT_PROFILE_PATH
+    text = read_text(path, what="laser profile", expect="a TOML file")
     try:
-        with open(path, "rb") as handle:
-            data = tomllib.load(handle)
-    except FileNotFoundError:
-        raise InputError(f"laser profile {str(path)!r} does not exist") from None
-    except IsADirectoryError:
-        raise InputError(f"laser profile {str(path)!r} is a directory, not a TOML file") from None
+        data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as error:
         raise InputError(f"laser profile {str(path)!r} is not valid TOML: {error}") from None
-    except (OSError, UnicodeDecodeError) as error:
-        raise InputError(f"cannot read laser profile {str(path)!r}: {error}") from None
     return laser_profile_from_dict(data, source=f"laser profile {path.name!r}")
