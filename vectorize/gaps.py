@@ -13,8 +13,11 @@ from __future__ import annotations
 import math
 
 import numpy as np
+from scipy.sparse import coo_matrix
+from scipy.sparse.csgraph import connected_components
 
 from vectorize.graph import Branch, MedialGraph
+from vectorize.simplify import slot_direction, slots
 
 BRIDGE_WIDTHS = 4.0  # longest gap bridged, in stroke widths (centre to centre of the caps)
 BRIDGE_ANGLE = math.radians(40.0)  # largest angle between an end's direction and the gap
@@ -23,32 +26,18 @@ DIRECTION_REACH = 3.0  # an end's direction: from this many stroke widths inside
 
 def components(graph: MedialGraph) -> dict[int, int]:
     """Node -> index of its connected piece."""
-    piece: dict[int, int] = {}
-    index = -1
-    for start in graph.incident:
-        if start in piece:
-            continue
-        index += 1
-        stack = [start]
-        piece[start] = index
-        while stack:
-            node = stack.pop()
-            for bid in graph.incident[node]:
-                other = graph.branches[bid].other(node)
-                if other not in piece:
-                    piece[other] = index
-                    stack.append(other)
-    return piece
+    nodes = list(graph.incident)
+    index = {n: i for i, n in enumerate(nodes)}
+    ends = np.array([(index[b.a], index[b.b]) for b in graph.branches.values()], dtype=np.int64).reshape(-1, 2)
+    links = coo_matrix((np.ones(len(ends)), (ends[:, 0], ends[:, 1])), shape=(len(nodes), len(nodes)))
+    _, labels = connected_components(links, directed=False)
+    return dict(zip(nodes, labels.tolist()))
 
 
 def end_direction(graph: MedialGraph, node: int, stroke_width: float) -> np.ndarray:
-    """Unit vector (2,) along which the line leaves at free end `node`."""
-    branch = graph.branches[graph.incident[node][0]].oriented_from(node)
-    arc = np.concatenate([[0.0], np.cumsum(branch.edge_lengths)])
-    inner = branch.points[min(int(np.searchsorted(arc, DIRECTION_REACH * stroke_width)), len(arc) - 1)]
-    direction = branch.points[0] - inner
-    norm = float(np.linalg.norm(direction))
-    return direction / norm if norm > 0 else direction
+    """Unit vector (2,) along which the line leaves at free end `node`: the reverse of the
+    branch's direction into the ink, `DIRECTION_REACH` widths deep."""
+    return -slot_direction(graph, slots(graph, node)[0], DIRECTION_REACH * stroke_width)
 
 
 def bridge_gaps(graph: MedialGraph, *, stroke_width: float) -> int:
