@@ -166,18 +166,13 @@ def test_image_modes_all_read_as_the_same_drawing(tmp_path, mode):
 
 
 def shaded_scan(drawing: np.ndarray, seed: int = 0) -> np.ndarray:
-    """`drawing` as an unevenly lit scan: paper 0.68-0.98 across the page, gray ink,
-    grain, JPEG. A global threshold cuts such a page in half."""
-    import io
+    """`drawing` (uint8) as an unevenly lit scan, the benchmark's "scan" condition: paper
+    0.68-0.98 across the page, gray ink, grain, JPEG. A global threshold cuts such a page
+    in half."""
+    from benchmarks.conditions import condition_image
 
-    gray = drawing.astype(np.float64) / 255.0
-    h, w = gray.shape
-    yy, xx = np.mgrid[0:h, 0:w] / max(h, w)
-    paper = 0.83 + 0.15 * np.cos(2.5 * xx + 1.3 * yy)
-    page = 0.2 + (paper - 0.2) * gray + np.random.default_rng(seed).normal(0, 0.03, gray.shape)
-    buffer = io.BytesIO()
-    Image.fromarray(np.clip(np.round(page * 255), 0, 255).astype(np.uint8)).save(buffer, "JPEG", quality=70)
-    return np.asarray(Image.open(buffer))
+    image, _ = condition_image(None, drawing.astype(np.float64) / 255.0, "scan", np.random.default_rng(seed))
+    return image
 
 
 def test_unevenly_lit_scan_is_flattened_before_thresholding():
