@@ -1,6 +1,6 @@
 """Single-stroke Hershey/EMS glyphs as benchmark drawings with ground truth.
 
-Each `<glyph d="...">` of ../shared/data/hershey/*.svg drawn with ONE move-to is a real
+Each `<glyph d="...">` of benchmarks/data/hershey/*.svg drawn with ONE move-to is a real
 single-line drawing (font units, y up). We flip y, scale it to fit the 1000 px canvas with a
 margin, give it a seeded width of 3-8 px, and derive its ground truth from its exact
 polyline: crossings (intersections), touches (a pass meeting another without crossing; not
@@ -32,7 +32,7 @@ from benchmarks.metrics import ambiguous_junctions, merged_without_crossing, pol
 from vectorize.drawing import Drawing
 from vectorize.stroke import Stroke
 
-HERSHEY_DIR = Path(__file__).resolve().parents[2] / "shared" / "data" / "hershey"
+HERSHEY_DIR = Path(__file__).resolve().parent / "data" / "hershey"  # a copy of ../shared/data/hershey
 GLYPH_MARGIN = 60  # px
 _GLYPH = re.compile(r"<glyph\b([^>]*)/?>", re.S)
 _ATTR = re.compile(r'([\w:-]+)="([^"]*)"')

@@ -10,8 +10,8 @@ import numpy as np
 from vectorize.drawing import Drawing
 from vectorize.stroke import Stroke
 
-HERSHEY = Path("/work/shared/data/hershey/HersheyScriptMed.svg")
 REPO = Path(__file__).resolve().parents[1]
+HERSHEY = REPO / "benchmarks" / "data" / "hershey" / "HersheyScriptMed.svg"
 
 
 def catmull_rom_stroke(points: np.ndarray, closed: bool = False) -> Stroke:
