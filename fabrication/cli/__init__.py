@@ -39,6 +39,7 @@ def main() -> None:
 
 def _register() -> None:
     # Each command lives in its own module; registered here in the order --help lists them.
+    from fabrication.cli.batch_cmd import batch
     from fabrication.cli.embroider_cmd import embroider
     from fabrication.cli.laser_cmd import laser
     from fabrication.cli.ports_cmd import ports
@@ -48,7 +49,7 @@ def _register() -> None:
     from fabrication.cli.vectorize_cmd import vectorize
 
     for command in (vectorize, embroider, laser, stream, preview, ports, emulator, train_classifier,
-                    validate_classifier):
+                    validate_classifier, batch):
         main.add_command(command)
 
 
