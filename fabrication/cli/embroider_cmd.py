@@ -7,7 +7,7 @@ import time
 
 import click
 
-from fabrication.cli.common import console, done
+from fabrication.cli.common import console, done, edits_option
 from onestroke.atomic import check_writable
 from onestroke.errors import InputError
 
@@ -58,13 +58,14 @@ def warn(message: str) -> None:
 @click.option("--blur", type=float, default=0.0, show_default=True, help="Raster input: Gaussian blur sigma in px.")
 @click.option("--classifier", default="cnn", show_default=True,
               help="Raster input: crossing classifier, cnn or geometric.")
+@edits_option
 def embroider(source: str, output: str, style: str, size: str | None, width: str | None, height: str | None,
               rotate: float, hoop: str, fit: bool, stitch_length: str | None, tolerance: str | None,
               stitch_width: str | None, spacing: str | None, pull_comp: str | None, repeats: int | None,
               arrow_size: str | None, min_stitch: str, max_stitch: str, trim_distance: str, lock_form: str,
               color: str, pes_version: int | None, spm: float | None, preview_path: str | None,
               preview_width: int, multi: bool, threshold: float | None, blur: float,
-              classifier: str) -> None:
+              classifier: str, edits: str | None) -> None:
     """Sew SOURCE (PNG/JPG/SVG/JSON drawing) along its curve into an embroidery file."""
     from fabrication.cli.job_options import embroidery_settings
     from fabrication.embroidery.canvas import check_preview_path
@@ -100,7 +101,8 @@ def embroider(source: str, output: str, style: str, size: str | None, width: str
     else:
         from fabrication.cli.common import read_drawing
 
-        drawing = read_drawing(source, multi=multi, threshold=threshold, blur=blur, classifier=classifier)
+        drawing = read_drawing(source, multi=multi, threshold=threshold, blur=blur, classifier=classifier,
+                               edits=edits)
     result = embroider_drawing(drawing, job)
     write_embroidery(result.plan, output, pes_version=pes_version)
     if preview_path is not None:

@@ -8,7 +8,7 @@ from pathlib import Path
 
 import click
 
-from fabrication.cli.common import console, done, warn
+from fabrication.cli.common import console, done, edits_option, warn
 from onestroke.atomic import check_writable
 from onestroke.errors import InputError
 
@@ -55,11 +55,12 @@ def frame_path_for(output: str) -> str:
               help="Raster input: how the vectorizer tells crossings from touchings.")
 @click.option("--port", default=None, help="After writing, stream the job to this serial port (sim:// for a dry run).")
 @click.option("--baud", type=int, default=115200, show_default=True, help="Baud rate for --port.")
+@edits_option
 def laser(source: str, output: str, size: str | None, width: str | None, height: str | None, rotate: float,
           origin: str, feed: str, power: str, passes: int, tolerance: str, arcs: bool, keep_order: bool,
           profile_path: str | None, air_assist: bool | None, return_home: bool, frame: bool, frame_power: str,
           preview_path: str | None, raster_interval: str, raster_feed: str | None, multi: bool, threshold: float | None,
-          classifier: str, port: str | None, baud: int) -> None:
+          classifier: str, port: str | None, baud: int, edits: str | None) -> None:
     """Turn SOURCE (PNG/JPG/SVG) into G-code for a GRBL 1.1 laser in one continuous pass per stroke."""
     from fabrication.cli.common import read_drawing
     from fabrication.cli.job_options import laser_settings
@@ -102,7 +103,7 @@ def laser(source: str, output: str, size: str | None, width: str | None, height:
         raise InputError(f"input file {source!r} does not exist")
 
     with console.status(f"reading {os.path.basename(source)}"):
-        drawing = read_drawing(source, multi=multi, threshold=threshold, classifier=classifier)
+        drawing = read_drawing(source, multi=multi, threshold=threshold, classifier=classifier, edits=edits)
     with console.status("planning the toolpath"):
         program = laser_program(drawing, profile, settings.toolpath, settings.gcode, name=Path(source).name)
     toolpath, job, lines = program.toolpath, program.time, list(program.lines)
