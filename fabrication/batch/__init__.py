@@ -7,10 +7,10 @@ a Dask cluster, write outputs atomically, the manifest and the CSV/JSON report).
 """
 
 from fabrication.batch.inputs import BatchItem, find_inputs
-from fabrication.batch.report import BatchSummary, FileRecord
+from fabrication.batch.report import BatchSummary, FileRecord, FileStats
 from fabrication.batch.runner import run_batch
 from fabrication.batch.work import (INPUT_EXTENSIONS, BatchJob, DrawingTarget, EmbroideryTarget, FileResult,
                                     LaserTarget, process_file)
 
 __all__ = ["BatchItem", "BatchJob", "BatchSummary", "DrawingTarget", "EmbroideryTarget", "FileRecord",
-           "FileResult", "INPUT_EXTENSIONS", "LaserTarget", "find_inputs", "process_file", "run_batch"]
+           "FileResult", "FileStats", "INPUT_EXTENSIONS", "LaserTarget", "find_inputs", "process_file", "run_batch"]

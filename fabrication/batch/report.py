@@ -17,15 +17,11 @@ COLUMNS = ("input", "status", "outputs", "strokes", "intersections", "warnings",
 
 
 @dataclass(frozen=True, kw_only=True)
-class FileRecord:
-    """One report row. status: "ok", "failed", "skipped" (outputs current) or "not run"
-    (the batch was stopped first); outputs: paths relative to the output folder;
-    sew_seconds: machine time of the embroidery; laser_seconds: estimated laser job time;
-    seconds: processing wall time."""
+class FileStats:
+    """What one input gave: strokes / intersections (the vectorizer's counts), warnings,
+    stitches and sew_seconds (machine time) of the first embroidery target, laser_seconds
+    (estimated job time) of the first laser target, seconds (processing wall time)."""
 
-    input: str
-    status: str
-    outputs: tuple[str, ...] = ()
     strokes: int | None = None
     intersections: int | None = None
     warnings: tuple[str, ...] = ()
@@ -33,7 +29,24 @@ class FileRecord:
     sew_seconds: float | None = None
     laser_seconds: float | None = None
     seconds: float | None = None
+
+
+@dataclass(frozen=True, kw_only=True)
+class FileRecord:
+    """One report row. status: "ok", "failed", "skipped" (outputs current) or "not run"
+    (the batch was stopped first); outputs: paths relative to the output folder;
+    stats: None when the input was not processed in this run."""
+
+    input: str
+    status: str
+    outputs: tuple[str, ...] = ()
+    stats: FileStats | None = None
     error: str | None = None
+
+    def row(self) -> dict:
+        """The flat row of the CSV and JSON report (keys: COLUMNS)."""
+        stats = asdict(self.stats or FileStats())
+        return {"input": self.input, "status": self.status, "outputs": self.outputs, **stats, "error": self.error}
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -83,7 +96,8 @@ def write_report(out_dir: str | os.PathLike, records: list[FileRecord], summary:
     writer = csv.writer(buffer, lineterminator="\n")
     writer.writerow(COLUMNS)
     for record in rows:
-        writer.writerow([_cell(getattr(record, column)) for column in COLUMNS])
+        row = record.row()
+        writer.writerow([_cell(row[column]) for column in COLUMNS])
     atomic_write_text(csv_path, buffer.getvalue())
-    payload = {"summary": summary, "files": [asdict(r) for r in rows]}
+    payload = {"summary": summary, "files": [r.row() for r in rows]}
     atomic_write_text(json_path, json.dumps(payload, indent=1) + "\n")

@@ -168,7 +168,7 @@ def run_batch(items: list[BatchItem], job: BatchJob, out_dir: str | os.PathLike,
         rows = list(records.values())
         csv_path, json_path = report_paths(out)
         summary = BatchSummary(
-            total=len(rows), ran=sum(r.seconds is not None for r in rows), ok=sum(r.status == "ok" for r in rows),
+            total=len(rows), ran=sum(r.stats is not None for r in rows), ok=sum(r.status == "ok" for r in rows),
             failed=sum(r.status == "failed" for r in rows), skipped=sum(r.status == "skipped" for r in rows), not_run=sum(r.status == "not run" for r in rows),
             seconds=time.perf_counter() - started, workers=workers_seen[-1] if workers_seen else workers,
             scheduler=scheduler, report_csv=str(csv_path), report_json=str(json_path))
@@ -194,7 +194,5 @@ def _store(item: BatchItem, result: FileResult, job: BatchJob, manifest: Manifes
         manifest.failure(item.source, item.name, key, error)
     # every output of the input is current now: made in this run or found current
     outputs = () if error else tuple(path.relative_to(manifest.root).as_posix() for _, path in item.outputs)
-    return FileRecord(input=item.name, status="failed" if error else "ok", outputs=outputs,
-                      strokes=result.strokes, intersections=result.intersections, warnings=result.warnings,
-                      stitches=result.stitches, sew_seconds=result.sew_seconds,
-                      laser_seconds=result.laser_seconds, seconds=result.seconds, error=error)
+    return FileRecord(input=item.name, status="failed" if error else "ok", outputs=outputs, stats=result.stats,
+                      error=error)

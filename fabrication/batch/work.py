@@ -15,6 +15,7 @@ import tempfile
 import time
 from dataclasses import dataclass
 
+from fabrication.batch.report import FileStats
 from vectorize.pipeline import VectorizeOptions
 
 # Raster and SVG drawings a batch picks up from folders (lower-case, without the dot).
@@ -79,23 +80,12 @@ class BatchJob:
 
 @dataclass(frozen=True, kw_only=True)
 class FileResult:
-    """What became of one input.
-
-    name: the input's path relative to its folder (posix); outputs: (extension, file content)
-    per target made; strokes / intersections: the vectorizer's counts; stitches and
-    sew_seconds: of the first embroidery target; laser_seconds: estimated job time of the
-    first laser target; seconds: wall time on the worker; error: one line, None if it worked.
-    """
+    """What became of one input: name (its path relative to its folder, posix), outputs
+    ((extension, file content) per target made), stats, error (one line; None if it worked)."""
 
     name: str
     outputs: tuple[tuple[str, bytes], ...] = ()
-    strokes: int | None = None
-    intersections: int | None = None
-    warnings: tuple[str, ...] = ()
-    stitches: int | None = None
-    sew_seconds: float | None = None
-    laser_seconds: float | None = None
-    seconds: float = 0.0
+    stats: FileStats = FileStats()
     error: str | None = None
 
 
@@ -143,7 +133,8 @@ def process_file(name: str, job: BatchJob, *, path: str | None = None, data: byt
         text = str(error) if isinstance(error, OnestrokeError) else f"{type(error).__name__}: {error}"
         if local is not None:  # name the user's file, not the worker's copy of it
             text = text.replace(local, name)
-        return FileResult(name=name, seconds=time.perf_counter() - started, error=" ".join(text.split()))
+        return FileResult(name=name, stats=FileStats(seconds=time.perf_counter() - started),
+                          error=" ".join(text.split()))
 
 
 def _process(name: str, path: str, job: BatchJob, wanted: tuple[str, ...], started: float) -> FileResult:
@@ -182,7 +173,7 @@ def _process(name: str, path: str, job: BatchJob, wanted: tuple[str, ...], start
                 warnings.append(f"{program.toolpath.dropped} stroke(s) of zero length left out")
             if laser_seconds is None:
                 laser_seconds = float(program.time.total_seconds)
-    return FileResult(name=name, outputs=tuple(outputs), strokes=report.strokes,
-                      intersections=report.intersections, warnings=tuple(warnings), stitches=stitches,
-                      sew_seconds=sew_seconds, laser_seconds=laser_seconds,
+    stats = FileStats(strokes=report.strokes, intersections=report.intersections, warnings=tuple(warnings),
+                      stitches=stitches, sew_seconds=sew_seconds, laser_seconds=laser_seconds,
                       seconds=time.perf_counter() - started)
+    return FileResult(name=name, outputs=tuple(outputs), stats=stats)
