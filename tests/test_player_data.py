@@ -149,3 +149,17 @@ def test_script_cannot_end_early():
     plan = plan_embroidery(design(), PlanOptions(style=style_options("running")))
     html = player_html(stitch_player_data(plan, title="</script><script>alert(1)</script>"))
     assert html.count("</script>") == 2
+
+
+def test_raster_drawing_is_vectorized_then_played(tmp_path):
+    """A .png is vectorized with the defaults: one stroke for loops.png, played along its length."""
+    from vectorize import VectorizeOptions, vectorize_file
+
+    out = tmp_path / "loops.html"
+    result = _preview("examples/loops.png", "-o", out)
+    assert result.exit_code == 0, result.output
+    data = page_data(out.read_text(encoding="utf-8"))
+    drawing = vectorize_file("examples/loops.png", VectorizeOptions()).drawing
+    assert data["source"] == "drawing" and data["unit"] == "px"
+    assert data["numberTotal"] == len(drawing.strokes) == 1
+    assert data["total"] == pytest.approx(drawing.length, rel=1e-12)
