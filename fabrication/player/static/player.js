@@ -77,6 +77,7 @@ function buildDom(root) {
     fit: el("button", { type: "button", "data-role": "fit", title: "fit the design", text: "fit" }),
     travel: el("input", { type: "checkbox", "data-role": "show-travel", checked: "" }),
     ghost: el("input", { type: "checkbox", "data-role": "show-all", checked: "" }),
+    follow: el("input", { type: "checkbox", "data-role": "follow", checked: "" }),
   };
   dom.numberLabel = el("span", { class: "osp-label" });
   dom.timeLabel = el("span", { class: "osp-label", text: "time" });
@@ -95,7 +96,8 @@ function buildDom(root) {
     el("div", { class: "osp-controls" }, [
       dom.back, dom.play, dom.next, dom.scrub, el("label", {}, ["speed ", speed]),
       dom.zoomOut, dom.zoomIn, dom.fit,
-      el("label", {}, [dom.travel, " travel"]), el("label", {}, [dom.ghost, " whole design"])]));
+      el("label", {}, [dom.travel, " travel"]), el("label", {}, [dom.ghost, " whole design"]),
+      el("label", { title: "when zoomed in, keep the head in view" }, [dom.follow, " follow"])]));
   return dom;
 }
 
@@ -107,6 +109,7 @@ export function createPlayer(root, input, options = {}) {
   let d = null, time = 0, playing = false, speed = 1, last = null, frameId = 0;
   let inkUpTo = -1, dirtyView = true, scrubbing = false;
   const view = { scale: 1, ox: 0, oy: 0 };
+  let fitScale = 1;  // the scale "fit" chose: following the head only makes sense zoomed in
   let dpr = window.devicePixelRatio || 1;
 
   const sx = (i) => view.ox + d.x[i] * view.scale;
@@ -151,6 +154,14 @@ export function createPlayer(root, input, options = {}) {
     }
     flush();
     if (plain) return;
+    if (d.source === "embroidery" && view.scale >= 8) {
+      // zoomed in: the needle penetrations, where the thread goes through the fabric
+      const r = 2 * dpr;
+      c.fillStyle = "rgba(0,0,0,0.7)";
+      for (let i = from; i <= to; i++) {
+        if (d.kind[i] === DRAW || d.kind[i] === DOWN) c.fillRect(sx(i) - r, sy(i) - r, 2 * r, 2 * r);
+      }
+    }
     if (dom.travel.checked) {
       c.save();
       c.strokeStyle = "rgba(110,110,110,0.7)"; c.lineWidth = dpr; c.setLineDash([4 * dpr, 4 * dpr]);
@@ -203,7 +214,7 @@ export function createPlayer(root, input, options = {}) {
     }
     const w = dom.canvas.width, h = dom.canvas.height, pad = 0.05;
     const bw = Math.max(xmax - xmin, 1e-6), bh = Math.max(ymax - ymin, 1e-6);
-    view.scale = Math.min(w / (bw * (1 + 2 * pad)), h / (bh * (1 + 2 * pad)));
+    view.scale = fitScale = Math.min(w / (bw * (1 + 2 * pad)), h / (bh * (1 + 2 * pad)));
     view.ox = w / 2 - (xmin + bw / 2) * view.scale;
     view.oy = h / 2 - (ymin + bh / 2) * view.scale;
     dirtyView = true; request();
@@ -254,6 +265,12 @@ export function createPlayer(root, input, options = {}) {
         else { ctx.strokeStyle = "rgba(110,110,110,0.7)"; ctx.lineWidth = dpr; ctx.setLineDash([4 * dpr, 4 * dpr]); }
         ctx.beginPath(); ctx.moveTo(px, py); ctx.lineTo(hx, hy); ctx.stroke(); ctx.restore();
       }
+    }
+    // zoomed in and the head is leaving the view: bring it back to the centre
+    if (playing && dom.follow.checked && view.scale > fitScale * 1.01
+        && (hx < 0.1 * w || hx > 0.9 * w || hy < 0.1 * h || hy > 0.9 * h)) {
+      view.ox += w / 2 - hx; view.oy += h / 2 - hy; dirtyView = true;
+      return render();
     }
     const active = j < d.n ? d.kind[j] === DRAW : false;
     ctx.save(); ctx.lineWidth = 2 * dpr; ctx.strokeStyle = active ? "#e53935" : "#1e88e5";
