@@ -1,5 +1,8 @@
 """Benchmark: how fast the studio answers an edit (the page's POST /api/state round trip).
 
+Prints wall-clock medians and, below them, the CPU seconds the answer took in this
+process (all threads): on a loaded machine the wall time includes waiting for a core.
+
 Run from the repo root: `python benchmarks/studio_edit.py [DRAWING ...]` (default: the
 1000 px examples loops.png, touch-drawing.png and hershey ampersand). After the first
 vectorization, each edit kind is sent REPEATS times through Starlette's test client, the
@@ -44,39 +47,48 @@ def bench(path: Path) -> dict[str, float]:
     crossings = [j for j in base["graph"]["junctions"] if j["role"] == "crossing"] or [None]
     stroke = base["strokes"][0]["points"]
 
+    cpu: dict[str, list[float]] = {}
+
     def post(extra: dict, items: list) -> float:
-        start = time.perf_counter()
+        start, start_cpu = time.perf_counter(), time.process_time()
         answer = client.post("/api/state", json={"edits": dict(edits, **extra, edits=items)})
         assert answer.status_code == 200, answer.text
+        post.cpu = time.process_time() - start_cpu
         return time.perf_counter() - start
 
-    times: dict[str, list[float]] = {k: [] for k in
-                                     ("pairing", "split", "merge", "start", "reverse", "threshold", "blur", "multi")}
+    class Times(dict):
+        """kind -> wall seconds; the CPU seconds of the same answer go to `cpu`."""
+
+        def add(self, kind: str, seconds: float) -> None:
+            self.setdefault(kind, []).append(seconds)
+            cpu.setdefault(kind, []).append(post.cpu)
+
+    times = Times()
     for rep in range(REPEATS):
         j = crossings[rep % len(crossings)]
         if j is not None:
             other = PAIRINGS[(PAIRINGS.index(j["decision"]) + 1 + rep % 2) % 3]
             session.cache.solved.clear()
-            times["pairing"].append(post({}, [{"kind": "pairing", "at": j["at"], "pairing": other}]))
+            times.add("pairing", post({}, [{"kind": "pairing", "at": j["at"], "pairing": other}]))
             session.cache.simplified.clear()
             session.cache.solved.clear()
-            times["split"].append(post({}, [{"kind": "split", "at": j["at"]}]))
+            times.add("split", post({}, [{"kind": "split", "at": j["at"]}]))
             split = client.post("/api/state", json={"edits": dict(edits, edits=[{"kind": "split", "at": j["at"]}])})
             branch = min(split.json()["graph"]["branches"] or [{"at": j["at"]}],
                          key=lambda b: (b["at"][0] - j["at"][0]) ** 2 + (b["at"][1] - j["at"][1]) ** 2)
             session.cache.simplified.clear()
             session.cache.solved.clear()
-            times["merge"].append(post({}, [{"kind": "split", "at": j["at"]}, {"kind": "merge", "at": branch["at"]}]))
+            times.add("merge", post({}, [{"kind": "split", "at": j["at"]}, {"kind": "merge", "at": branch["at"]}]))
         post({}, [])  # the page shows the automatic result before the user picks an end
-        times["start"].append(post({}, [{"kind": "start", "at": stroke[-1] if rep % 2 == 0 else stroke[0]}]))
-        times["reverse"].append(post({}, [{"kind": "reverse", "at": stroke[len(stroke) // 2]}]))
-        times["threshold"].append(post({"threshold": round(0.40 + 0.02 * rep, 2)}, []))
-        times["blur"].append(post({"blur": 0.5 + 0.25 * rep}, []))
+        times.add("start", post({}, [{"kind": "start", "at": stroke[-1] if rep % 2 == 0 else stroke[0]}]))
+        times.add("reverse", post({}, [{"kind": "reverse", "at": stroke[len(stroke) // 2]}]))
+        times.add("threshold", post({"threshold": round(0.40 + 0.02 * rep, 2)}, []))
+        times.add("blur", post({"blur": 0.5 + 0.25 * rep}, []))
         session.cache.front.pop(next((k for k in session.cache.front if k[2]), None), None)
-        times["multi"].append(post({"multi": True}, []))
+        times.add("multi", post({"multi": True}, []))
     result = {k: median(v) for k, v in times.items() if v}
     result["first"] = first
-    return result
+    return result, {k: median(v) for k, v in cpu.items() if v}
 
 
 def main() -> None:
@@ -89,8 +101,9 @@ def main() -> None:
 
         with Image.open(path) as picture:
             size = "x".join(map(str, picture.size))
-        figures = bench(path)
-        print(f"{path.name + ' ' + size:40s} " + " ".join(f"{figures.get(k, float('nan')):9.3f}" for k in kinds))
+        wall, cpu = bench(path)
+        print(f"{path.name + ' ' + size:40s} " + " ".join(f"{wall.get(k, float('nan')):9.3f}" for k in kinds))
+        print(f"{'  CPU s of this process':40s} " + " ".join(f"{cpu.get(k, float('nan')):9.3f}" for k in kinds))
 
 
 if __name__ == "__main__":

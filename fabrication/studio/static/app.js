@@ -171,6 +171,7 @@ function draw() {
   });
   junctionMarkers(g);
   if (studio.pen < 1 || studio.playing) penMarker(g, t, penAt);
+  else $("where").textContent = `${Math.round(t.total)} px, ${s.strokes.length} stroke${s.strokes.length === 1 ? "" : "s"}`;
 }
 
 function arrows(g, t) {
