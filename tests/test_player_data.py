@@ -69,6 +69,9 @@ def test_embroidery_page_matches_the_file(tmp_path, ext):
     change = int(np.flatnonzero(kinds == COLOR)[0])
     assert set(data["color"][:change]) == {data["color"][0]} and set(data["color"][change:]) == {data["color"][-1]}
     assert first != last
+    threads = ["#%02x%02x%02x" % (t.get_red(), t.get_green(), t.get_blue()) for t in pattern.threadlist]
+    if threads:  # the threads the file names (DST and EXP name none: filler colours)
+        assert data["palette"] == threads[:len(data["palette"])]
     if ext in ("vp3",):  # RGB kept exactly
         assert (first, last) == ("#%02x%02x%02x" % RED, "#%02x%02x%02x" % BLUE)
 
