@@ -131,6 +131,11 @@ def test_page_refine_play_and_export(page, studio, tmp_path):
     page.select_option("#embroidery-form select[name=style]", "zigzag")
     settle(page)
     page.wait_for_function("document.getElementById('embroidery-stats').textContent.includes('stitches')")
+    # The stitches play in the project's player: press its play, the stitch number moves.
+    page.click("#embroidery-player [data-role=play]")
+    page.wait_for_timeout(600)
+    page.click("#embroidery-player [data-role=play]")
+    assert page.inner_text("#embroidery-player [data-role=number]").strip() not in ("", "0")
     page.screenshot(path=str(ARTIFACTS / "studio-4-embroidery.png"))
     with page.expect_download() as download:
         page.click("[data-export=pes]")
