@@ -10,8 +10,8 @@ console = Console(stderr=True, highlight=False)
 
 
 def warn(message: str) -> None:
-    """Print a one-line warning."""
-    console.print(f"[yellow]warning:[/yellow] {message}")
+    """Print a one-line warning (soft wrap: long messages stay on one line in logs)."""
+    console.print(f"[yellow]warning:[/yellow] {message}", soft_wrap=True)
 
 
 def done(message: str) -> None:
@@ -19,13 +19,12 @@ def done(message: str) -> None:
     click.echo(message)
 
 
-def read_drawing(path: str, *, multi: bool = False, threshold: float | None = None,
-                 blur: float = 0.0, classifier: str = "cnn"):
-    """Read a drawing from a raster image or SVG, printing the vectorizer's warnings."""
+def read_drawing(path: str, options=None):
+    """Read a drawing from a raster image or SVG (`options`: a `VectorizeOptions`, default
+    ones if None), printing the vectorizer's warnings."""
     from vectorize import VectorizeOptions, vectorize_file
 
-    result = vectorize_file(path, VectorizeOptions(multi=multi, threshold=threshold, blur=blur,
-                                                   classifier=classifier))
+    result = vectorize_file(path, options or VectorizeOptions())
     for message in result.report.warnings:
         warn(message)
     return result.drawing

@@ -7,14 +7,13 @@ import time
 
 import click
 
-from fabrication.cli.common import console, done
-from onestroke.atomic import check_writable
+from fabrication.cli.common import console, done, warn
+from fabrication.cli.options import (Integer, Length, Number, drawing_input_options, input_argument,
+                                     output_option, placement_options)
 from onestroke.errors import InputError
+from onestroke.paths import check_distinct
 
 
-def warn(message: str) -> None:
-    """A one-line warning (soft wrap: long messages stay on one line in logs)."""
-    console.print(f"[yellow]warning:[/yellow] {message}", soft_wrap=True)
 
 # A design side this small (mm) given with --width/--height in a zigzag or arrows job is
 # worth a hint that --stitch-width is the stitch's width.
@@ -33,54 +32,53 @@ _STYLE_FIELDS = {
 
 
 @click.command()
-@click.argument("source", type=click.Path(path_type=str))
-@click.option("-o", "--output", required=True, type=click.Path(path_type=str),
-              help="Embroidery file to write: .pes, .dst, .jef, .exp or .vp3.")
-@click.option("--style", default="running", show_default=True,
-              help="Stitch style: running, triple, zigzag or arrows.")
-@click.option("--size", default=None, help="Longest side of the design, e.g. 90mm, 3.5in [default: 90mm].")
-@click.option("--width", default=None, help="Width of the design instead of --size.")
-@click.option("--height", default=None, help="Height of the design instead of --size.")
-@click.option("--rotate", type=float, default=0.0, show_default=True, help="Degrees, counter-clockwise.")
+@input_argument()
+@output_option(help="Embroidery file to write: .pes, .dst, .jef, .exp or .vp3.")
+@click.option("--style", type=click.Choice(["running", "triple", "zigzag", "arrows"]), default="running",
+              show_default=True, help="Stitch style.")
+@placement_options(default_size="90mm")
 @click.option("--hoop", default="100x100", show_default=True,
               help="Hoop: 100x100 (4x4), 130x180 (5x7), 150x250, 160x260 (6x10), 200x200, or WxH in mm.")
 @click.option("--fit", is_flag=True, help="Scale the design down to fit the hoop instead of refusing it.")
-@click.option("--stitch-length", default=None,
-              help="Running/triple stitch and the arrows' centre walk [default: 2.5mm].")
-@click.option("--tolerance", default=None, help="Largest chord-to-curve distance [default: 0.2mm].")
-@click.option("--stitch-width", "--zigzag-width", "stitch_width", default=None,
-              help="Zigzag width rail to rail [2mm] or arrow spread [2.5mm].")
-@click.option("--spacing", default=None, help="Zigzag peak-to-peak spacing [0.4mm] or arrow spacing [5mm].")
-@click.option("--pull-comp", default=None, help="Zigzag pull compensation added to the width [default: 0.2mm].")
-@click.option("--repeats", type=int, default=None, help="Triple stitch: back-and-forth passes [default: 1].")
-@click.option("--arrow-size", default=None, help="Arrows: arm length along the curve [default: 2mm].")
-@click.option("--min-stitch", default="0.3mm", show_default=True,
-              help="Shorter stitches are merged away (locks excepted).")
-@click.option("--max-stitch", default="12.1mm", show_default=True,
-              help="Longest needle-down stitch per axis (never above the format's limit).")
-@click.option("--trim-distance", default="3mm", show_default=True,
-              help="Strokes further apart are joined by lock, trim and jump.")
-@click.option("--lock", "lock_form", default="half", show_default=True, help="Lock/tack form: half or back_forth.")
+@click.option("--stitch-length", type=Length(0.1, 12.7), default=None,
+              help="Running/triple stitch and the arrows' centre walk, 0.1-12.7 mm, at least --min-stitch "
+                   "[default: 2.5mm].")
+@click.option("--tolerance", type=Length(0.1, 5.0), default=None,
+              help="Largest chord-to-curve distance, 0.1-5 mm [default: 0.2mm].")
+@click.option("--stitch-width", "--zigzag-width", "stitch_width", type=Length(0.1, 12.0), default=None,
+              help="Zigzag width rail to rail [2mm] or arrow spread [2.5mm]; 0.1-12 mm.")
+@click.option("--spacing", type=Length(0.1, 50.0), default=None,
+              help="Zigzag peak-to-peak spacing [0.4mm] or arrow spacing [5mm]; 0.1-50 mm.")
+@click.option("--pull-comp", type=Length(0.0, 2.0), default=None,
+              help="Zigzag pull compensation added to the width, 0-2 mm [default: 0.2mm].")
+@click.option("--repeats", type=Integer(1, 5), default=None, help="Triple stitch: back-and-forth passes, 1-5 "
+                                                                  "[default: 1].")
+@click.option("--arrow-size", type=Length(0.1, 20.0), default=None,
+              help="Arrows: arm length along the curve, 0.1-20 mm [default: 2mm].")
+@click.option("--min-stitch", type=Length(0.1, 3.0), default="0.3mm", show_default=True,
+              help="Shorter stitches are merged away (locks excepted); 0.1-3 mm.")
+@click.option("--max-stitch", type=Length(1.0, 12.7), default="12.1mm", show_default=True,
+              help="Longest needle-down stitch per axis, 1-12.7 mm (never above the format's limit).")
+@click.option("--trim-distance", type=Length(0.0, 1000.0), default="3mm", show_default=True,
+              help="Strokes further apart are joined by lock, trim and jump; 0-1000 mm.")
+@click.option("--lock", "lock_form", type=click.Choice(["half", "back_forth"]), default="half", show_default=True,
+              help="Lock/tack form.")
 @click.option("--color", "--colour", "color", default="#000000", show_default=True,
               help="Thread colour: #rrggbb or a name.")
-@click.option("--pes-version", type=int, default=None,
+@click.option("--pes-version", type=Integer(1, 6), default=None,
               help="PES version: 6 (default; keeps RGB colours) or 1 (Brother's 64-colour palette).")
-@click.option("--spm", type=float, default=None, help="Machine speed in stitches per minute [default: 600].")
-@click.option("--preview", "preview_path", default=None, type=click.Path(path_type=str),
-              help="Also write a preview image (.png or .svg).")
-@click.option("--preview-width", type=int, default=1000, show_default=True, help="Preview width in px.")
-@click.option("--multi", is_flag=True, help="Raster input: multi-stroke vectorization.")
-@click.option("--threshold", type=float, default=None, help="Raster input: ink threshold in (0, 1).")
-@click.option("--blur", type=float, default=0.0, show_default=True, help="Raster input: Gaussian blur sigma in px.")
-@click.option("--classifier", default="cnn", show_default=True,
-              help="Raster input: crossing classifier, cnn or geometric.")
-def embroider(source: str, output: str, style: str, size: str | None, width: str | None, height: str | None,
-              rotate: float, hoop: str, fit: bool, stitch_length: str | None, tolerance: str | None,
-              stitch_width: str | None, spacing: str | None, pull_comp: str | None, repeats: int | None,
-              arrow_size: str | None, min_stitch: str, max_stitch: str, trim_distance: str, lock_form: str,
-              color: str, pes_version: int | None, spm: float | None, preview_path: str | None,
-              preview_width: int, multi: bool, threshold: float | None, blur: float,
-              classifier: str) -> None:
+@click.option("--spm", type=Number(100, 3000), default=None,
+              help="Machine speed in stitches per minute, 100-3000 [default: 600].")
+@output_option(".png", ".svg", flags=("--preview",), dest="preview_path", required=False,
+               help="Also write a preview image (.png or .svg).")
+@click.option("--preview-width", type=Integer(64, 8000), default=1000, show_default=True,
+              help="Preview width in px, 64-8000.")
+@drawing_input_options(prefix="Raster input: ")
+def embroider(source: str, output: str, style: str, placement, hoop: str, fit: bool, stitch_length: float | None,
+              tolerance: float | None, stitch_width: float | None, spacing: float | None, pull_comp: float | None,
+              repeats: int | None, arrow_size: float | None, min_stitch: float, max_stitch: float,
+              trim_distance: float, lock_form: str, color: str, pes_version: int | None, spm: float | None,
+              preview_path: str | None, preview_width: int, vectorize_options) -> None:
     """Sew SOURCE (PNG/JPG/SVG/JSON drawing) along its curve into an embroidery file."""
     from fabrication.embroidery.canvas import check_preview_path
     from fabrication.embroidery.export import PES_VERSIONS, write_embroidery
@@ -89,15 +87,13 @@ def embroider(source: str, output: str, style: str, size: str | None, width: str
     from fabrication.embroidery.plan import PlanOptions, style_options
     from fabrication.embroidery.preview import PreviewOptions, render_stitch_preview
     from fabrication.embroidery.thread import parse_color
-    from fabrication.placement import PlacementOptions
     from machines.hoops import load_embroidery_profile
-    from onestroke.units import parse_length, parse_positive_length
 
     started = time.perf_counter()
     # Every option is checked before anything is read or written.
     profile = load_embroidery_profile()
     fmt = profile.format_for(output)
-    check_writable(output)
+    check_distinct(inputs=[("input", source)], outputs=[("output", output), ("--preview", preview_path)])
     if pes_version is not None:
         if fmt.extension != "pes":
             raise InputError(f"--pes-version applies to .pes output only, not .{fmt.extension}")
@@ -105,41 +101,25 @@ def embroider(source: str, output: str, style: str, size: str | None, width: str
             raise InputError(f"--pes-version {pes_version} is not supported; use 1 or 6")
     if preview_path is not None:
         check_preview_path(preview_path)
-        check_writable(preview_path)
         preview_options = PreviewOptions(width=preview_width)
-    if not os.path.isfile(source):
-        raise InputError(f"input file {source!r} does not exist")
+    if stitch_length is not None and stitch_length < min_stitch:
+        raise InputError(f"--stitch-length {stitch_length:g} mm is shorter than --min-stitch {min_stitch:g} mm, "
+                         "so every stitch would be merged away; lengthen it or lower --min-stitch")
+    if stitch_length is not None and stitch_length > max_stitch:
+        raise InputError(f"--stitch-length {stitch_length:g} mm is longer than --max-stitch {max_stitch:g} mm")
 
-    lengths = {name: parse_positive_length(value, what=flag)
-               for name, value, flag in (("stitch_length", stitch_length, "--stitch-length"),
-                                         ("tolerance", tolerance, "--tolerance"),
-                                         ("stitch_width", stitch_width, "--stitch-width"),
-                                         ("spacing", spacing, "--spacing"),
-                                         ("arrow_size", arrow_size, "--arrow-size")) if value is not None}
-    if pull_comp is not None:
-        lengths["pull_comp"] = parse_length(pull_comp, what="--pull-comp")
-    if repeats is not None:
-        lengths["repeats"] = repeats
+    lengths = {name: value for name, value in (("stitch_length", stitch_length), ("tolerance", tolerance),
+                                               ("stitch_width", stitch_width), ("spacing", spacing),
+                                               ("arrow_size", arrow_size), ("pull_comp", pull_comp),
+                                               ("repeats", repeats)) if value is not None}
     style_values = {_STYLE_FIELDS[k][0]: v for k, v in lengths.items()}
     stitch_options = style_options(style, **style_values)
     unused = [_STYLE_FIELDS[k][1] for k in lengths
               if _STYLE_FIELDS[k][0] not in type(stitch_options).__dataclass_fields__]
-    if not any(v is not None for v in (size, width, height)):
-        size = "90mm"
-    placement = PlacementOptions(
-        size=parse_positive_length(size, what="--size") if size is not None else None,
-        width=parse_positive_length(width, what="--width") if width is not None else None,
-        height=parse_positive_length(height, what="--height") if height is not None else None,
-        rotate=rotate)
     the_hoop = profile.hoop(hoop)
-    limit = min(parse_positive_length(max_stitch, what="--max-stitch"), fmt.max_stitch, profile.max_stitch)
-    plan_options = PlanOptions(style=stitch_options, lock=LockOptions(form=lock_form),
-                               min_stitch=parse_positive_length(min_stitch, what="--min-stitch"),
-                               max_stitch=limit,
-                               trim_distance=parse_length(trim_distance, what="--trim-distance"),
-                               color=parse_color(color))
-    if spm is not None and not spm > 0:
-        raise InputError(f"--spm {spm:g} must be greater than zero")
+    limit = min(max_stitch, fmt.max_stitch, profile.max_stitch)
+    plan_options = PlanOptions(style=stitch_options, lock=LockOptions(form=lock_form), min_stitch=min_stitch,
+                               max_stitch=limit, trim_distance=trim_distance, color=parse_color(color))
     job = EmbroideryJob(placement=placement, hoop=the_hoop, fit=fit, plan=plan_options,
                         stitches_per_minute=spm or profile.stitches_per_minute,
                         trim_seconds=profile.trim_seconds)
@@ -160,7 +140,7 @@ def embroider(source: str, output: str, style: str, size: str | None, width: str
     else:
         from fabrication.cli.common import read_drawing
 
-        drawing = read_drawing(source, multi=multi, threshold=threshold, blur=blur, classifier=classifier)
+        drawing = read_drawing(source, vectorize_options)
     result = embroider_drawing(drawing, job)
     write_embroidery(result.plan, output, pes_version=pes_version)
     if preview_path is not None:
