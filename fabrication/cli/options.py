@@ -47,15 +47,16 @@ def _range_text(low: float | None, high: float | None, low_open: bool, high_open
 
 
 def check_range(value: float, *, what: str, text=None, low: float | None = None, high: float | None = None,
-                low_open: bool = False, high_open: bool = False, unit: str = "") -> float:
-    """`value` if finite and within [low, high] (open ends as asked), else `InputError`."""
-    shown = value if text is None else text
+                low_open: bool = False, high_open: bool = False, unit: str = "", quote: bool = True) -> float:
+    """`value` if finite and within [low, high] (open ends as asked), else `InputError`.
+    `text`: what the user typed, shown in the message (quoted if `quote`)."""
+    shown = repr(value if text is None else text) if quote else str(value if text is None else text).strip()
     if not math.isfinite(value):
-        raise InputError(f"{what} {shown!r} is not a finite number")
+        raise InputError(f"{what} {shown} is not a finite number")
     too_low = low is not None and (value <= low if low_open else value < low)
     too_high = high is not None and (value >= high if high_open else value > high)
     if too_low or too_high:
-        raise InputError(f"{what} {shown!r} must be {_range_text(low, high, low_open, high_open, unit)}")
+        raise InputError(f"{what} {shown} must be {_range_text(low, high, low_open, high_open, unit)}")
     return value
 
 
@@ -63,6 +64,7 @@ class _Ranged(click.ParamType):
     """Base of the numeric types: parse, then check the documented range."""
 
     unit = ""
+    quote = True  # lengths, speeds, percentages: show the typed text with its unit in quotes
 
     def __init__(self, low: float | None = None, high: float | None = None, *, low_open: bool = False,
                  high_open: bool = False) -> None:
@@ -75,7 +77,7 @@ class _Ranged(click.ParamType):
         what = _flag(param)
         number = self.parse(value, what)
         return check_range(number, what=what, text=value, low=self.low, high=self.high, low_open=self.low_open,
-                           high_open=self.high_open, unit=self.unit)
+                           high_open=self.high_open, unit=self.unit, quote=self.quote)
 
     def get_metavar(self, param, ctx=None) -> str:
         return self.name.upper()
@@ -85,6 +87,7 @@ class Number(_Ranged):
     """A plain finite float (degrees, px, a fraction) within a documented range."""
 
     name = "number"
+    quote = False
 
     def __init__(self, low=None, high=None, *, unit: str = "", **kwargs) -> None:
         super().__init__(low, high, **kwargs)
@@ -101,6 +104,7 @@ class Integer(_Ranged):
     """An integer within a documented range."""
 
     name = "integer"
+    quote = False
 
     def parse(self, text, what: str) -> float:
         try:
