@@ -103,6 +103,7 @@ COMMANDS = {
     "laser": "fabrication.cli.laser_cmd:laser",
     "stream": "fabrication.cli.stream_cmd:stream",
     "preview": "fabrication.cli.preview_cmd:preview",
+    "studio": "fabrication.cli.studio_cmd:studio",
     "ports": "fabrication.cli.ports_cmd:ports",
     "emulator": "fabrication.cli.stream_cmd:emulator",
     "train-classifier": "fabrication.cli.train_cmd:train_classifier",

@@ -19,12 +19,27 @@ def done(message: str) -> None:
     click.echo(message)
 
 
-def read_drawing(path: str, options=None):
-    """Read a drawing from a raster image or SVG (`options`: a `VectorizeOptions`, default
-    ones if None), printing the vectorizer's warnings."""
-    from vectorize import VectorizeOptions, vectorize_file
+def read_drawing(path: str, *, multi: bool = False, threshold: float | None = None,
+                 blur: float = 0.0, classifier: str = "cnn", edits: str | None = None):
+    """Read a drawing from a raster image or SVG, printing the vectorizer's warnings.
 
-    result = vectorize_file(path, options or VectorizeOptions())
+    edits: path of an edits file (the studio's corrections) to replay.
+    """
+    from vectorize import VectorizeOptions, vectorize_file
+    from vectorize.edits import read_edits
+
+    replay = read_edits(edits) if edits is not None else None
+    result = vectorize_file(path, VectorizeOptions(multi=multi, threshold=threshold, blur=blur,
+                                                   classifier=classifier), edits=replay)
     for message in result.report.warnings:
         warn(message)
     return result.drawing
+
+
+def edits_option(function):
+    """The `--edits FILE` option: replay the studio's corrections of the vectorization."""
+    from fabrication.cli.options import InputFile
+
+    return click.option("--edits", "edits", default=None, type=InputFile(),
+                        help="Raster input: replay the corrections saved by `onestroke studio` "
+                             "(edits JSON; its threshold, blur and mode win over the flags).")(function)

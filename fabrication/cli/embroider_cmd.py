@@ -7,28 +7,11 @@ import time
 
 import click
 
-from fabrication.cli.common import console, done, warn
+from fabrication.cli.common import console, done, edits_option, warn
 from fabrication.cli.options import (Integer, Length, Number, drawing_input_options, input_argument,
                                      output_option, placement_options)
 from onestroke.errors import InputError
 from onestroke.paths import check_distinct
-
-
-
-# A design side this small (mm) given with --width/--height in a zigzag or arrows job is
-# worth a hint that --stitch-width is the stitch's width.
-SMALL_DESIGN_MM = 15.0
-
-# CLI option -> field name in the style options; which styles use it (for warnings).
-_STYLE_FIELDS = {
-    "stitch_length": ("stitch_length", "--stitch-length"),
-    "tolerance": ("tolerance", "--tolerance"),
-    "stitch_width": ("width", "--stitch-width"),
-    "spacing": ("spacing", "--spacing"),
-    "pull_comp": ("pull_compensation", "--pull-comp"),
-    "repeats": ("repeats", "--repeats"),
-    "arrow_size": ("size", "--arrow-size"),
-}
 
 
 @click.command()
@@ -41,7 +24,7 @@ _STYLE_FIELDS = {
               help="Hoop: 100x100 (4x4), 130x180 (5x7), 150x250, 160x260 (6x10), 200x200, or WxH in mm.")
 @click.option("--fit", is_flag=True, help="Scale the design down to fit the hoop instead of refusing it.")
 @click.option("--stitch-length", type=Length(0.1, 12.7), default=None,
-              help="Running/triple stitch and the arrows' centre walk, 0.1-12.7 mm, at least --min-stitch "
+              help="Running/triple stitch and the arrows' centre walk, 0.1-12.7 mm and at least --min-stitch "
                    "[default: 2.5mm].")
 @click.option("--tolerance", type=Length(0.1, 5.0), default=None,
               help="Largest chord-to-curve distance, 0.1-5 mm [default: 0.2mm].")
@@ -51,8 +34,8 @@ _STYLE_FIELDS = {
               help="Zigzag peak-to-peak spacing [0.4mm] or arrow spacing [5mm]; 0.1-50 mm.")
 @click.option("--pull-comp", type=Length(0.0, 2.0), default=None,
               help="Zigzag pull compensation added to the width, 0-2 mm [default: 0.2mm].")
-@click.option("--repeats", type=Integer(1, 5), default=None, help="Triple stitch: back-and-forth passes, 1-5 "
-                                                                  "[default: 1].")
+@click.option("--repeats", type=Integer(1, 5), default=None,
+              help="Triple stitch: back-and-forth passes, 1-5 [default: 1].")
 @click.option("--arrow-size", type=Length(0.1, 20.0), default=None,
               help="Arrows: arm length along the curve, 0.1-20 mm [default: 2mm].")
 @click.option("--min-stitch", type=Length(0.1, 3.0), default="0.3mm", show_default=True,
@@ -61,8 +44,8 @@ _STYLE_FIELDS = {
               help="Longest needle-down stitch per axis, 1-12.7 mm (never above the format's limit).")
 @click.option("--trim-distance", type=Length(0.0, 1000.0), default="3mm", show_default=True,
               help="Strokes further apart are joined by lock, trim and jump; 0-1000 mm.")
-@click.option("--lock", "lock_form", type=click.Choice(["half", "back_forth"]), default="half", show_default=True,
-              help="Lock/tack form.")
+@click.option("--lock", "lock_form", type=click.Choice(["half", "back_forth"]), default="half",
+              show_default=True, help="Lock/tack form.")
 @click.option("--color", "--colour", "color", default="#000000", show_default=True,
               help="Thread colour: #rrggbb or a name.")
 @click.option("--pes-version", type=Integer(1, 6), default=None,
@@ -74,63 +57,41 @@ _STYLE_FIELDS = {
 @click.option("--preview-width", type=Integer(64, 8000), default=1000, show_default=True,
               help="Preview width in px, 64-8000.")
 @drawing_input_options(prefix="Raster input: ")
-def embroider(source: str, output: str, style: str, placement, hoop: str, fit: bool, stitch_length: float | None,
-              tolerance: float | None, stitch_width: float | None, spacing: float | None, pull_comp: float | None,
-              repeats: int | None, arrow_size: float | None, min_stitch: float, max_stitch: float,
-              trim_distance: float, lock_form: str, color: str, pes_version: int | None, spm: float | None,
-              preview_path: str | None, preview_width: int, vectorize_options) -> None:
+@edits_option
+def embroider(source: str, output: str, style: str, size: float | None, width: float | None,
+              height: float | None, rotate: float, hoop: str, fit: bool, stitch_length: float | None,
+              tolerance: float | None, stitch_width: float | None, spacing: float | None,
+              pull_comp: float | None, repeats: int | None, arrow_size: float | None, min_stitch: float,
+              max_stitch: float, trim_distance: float, lock_form: str, color: str, pes_version: int | None,
+              spm: float | None, preview_path: str | None, preview_width: int, multi: bool,
+              threshold: float | None, blur: float, classifier: str, edits: str | None) -> None:
     """Sew SOURCE (PNG/JPG/SVG/JSON drawing) along its curve into an embroidery file."""
+    from fabrication.cli.job_options import embroidery_settings
     from fabrication.embroidery.canvas import check_preview_path
-    from fabrication.embroidery.export import PES_VERSIONS, write_embroidery
-    from fabrication.embroidery.locks import LockOptions
-    from fabrication.embroidery.pipeline import EmbroideryJob, embroider as embroider_drawing
-    from fabrication.embroidery.plan import PlanOptions, style_options
+    from fabrication.embroidery.export import write_embroidery
+    from fabrication.embroidery.pipeline import embroider as embroider_drawing
     from fabrication.embroidery.preview import PreviewOptions, render_stitch_preview
-    from fabrication.embroidery.thread import parse_color
-    from machines.hoops import load_embroidery_profile
 
     started = time.perf_counter()
     # Every option is checked before anything is read or written.
-    profile = load_embroidery_profile()
-    fmt = profile.format_for(output)
-    check_distinct(inputs=[("input", source)], outputs=[("output", output), ("--preview", preview_path)])
-    if pes_version is not None:
-        if fmt.extension != "pes":
-            raise InputError(f"--pes-version applies to .pes output only, not .{fmt.extension}")
-        if pes_version not in PES_VERSIONS:
-            raise InputError(f"--pes-version {pes_version} is not supported; use 1 or 6")
-    if preview_path is not None:
-        check_preview_path(preview_path)
-        preview_options = PreviewOptions(width=preview_width)
+    settings = embroidery_settings(
+        output=output, style=style, size=size, width=width, height=height, rotate=rotate, hoop=hoop, fit=fit,
+        stitch_length=stitch_length, tolerance=tolerance, stitch_width=stitch_width, spacing=spacing,
+        pull_comp=pull_comp, repeats=repeats, arrow_size=arrow_size, min_stitch=min_stitch,
+        max_stitch=max_stitch, trim_distance=trim_distance, lock_form=lock_form, color=color,
+        pes_version=pes_version, spm=spm)
+    check_distinct(inputs=[("input", source), ("--edits file", edits)],
+                   outputs=[("output", output), ("--preview", preview_path)])
     if stitch_length is not None and stitch_length < min_stitch:
         raise InputError(f"--stitch-length {stitch_length:g} mm is shorter than --min-stitch {min_stitch:g} mm, "
                          "so every stitch would be merged away; lengthen it or lower --min-stitch")
-    if stitch_length is not None and stitch_length > max_stitch:
-        raise InputError(f"--stitch-length {stitch_length:g} mm is longer than --max-stitch {max_stitch:g} mm")
-
-    lengths = {name: value for name, value in (("stitch_length", stitch_length), ("tolerance", tolerance),
-                                               ("stitch_width", stitch_width), ("spacing", spacing),
-                                               ("arrow_size", arrow_size), ("pull_comp", pull_comp),
-                                               ("repeats", repeats)) if value is not None}
-    style_values = {_STYLE_FIELDS[k][0]: v for k, v in lengths.items()}
-    stitch_options = style_options(style, **style_values)
-    unused = [_STYLE_FIELDS[k][1] for k in lengths
-              if _STYLE_FIELDS[k][0] not in type(stitch_options).__dataclass_fields__]
-    the_hoop = profile.hoop(hoop)
-    limit = min(max_stitch, fmt.max_stitch, profile.max_stitch)
-    plan_options = PlanOptions(style=stitch_options, lock=LockOptions(form=lock_form), min_stitch=min_stitch,
-                               max_stitch=limit, trim_distance=trim_distance, color=parse_color(color))
-    job = EmbroideryJob(placement=placement, hoop=the_hoop, fit=fit, plan=plan_options,
-                        stitches_per_minute=spm or profile.stitches_per_minute,
-                        trim_seconds=profile.trim_seconds)
-    for flag in unused:
-        warn(f"{flag} has no effect with --style {style}")
-    if style in ("zigzag", "arrows") and stitch_width is None:
-        # `--width 3mm` next to --style zigzag most likely meant the zigzag, not the design.
-        for flag, side in (("--width", placement.width), ("--height", placement.height)):
-            if side is not None and side < SMALL_DESIGN_MM:
-                warn(f"{flag} {side:g} mm sizes the whole design; the {style}'s own width is "
-                     f"--stitch-width")
+    if preview_path is not None:
+        check_preview_path(preview_path)
+        preview_options = PreviewOptions(width=preview_width)
+    job = settings.job
+    the_hoop = job.hoop
+    for message in settings.warnings:
+        warn(message)
 
     if source.lower().endswith(".json"):
         from vectorize.svg_write import drawing_from_json
@@ -140,7 +101,8 @@ def embroider(source: str, output: str, style: str, placement, hoop: str, fit: b
     else:
         from fabrication.cli.common import read_drawing
 
-        drawing = read_drawing(source, vectorize_options)
+        drawing = read_drawing(source, multi=multi, threshold=threshold, blur=blur, classifier=classifier,
+                               edits=edits)
     result = embroider_drawing(drawing, job)
     write_embroidery(result.plan, output, pes_version=pes_version)
     if preview_path is not None:

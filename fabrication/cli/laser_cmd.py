@@ -8,7 +8,7 @@ from pathlib import Path
 
 import click
 
-from fabrication.cli.common import console, done, warn
+from fabrication.cli.common import console, done, edits_option, warn
 from fabrication.cli.options import (Integer, Length, Percent, Speed, drawing_input_options, input_argument,
                                      machine_options, output_option, placement_options)
 from onestroke.atomic import check_writable
@@ -56,51 +56,46 @@ def frame_path_for(output: str) -> str:
               help="Scan speed of that raster engraving; default: --feed (the same burn per mm).")
 @drawing_input_options(prefix="Raster input: ")
 @machine_options(port_help="After writing, stream the job to this serial port (sim:// for a dry run).")
-def laser(source: str, output: str, placement, origin: str, feed: float, power: float, passes: int,
-          tolerance: float, arcs: bool, keep_order: bool, air_assist: bool | None, return_home: bool, frame: bool,
-          frame_power: float, preview_path: str | None, raster_interval: float, raster_feed: float | None,
-          vectorize_options, port: str | None, baud: int, profile_path: str | None) -> None:
+@edits_option
+def laser(source: str, output: str, size: float | None, width: float | None, height: float | None, rotate: float,
+          origin: str, feed: float, power: float, passes: int, tolerance: float, arcs: bool, keep_order: bool,
+          air_assist: bool | None, return_home: bool, frame: bool, frame_power: float, preview_path: str | None,
+          raster_interval: float, raster_feed: float | None, multi: bool, threshold: float | None, blur: float,
+          classifier: str, port: str | None, baud: int, profile_path: str | None, edits: str | None) -> None:
     """Turn SOURCE (PNG/JPG/SVG) into G-code for a GRBL 1.1 laser in one continuous pass per stroke."""
     from fabrication.cli.common import read_drawing
+    from fabrication.cli.job_options import laser_settings
     from fabrication.laser.framing import framing_lines
-    from fabrication.laser.gcode_write import GcodeOptions, comment_line, gcode_lines, write_gcode
-    from fabrication.laser.job_time import estimate_gcode_time, format_duration
+    from fabrication.laser.gcode_write import write_gcode
+    from fabrication.laser.job_time import format_duration
+    from fabrication.laser.program import laser_program
     from fabrication.laser.raster_time import raster_time
-    from fabrication.laser.toolpath import ToolpathOptions, plan_toolpath
-    from machines.laser_profile import load_laser_profile
 
     started = time.perf_counter()
     # every option is checked before anything is read or written
     frame_file = frame_path_for(output) if frame else None
     if frame_file:
         check_writable(frame_file)
-    check_distinct(inputs=[("input", source), ("--profile", profile_path)],
+    check_distinct(inputs=[("input", source), ("--profile", profile_path), ("--edits file", edits)],
                    outputs=[("output", output), ("--preview", preview_path), ("frame file", frame_file)])
-    feed_mm, power_fraction, frame_fraction, tol, interval = feed, power, frame_power, tolerance, raster_interval
+    settings = laser_settings(size=size, width=width, height=height, rotate=rotate, origin=origin, feed=feed,
+                              power=power, passes=passes, tolerance=tolerance, arcs=arcs, keep_order=keep_order,
+                              profile_path=profile_path, air_assist=air_assist, return_home=return_home)
+    profile = settings.profile
+    frame_fraction = frame_power / 100.0
+    interval = raster_interval
+    feed_mm = settings.gcode.feed
     raster_feed_mm = feed_mm if raster_feed is None else raster_feed
-    profile = load_laser_profile(profile_path)
-    toolpath_options = ToolpathOptions(placement=placement, origin=origin, tolerance=tol, arcs=arcs,
-                                       optimize=not keep_order)
-    gcode_options = GcodeOptions(feed=feed_mm, power=power_fraction, passes=passes, return_home=return_home,
-                                 air_assist=air_assist)
-    if feed_mm > min(profile.max_rate_x, profile.max_rate_y):
-        warn(f"--feed {feed_mm:g} mm/min is above the profile's max rate; GRBL will cap it")
+    for message in settings.warnings:
+        warn(message)
 
     with console.status(f"reading {os.path.basename(source)}"):
-        drawing = read_drawing(source, vectorize_options)
+        drawing = read_drawing(source, multi=multi, threshold=threshold, blur=blur, classifier=classifier,
+                               edits=edits)
     with console.status("planning the toolpath"):
-        toolpath = plan_toolpath(drawing, profile, toolpath_options)
-        lines = gcode_lines(toolpath, profile, gcode_options)
-        job = estimate_gcode_time(lines, profile)
+        program = laser_program(drawing, profile, settings.toolpath, settings.gcode, name=Path(source).name)
+    toolpath, job, lines = program.toolpath, program.time, list(program.lines)
     w, h = toolpath.size
-    comments = (
-        f"onestroke laser: {Path(source).name}",
-        f"{w:.1f} x {h:.1f} mm, {len(toolpath.paths)} stroke(s), {passes} pass(es)",
-        f"feed {feed_mm:g} mm/min, power {power_fraction * 100:g}% (S{power_fraction * profile.max_power:g})",
-        f"estimated time {format_duration(job.total_seconds)} (GRBL planner model)",
-        f"profile: {profile.name}",
-    )
-    lines = [comment_line(c) for c in comments] + lines
     frame_lines = framing_lines(toolpath.bounds, profile, power=frame_fraction) if frame_file else None
     # everything that can refuse the input runs before the first file is written
     raster = raster_time(toolpath, profile, interval=interval, feed=raster_feed_mm)

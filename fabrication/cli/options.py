@@ -5,12 +5,12 @@ Every command spells and checks an option the same way. Values are checked while
 parses the command line, before any file is read or written; a bad value raises
 `InputError` (one line, exit 2) naming the flag and its documented range. This module
 imports no numpy or library package at import time: `onestroke --help` and the start of
-every command stay fast; the library's option objects are built when the command runs.
+every command stay fast. Values come back in the library's units (mm, mm/min, percent),
+which `onestroke.units` and `job_options` read back unchanged.
 """
 
 from __future__ import annotations
 
-import functools
 import math
 import os
 from collections.abc import Callable
@@ -137,17 +137,14 @@ class Speed(_Ranged):
 
 
 class Percent(_Ranged):
-    """A percentage ("60%", a bare number is percent), returned as a fraction in [0, 1]."""
+    """A percentage ("60%"; a bare number is percent), returned in percent (0-100), which
+    `onestroke.units.parse_fraction` reads back as the same value."""
 
     name = "percent"
+    unit = "%"
 
     def parse(self, text, what: str) -> float:
         return units.parse_fraction(text, what=what) * 100.0
-
-    def convert(self, value, param, ctx):
-        return super().convert(value, param, ctx) / 100.0
-
-    unit = "%"
 
 
 class InputFile(click.ParamType):
@@ -230,25 +227,6 @@ def _apply(function: Callable, decorators: list[Callable]) -> Callable:
     return function
 
 
-def _grouped(names: tuple[str, ...], target: str, build: Callable[..., object],
-             decorators: list[Callable]) -> Callable:
-    """Declare `decorators`' options and hand the command one object, `target`, built from them
-    by `build(**values)` when the command runs (after parsing, before any work)."""
-
-    def decorate(function: Callable) -> Callable:
-        @functools.wraps(function)
-        def wrapper(*args, **kwargs):
-            values = {name: kwargs.pop(name) for name in names}
-            kwargs[target] = build(**values)
-            return function(*args, **kwargs)
-
-        wrapper.__dict__.pop("__click_params__", None)
-        wrapper.__click_params__ = list(getattr(function, "__click_params__", []))
-        return _apply(wrapper, decorators)
-
-    return decorate
-
-
 def input_argument(name: str = "source", **kwargs) -> Callable:
     """The drawing or file a command reads: must exist and be a readable file."""
     return click.argument(name, type=InputFile(), **kwargs)
@@ -261,17 +239,12 @@ def output_option(*suffixes: str, help: str, required: bool = True, flags: tuple
     return click.option(*names, required=required, default=None, type=OutputFile(suffixes), help=help)
 
 
-def _vectorize_options(*, multi: bool, threshold: float | None, blur: float, classifier: str):
-    from vectorize.pipeline import VectorizeOptions
-
-    return VectorizeOptions(multi=multi, threshold=threshold, blur=blur, classifier=classifier)
-
-
 def drawing_input_options(function: Callable | None = None, *, prefix: str = "") -> Callable:
     """--multi, --threshold, --blur, --classifier: how a raster drawing is vectorized.
 
-    The command receives `vectorize_options` (a `vectorize.VectorizeOptions`).
-    `prefix` (e.g. "Raster input: ") starts each help text on commands that also read SVG.
+    The command receives `multi`, `threshold` (None or in (0, 1)), `blur` (px) and
+    `classifier`, as `common.read_drawing` takes them. `prefix` (e.g. "Raster input: ")
+    starts each help text on commands that also read SVG.
     """
     def text(words: str) -> str:
         return prefix + words if prefix else words[0].upper() + words[1:]
@@ -288,30 +261,21 @@ def drawing_input_options(function: Callable | None = None, *, prefix: str = "")
         click.option("--classifier", type=click.Choice(["cnn", "geometric"]), default="cnn", show_default=True,
                      help=text("how crossings are told from touchings.")),
     ]
-    decorate = _grouped(("multi", "threshold", "blur", "classifier"), "vectorize_options", _vectorize_options,
-                        decorators)
+    def decorate(f: Callable) -> Callable:
+        return _apply(f, decorators)
+
     return decorate(function) if function is not None else decorate
 
 
-def _placement(*, default_size: float | None, size: float | None, width: float | None, height: float | None,
-               rotate: float):
-    from fabrication.placement import PlacementOptions
-
-    if size is None and width is None and height is None:
-        size = default_size
-    return PlacementOptions(size=size, width=width, height=height, rotate=rotate)
-
-
 def placement_options(default_size: str | None = None) -> Callable:
-    """--size, --width, --height, --rotate: where and how large the design is, in mm.
+    """--size, --width, --height, --rotate: how large the design is (mm) and its turn (degrees).
 
-    The command receives `placement` (a `fabrication.placement.PlacementOptions`);
-    `default_size` applies when none of the three sides is given.
+    The command receives `size`, `width`, `height` (mm or None) and `rotate`, as
+    `job_options` takes them; `default_size` is only named in the help (the job applies it).
     """
     side = Length(MIN_DESIGN_MM, MAX_DESIGN_MM)
-    default_mm = units.parse_length(default_size) if default_size else None
     shown = f" [default: {default_size}]" if default_size else ""
-    decorators = [
+    return lambda function: _apply(function, [
         click.option("--size", type=side, default=None,
                      help=f"Longest side of the design, e.g. 90mm, 3.5in ({MIN_DESIGN_MM:g} mm to "
                           f"{MAX_DESIGN_MM / 1000:g} m){shown}."),
@@ -319,9 +283,7 @@ def placement_options(default_size: str | None = None) -> Callable:
         click.option("--height", type=side, default=None, help="Height of the design instead of --size."),
         click.option("--rotate", type=Number(-360.0, 360.0, unit=" degrees"), default=0.0, show_default=True,
                      help="Degrees counter-clockwise, -360 to 360."),
-    ]
-    return _grouped(("size", "width", "height", "rotate"), "placement",
-                    functools.partial(_placement, default_size=default_mm), decorators)
+    ])
 
 
 def machine_options(*, port_required: bool = False, port_help: str | None = None) -> Callable:

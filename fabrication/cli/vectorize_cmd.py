@@ -2,14 +2,14 @@
 
 from __future__ import annotations
 
-import dataclasses
 import os
 import time
 
 import click
 
-from fabrication.cli.common import console, done, warn
+from fabrication.cli.common import console, done, edits_option, warn
 from fabrication.cli.options import drawing_input_options, input_argument, output_option
+from onestroke.errors import InputError
 from onestroke.paths import check_distinct
 
 
@@ -19,20 +19,23 @@ from onestroke.paths import check_distinct
 @drawing_input_options
 @click.option("--debug", "debug_dir", type=click.Path(file_okay=False, path_type=str), default=None,
               help="Write a PNG overlay of every stage into this folder.")
-def vectorize(source: str, output: str, vectorize_options, debug_dir: str | None) -> None:
+@edits_option
+def vectorize(source: str, output: str, multi: bool, threshold: float | None, blur: float,
+              classifier: str, debug_dir: str | None, edits: str | None) -> None:
     """Vectorize SOURCE into one ordered cubic Bézier curve (or several with --multi)."""
-    check_distinct(inputs=[("input", source)], outputs=[("output", output)])
+    check_distinct(inputs=[("input", source), ("--edits file", edits)], outputs=[("output", output)])
     if debug_dir is not None and os.path.exists(debug_dir) and not os.path.isdir(debug_dir):
-        from onestroke.errors import InputError
-
         raise InputError(f"--debug {debug_dir!r} is a file; give a folder for the stage images")
-    from vectorize import vectorize_file
+    from vectorize import VectorizeOptions, vectorize_file
+    from vectorize.edits import read_edits
     from vectorize.svg_write import write_drawing
 
+    replay = read_edits(edits) if edits is not None else None
     started = time.perf_counter()
-    options = dataclasses.replace(vectorize_options, keep_stages=debug_dir is not None)
+    options = VectorizeOptions(multi=multi, threshold=threshold, blur=blur, classifier=classifier,
+                               keep_stages=debug_dir is not None)
     with console.status(f"vectorizing {os.path.basename(source)}"):
-        result = vectorize_file(source, options)
+        result = vectorize_file(source, options, edits=replay)
     for message in result.report.warnings:
         warn(message)
     write_drawing(result.drawing, output)
