@@ -113,6 +113,7 @@ export function createPlayer(root, input, options = {}) {
   let d = null, time = 0, playing = false, speed = 1, last = null, frameId = 0;
   let inkUpTo = -1, dirtyView = true, scrubbing = false;
   const view = { scale: 1, ox: 0, oy: 0 };
+  const shift = { x: 0, y: 0 };  // pan not yet applied to the layers, device px
   let fitScale = 1;  // the scale "fit" chose: following the head only makes sense zoomed in
   let dpr = window.devicePixelRatio || 1;
 
@@ -237,6 +238,12 @@ export function createPlayer(root, input, options = {}) {
     if (resize()) { fit(); }
     const w = dom.canvas.width, h = dom.canvas.height;
     const i = rowAt(time);
+    if (!dirtyView && (shift.x || shift.y)) {
+      for (const c of [ghostCtx, inkCtx]) {
+        c.save(); c.globalCompositeOperation = "copy"; c.drawImage(c.canvas, shift.x, shift.y); c.restore();
+      }
+    }
+    shift.x = shift.y = 0;
     if (dirtyView) {
       ghostCtx.clearRect(0, 0, w, h);
       drawRows(ghostCtx, 0, d.n - 1, { plain: "rgba(0,0,0,0.09)" });
@@ -364,10 +371,14 @@ export function createPlayer(root, input, options = {}) {
   dom.canvas.addEventListener("pointerdown", (e) => { drag = { x: e.clientX, y: e.clientY }; dom.canvas.setPointerCapture(e.pointerId); });
   dom.canvas.addEventListener("pointermove", (e) => {
     if (!drag) return;
-    view.ox += (e.clientX - drag.x) * dpr; view.oy += (e.clientY - drag.y) * dpr;
-    drag = { x: e.clientX, y: e.clientY }; dirtyView = true; request();
+    const dx = (e.clientX - drag.x) * dpr, dy = (e.clientY - drag.y) * dpr;
+    view.ox += dx; view.oy += dy; shift.x += dx; shift.y += dy;
+    drag = { x: e.clientX, y: e.clientY }; request();
   });
-  dom.canvas.addEventListener("pointerup", () => { drag = null; });
+  // while dragging the layers only slide; one full redraw when the drag ends
+  for (const end of ["pointerup", "pointercancel"]) {
+    dom.canvas.addEventListener(end, () => { if (drag) { drag = null; dirtyView = true; request(); } });
+  }
   root.tabIndex = 0;
   root.addEventListener("keydown", (e) => {
     if (e.target instanceof HTMLInputElement && e.target.type !== "checkbox" && e.key !== " ") return;
