@@ -162,6 +162,9 @@ def print_tables(rows: list[dict]) -> None:
     print(_fmt_header())
     for (set_name, classifier), rs in groups.items():
         print(_fmt_row({"set": set_name, "classifier": classifier, **_summary(rs)}))
+    if len({r["set"] for r in rows} & {"hershey", "hershey-retrace"}) == 2:
+        both = [r for r in rows if r["set"] in ("hershey", "hershey-retrace") and r["classifier"] == "cnn"]
+        print(_fmt_row({"set": "hershey+retr", "classifier": "cnn", **_summary(both)}))
     if len({r["set"] for r in rows} & {"plain", "hershey"}) == 2:
         main = [r for r in rows if r["set"] in ("plain", "hershey") and r["classifier"] == "cnn"]
         if main:

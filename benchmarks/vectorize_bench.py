@@ -170,7 +170,7 @@ def _run_one(index: int, classifier: str, oracle: bool, conn) -> None:
         row.update(seconds=seconds, peak_mb=peak, memory_method=method, strokes=scores.stroke_count,
                    ssim=scores.ssim, psnr=scores.psnr, length_ratio=scores.length_ratio,
                    gt_intersections=scores.gt_intersections, out_intersections=scores.out_intersections, matched=scores.matched,
-                   order=scores.order, order_correct=scores.correct, **_ink_row(gt, output, image, scores),
+                   order=scores.order, order_correct=scores.correct, **_ink_row(gt, output, scores),
                    warnings=" | ".join(report.warnings) if report is not None else "")
     except BaseException as exc:  # noqa: BLE001 - a failing drawing is a result, not a crash
         row["error"] = f"{type(exc).__name__}: {exc}".replace("\n", " ")[:300]
@@ -179,10 +179,10 @@ def _run_one(index: int, classifier: str, oracle: bool, conn) -> None:
     conn.close()
 
 
-def _ink_row(gt, output, image: np.ndarray, scores) -> dict:
+def _ink_row(gt, output, scores) -> dict:
     """Excursion figures and the verdict: the order score's, or for a drawing whose order cannot
     be read from the ink (meta "fair") the fair-retrace rule's (docs/benchmark.md)."""
-    ink = ink_scores(gt, output, image, order_tolerance(gt.width))
+    ink = ink_scores(gt, output, order_tolerance(gt.width))
     fair = bool(gt.meta.get("fair"))
     correct = scores.correct or (fair and ink.fair_ok and scores.undetected == 0)
     return {"excursion": ink.excursion, "excursion_w": ink.excursion_widths, "within": ink.within, "uncovered": ink.uncovered, "fair": fair,
