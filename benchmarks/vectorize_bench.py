@@ -47,7 +47,7 @@ if str(ROOT) not in sys.path:
 import numpy as np  # noqa: E402
 
 from benchmarks.conditions import CONDITIONS, condition_image  # noqa: E402
-from benchmarks.bench_tables import PSNR_CAP, print_tables  # noqa: E402
+from benchmarks.bench_tables import PSNR_CAP, print_failures, print_tables  # noqa: E402
 from benchmarks.drawings import generate_set  # noqa: E402
 from benchmarks.hershey import hershey_set  # noqa: E402
 from benchmarks.ink_metrics import ink_pieces, ink_scores  # noqa: E402
@@ -185,7 +185,9 @@ def _ink_row(gt, output, scores) -> dict:
     ink = ink_scores(gt, output, order_tolerance(gt.width))
     fair = bool(gt.meta.get("fair"))
     correct = scores.correct or (fair and ink.fair_ok and scores.undetected == 0)
-    return {"excursion": ink.excursion, "excursion_w": ink.excursion_widths, "within": ink.within, "uncovered": ink.uncovered, "fair": fair,
+    return {"excursion": ink.excursion, "excursion_w": ink.excursion_widths, "within": ink.within,
+            "uncovered": ink.uncovered, "cover_tolerance": order_tolerance(gt.width), "fair": fair,
+            "out_length": output.length, "min_length": gt.meta.get("min_length", float("nan")),
             "correct": bool(correct)}
 
 
@@ -425,6 +427,7 @@ def main(argv: list[str] | None = None) -> int:
 
     rows = run_tasks(jobs, args.ground_truth_as_output, max(1, args.jobs), args.timeout, progress)
     print_tables(rows)
+    print_failures(rows)
     errors = [r for r in rows if r.get("error")]
     if errors:
         print()
@@ -435,6 +438,7 @@ def main(argv: list[str] | None = None) -> int:
         keys = ["set", "classifier", "name", "kind", "width", "closed", "strokes", "order", "correct", "ssim",
                 "psnr", "length_ratio", "gt_intersections", "out_intersections", "matched", "seconds",
                 "peak_mb", "order_correct", "fair", "one_piece", "excursion", "excursion_w", "within", "uncovered",
+                "cover_tolerance", "out_length", "min_length",
                 "error", "warnings"]
         args.csv.parent.mkdir(parents=True, exist_ok=True)
         with open(args.csv, "w", newline="") as fh:
