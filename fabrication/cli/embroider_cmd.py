@@ -29,7 +29,24 @@ _STYLE_FIELDS = {
     "pull_comp": ("pull_compensation", "--pull-comp"),
     "repeats": ("repeats", "--repeats"),
     "arrow_size": ("size", "--arrow-size"),
+    "underlay": ("underlay", "--underlay"),
 }
+
+
+def source_date() -> str:
+    """JEF's date: SOURCE_DATE_EPOCH (reproducible builds) when set, else a fixed value."""
+    import datetime
+
+    from fabrication.embroidery.plan import FIXED_DATE
+
+    value = os.environ.get("SOURCE_DATE_EPOCH")
+    if value is None or not value.strip():
+        return FIXED_DATE
+    try:
+        moment = datetime.datetime.fromtimestamp(int(value), tz=datetime.timezone.utc)
+    except (ValueError, OverflowError, OSError):
+        raise InputError(f"SOURCE_DATE_EPOCH {value!r} is not a number of seconds since 1970") from None
+    return moment.strftime("%Y%m%d%H%M%S")
 
 
 @click.command()
@@ -54,6 +71,10 @@ _STYLE_FIELDS = {
 @click.option("--pull-comp", default=None, help="Zigzag pull compensation added to the width [default: 0.2mm].")
 @click.option("--repeats", type=int, default=None, help="Triple stitch: back-and-forth passes [default: 1].")
 @click.option("--arrow-size", default=None, help="Arrows: arm length along the curve [default: 2mm].")
+@click.option("--underlay", default=None,
+              help="Zigzag underlay: center, edge, zigzag or none [default: center when wider than 1.5mm].")
+@click.option("--min-stroke", default="1mm", show_default=True,
+              help="Shorter strokes join a neighbour within --trim-distance by travel stitches, or are left out.")
 @click.option("--min-stitch", default="0.3mm", show_default=True,
               help="Shorter stitches are merged away (locks excepted).")
 @click.option("--max-stitch", default="12.1mm", show_default=True,
@@ -61,14 +82,24 @@ _STYLE_FIELDS = {
 @click.option("--trim-distance", default="3mm", show_default=True,
               help="Strokes further apart are joined by lock, trim and jump.")
 @click.option("--lock", "lock_form", default="half", show_default=True, help="Lock/tack form: half or back_forth.")
-@click.option("--color", "--colour", "color", default="#000000", show_default=True,
-              help="Thread colour: #rrggbb or a name.")
+@click.option("--color", "--colour", "color", default=None,
+              help="Thread colour (#rrggbb or a name), or a comma-separated list, one per stroke in "
+                   "drawing order [default: the SVG's stroke colours, else black].")
+@click.option("--thread-chart", default=None,
+              help="Pick the nearest thread of a catalogue pyembroidery ships: brother, janome, "
+                   "husqvarna, viking, janome-sew.")
+@click.option("--name", "design_name", default=None, help="Design name stored in .pes/.dst [default: input file stem].")
+@click.option("--start", default=None,
+              help="Where sewing starts: X,Y in mm from the design centre (y down), or 'reverse'.")
 @click.option("--pes-version", type=int, default=None,
               help="PES version: 6 (default; keeps RGB colours) or 1 (Brother's 64-colour palette).")
 @click.option("--spm", type=float, default=None, help="Machine speed in stitches per minute [default: 600].")
 @click.option("--preview", "preview_path", default=None, type=click.Path(path_type=str),
               help="Also write a preview image (.png or .svg).")
 @click.option("--preview-width", type=int, default=1000, show_default=True, help="Preview width in px.")
+@click.option("--preview-style", default="realistic", show_default=True,
+              help="realistic (thread on fabric) or diagnostic (needle points, jumps, trims, order).")
+@click.option("--preview-hoop", is_flag=True, help="Draw the hoop in the preview (the diagnostic style always does).")
 @click.option("--multi", is_flag=True, help="Raster input: multi-stroke vectorization.")
 @click.option("--threshold", type=float, default=None, help="Raster input: ink threshold in (0, 1).")
 @click.option("--blur", type=float, default=0.0, show_default=True, help="Raster input: Gaussian blur sigma in px.")
@@ -77,10 +108,12 @@ _STYLE_FIELDS = {
 def embroider(source: str, output: str, style: str, size: str | None, width: str | None, height: str | None,
               rotate: float, hoop: str, fit: bool, stitch_length: str | None, tolerance: str | None,
               stitch_width: str | None, spacing: str | None, pull_comp: str | None, repeats: int | None,
-              arrow_size: str | None, min_stitch: str, max_stitch: str, trim_distance: str, lock_form: str,
-              color: str, pes_version: int | None, spm: float | None, preview_path: str | None,
-              preview_width: int, multi: bool, threshold: float | None, blur: float,
-              classifier: str) -> None:
+              arrow_size: str | None, underlay: str | None, min_stroke: str, min_stitch: str,
+              max_stitch: str, trim_distance: str, lock_form: str, color: str | None,
+              thread_chart: str | None, design_name: str | None, start: str | None,
+              pes_version: int | None, spm: float | None, preview_path: str | None,
+              preview_width: int, preview_style: str, preview_hoop: bool, multi: bool,
+              threshold: float | None, blur: float, classifier: str) -> None:
     """Sew SOURCE (PNG/JPG/SVG/JSON drawing) along its curve into an embroidery file."""
     from fabrication.embroidery.canvas import check_preview_path
     from fabrication.embroidery.export import PES_VERSIONS, write_embroidery
@@ -88,7 +121,8 @@ def embroider(source: str, output: str, style: str, size: str | None, width: str
     from fabrication.embroidery.pipeline import EmbroideryJob, embroider as embroider_drawing
     from fabrication.embroidery.plan import PlanOptions, style_options
     from fabrication.embroidery.preview import PreviewOptions, render_stitch_preview
-    from fabrication.embroidery.thread import parse_color
+    from fabrication.embroidery.order import parse_start
+    from fabrication.embroidery.thread import check_chart, parse_colors
     from fabrication.placement import PlacementOptions
     from machines.hoops import load_embroidery_profile
     from onestroke.units import parse_length, parse_positive_length
@@ -106,7 +140,8 @@ def embroider(source: str, output: str, style: str, size: str | None, width: str
     if preview_path is not None:
         check_preview_path(preview_path)
         check_writable(preview_path)
-        preview_options = PreviewOptions(width=preview_width)
+        preview_options = PreviewOptions(width=preview_width, style=preview_style,
+                                         hoop=preview_hoop or preview_style == "diagnostic")
     if not os.path.isfile(source):
         raise InputError(f"input file {source!r} does not exist")
 
@@ -120,6 +155,8 @@ def embroider(source: str, output: str, style: str, size: str | None, width: str
         lengths["pull_comp"] = parse_length(pull_comp, what="--pull-comp")
     if repeats is not None:
         lengths["repeats"] = repeats
+    if underlay is not None:
+        lengths["underlay"] = underlay
     style_values = {_STYLE_FIELDS[k][0]: v for k, v in lengths.items()}
     stitch_options = style_options(style, **style_values)
     unused = [_STYLE_FIELDS[k][1] for k in lengths
@@ -137,12 +174,17 @@ def embroider(source: str, output: str, style: str, size: str | None, width: str
                                min_stitch=parse_positive_length(min_stitch, what="--min-stitch"),
                                max_stitch=limit,
                                trim_distance=parse_length(trim_distance, what="--trim-distance"),
-                               color=parse_color(color))
+                               min_stroke=parse_length(min_stroke, what="--min-stroke"),
+                               colors=parse_colors(color) if color is not None else (),
+                               thread_chart=check_chart(thread_chart) if thread_chart else None,
+                               start=parse_start(start) if start is not None else None)
     if spm is not None and not spm > 0:
         raise InputError(f"--spm {spm:g} must be greater than zero")
     job = EmbroideryJob(placement=placement, hoop=the_hoop, fit=fit, plan=plan_options,
                         stitches_per_minute=spm or profile.stitches_per_minute,
-                        trim_seconds=profile.trim_seconds)
+                        trim_seconds=profile.trim_seconds,
+                        name=design_name if design_name is not None else os.path.splitext(os.path.basename(source))[0],
+                        date=source_date())
     for flag in unused:
         warn(f"{flag} has no effect with --style {style}")
     if style in ("zigzag", "arrows") and stitch_width is None:
@@ -166,6 +208,9 @@ def embroider(source: str, output: str, style: str, size: str | None, width: str
     if preview_path is not None:
         render_stitch_preview(result.plan, preview_path, hoop=the_hoop, stats=result.stats,
                               options=preview_options)
+    if color is not None and len(plan_options.colors) > len(result.drawing.strokes):
+        warn(f"--color lists {len(plan_options.colors)} colours for {len(result.drawing.strokes)} "
+             "stroke(s); the extra colours are unused")
 
     for message in result.warnings:
         warn(message)

@@ -9,11 +9,13 @@ import numpy as np
 import pyembroidery
 
 from fabrication.embroidery.needles import BODY
-from fabrication.embroidery.plan import JUMP, STITCH, TRIM, StitchPlan
+from fabrication.embroidery.plan import COLOR, JUMP, STITCH, TRIM, StitchPlan
+from fabrication.embroidery.thread import Thread
 from onestroke.errors import InputError
 
-# pyembroidery commands that end a run of thread like a trim does.
-_CUTS = (pyembroidery.TRIM, pyembroidery.COLOR_CHANGE, pyembroidery.NEEDLE_SET, pyembroidery.STOP)
+# pyembroidery commands that end a run of thread like a trim does, and thread changes.
+_CUTS = (pyembroidery.TRIM, pyembroidery.STOP)
+_CHANGES = (pyembroidery.COLOR_CHANGE, pyembroidery.NEEDLE_SET)
 
 
 @dataclass(frozen=True, eq=False)
@@ -53,15 +55,25 @@ def read_embroidery(path: str | os.PathLike) -> EmbroideryFile:
     kinds[command == pyembroidery.STITCH] = STITCH
     kinds[command == pyembroidery.JUMP] = JUMP
     kinds[np.isin(command, _CUTS)] = TRIM
+    changes = np.isin(command, _CHANGES)
+    # A file's first NEEDLE_SET picks the first thread; it is not a change.
+    first_stitch = int(np.argmax(command == pyembroidery.STITCH)) if (command == pyembroidery.STITCH).any() else 0
+    changes[:first_stitch] = False
+    kinds[changes] = COLOR
     keep = kinds != 255
     if not (kinds == STITCH).any():
         raise InputError(f"{path!r} holds no stitches pyembroidery can read")
-    changes = int(np.isin(command, (pyembroidery.COLOR_CHANGE, pyembroidery.NEEDLE_SET)).sum())
+    blocks = np.cumsum(changes)[keep]
     points, kinds = rows[keep, :2] / 10.0, kinds[keep]
     params = np.linspace(0.0, 1.0, len(points)) if len(points) > 1 else np.zeros(len(points))
     params[kinds != STITCH] = np.nan
-    threads = tuple(tuple(int(v) for v in (t.get_red(), t.get_green(), t.get_blue()))
-                    for t in pattern.threadlist) or ((0, 0, 0),)
+    threads = tuple(Thread(color=(t.get_red(), t.get_green(), t.get_blue()),
+                           number=t.catalog_number or None, name=t.description or None,
+                           chart=t.chart or t.brand or None) for t in pattern.threadlist)
+    # Files without colours (DST, EXP) get black thread for every block.
+    need = int(blocks.max()) + 1 if len(blocks) else 1
+    threads = (threads + (Thread(color=(0, 0, 0)),) * need)[:max(need, len(threads))]
     plan = StitchPlan(points=points, kinds=kinds, roles=np.full(len(points), BODY, dtype=np.uint8),
-                      params=params, strokes=np.where(kinds == STITCH, 0, -1), color=threads[0])
-    return EmbroideryFile(plan=plan, threads=threads, color_changes=changes)
+                      params=params, strokes=np.where(kinds == STITCH, 0, -1), threads=threads,
+                      blocks=blocks)
+    return EmbroideryFile(plan=plan, threads=tuple(t.color for t in threads), color_changes=int(changes.sum()))
