@@ -9,23 +9,25 @@ import numpy as np
 import pyembroidery
 
 from fabrication.embroidery.needles import BODY
-from fabrication.embroidery.plan import COLOR, JUMP, STITCH, TRIM, StitchPlan
+from fabrication.embroidery.plan import JUMP, STITCH, TRIM, StitchPlan
 from fabrication.embroidery.thread import Thread
 from onestroke.errors import InputError
 
-# pyembroidery commands that end a run of thread like a trim does, and thread changes.
-_CUTS = (pyembroidery.TRIM, pyembroidery.STOP)
-_CHANGES = (pyembroidery.COLOR_CHANGE, pyembroidery.NEEDLE_SET)
+# pyembroidery commands that end a run of thread like a trim does.
+_CUTS = (pyembroidery.TRIM, pyembroidery.COLOR_CHANGE, pyembroidery.NEEDLE_SET, pyembroidery.STOP)
 
 
 @dataclass(frozen=True, eq=False)
 class EmbroideryFile:
     """A file read back: `plan` (rows as STITCH/JUMP/TRIM, params = progress 0..1),
-    `threads` (RGB per colour block) and `color_changes`."""
+    `threads` (RGB per colour block), `color_changes` and `blocks` (N,) int: the colour
+    block of each row of `plan` (0, 1, ...; a colour change row opens the next block; may
+    exceed len(threads) - 1 when a file, like DST, has more blocks than threads)."""
 
     plan: StitchPlan
     threads: tuple[tuple[int, int, int], ...]
     color_changes: int
+    blocks: np.ndarray
 
 
 def readable_extensions() -> tuple[str, ...]:
@@ -55,25 +57,18 @@ def read_embroidery(path: str | os.PathLike) -> EmbroideryFile:
     kinds[command == pyembroidery.STITCH] = STITCH
     kinds[command == pyembroidery.JUMP] = JUMP
     kinds[np.isin(command, _CUTS)] = TRIM
-    changes = np.isin(command, _CHANGES)
-    # A file's first NEEDLE_SET picks the first thread; it is not a change.
-    first_stitch = int(np.argmax(command == pyembroidery.STITCH)) if (command == pyembroidery.STITCH).any() else 0
-    changes[:first_stitch] = False
-    kinds[changes] = COLOR
     keep = kinds != 255
     if not (kinds == STITCH).any():
         raise InputError(f"{path!r} holds no stitches pyembroidery can read")
-    blocks = np.cumsum(changes)[keep]
+    is_change = np.isin(command, (pyembroidery.COLOR_CHANGE, pyembroidery.NEEDLE_SET))
+    changes = int(is_change.sum())
+    blocks = np.cumsum(is_change)[keep]
     points, kinds = rows[keep, :2] / 10.0, kinds[keep]
     params = np.linspace(0.0, 1.0, len(points)) if len(points) > 1 else np.zeros(len(points))
     params[kinds != STITCH] = np.nan
-    threads = tuple(Thread(color=(t.get_red(), t.get_green(), t.get_blue()),
-                           number=t.catalog_number or None, name=t.description or None,
-                           chart=t.chart or t.brand or None) for t in pattern.threadlist)
-    # Files without colours (DST, EXP) get black thread for every block.
-    need = int(blocks.max()) + 1 if len(blocks) else 1
-    threads = (threads + (Thread(color=(0, 0, 0)),) * need)[:max(need, len(threads))]
+    threads = tuple(tuple(int(v) for v in (t.get_red(), t.get_green(), t.get_blue()))
+                    for t in pattern.threadlist) or ((0, 0, 0),)
     plan = StitchPlan(points=points, kinds=kinds, roles=np.full(len(points), BODY, dtype=np.uint8),
-                      params=params, strokes=np.where(kinds == STITCH, 0, -1), threads=threads,
-                      blocks=blocks)
-    return EmbroideryFile(plan=plan, threads=tuple(t.color for t in threads), color_changes=int(changes.sum()))
+                      params=params, strokes=np.where(kinds == STITCH, 0, -1),
+                      threads=tuple(Thread(color=c) for c in threads), blocks=blocks)
+    return EmbroideryFile(plan=plan, threads=threads, color_changes=changes, blocks=blocks)
