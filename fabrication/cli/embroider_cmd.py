@@ -113,7 +113,7 @@ def embroider(source: str, output: str, style: str, size: str | None, width: str
         pull_comp=pull_comp, repeats=repeats, arrow_size=arrow_size, underlay=underlay,
         min_stroke=min_stroke, min_stitch=min_stitch, max_stitch=max_stitch, trim_distance=trim_distance,
         lock_form=lock_form, color=color, thread_chart=thread_chart, start=start,
-        name=design_name if design_name is not None else os.path.splitext(os.path.basename(source))[0],
+        name=design_name, source=source,
         date=source_date(), pes_version=pes_version, spm=spm)
     check_writable(output)
     if preview_path is not None:

@@ -7,6 +7,7 @@ Nothing here prints: warnings come back as one-line messages for the caller to s
 
 from __future__ import annotations
 
+import os
 from dataclasses import dataclass
 
 from onestroke.errors import InputError
@@ -68,12 +69,14 @@ def embroidery_settings(*, output: str, style: str = "running", size: str | None
                         underlay: str | None = None, min_stroke: str = "1mm",
                         min_stitch: str = "0.3mm", max_stitch: str = "12.1mm", trim_distance: str = "3mm",
                         lock_form: str = "half", color: str | None = None, thread_chart: str | None = None,
-                        start: str | None = None, name: str = "onestroke", date: str | None = None,
+                        start: str | None = None, name: str | None = None, source: str | None = None,
+                        date: str | None = None,
                         pes_version: int | None = None, spm: float | None = None) -> EmbroiderySettings:
     """The `EmbroideryJob` of `onestroke embroider`'s option values, for the format of `output`
     (a file name or just ".pes"); `InputError` naming the flag for a bad value. `color`: one
     colour or a comma-separated list (one per stroke); None keeps the drawing's colours.
-    `date`: YYYYMMDDhhmmss for JEF (None: the fixed default)."""
+    `name`: the design name files store (None: the stem of `source`, the input file, else
+    'onestroke'). `date`: YYYYMMDDhhmmss for JEF (None: the fixed default)."""
     from fabrication.embroidery.export import PES_VERSIONS
     from fabrication.embroidery.locks import LockOptions
     from fabrication.embroidery.pipeline import EmbroideryJob
@@ -123,7 +126,9 @@ def embroidery_settings(*, output: str, style: str = "running", size: str | None
         raise InputError(f"--spm {spm:g} must be greater than zero")
     job = EmbroideryJob(placement=placement, hoop=profile.hoop(hoop), fit=fit, plan=plan_options,
                         stitches_per_minute=spm or profile.stitches_per_minute,
-                        trim_seconds=profile.trim_seconds, name=name, date=date or FIXED_DATE)
+                        trim_seconds=profile.trim_seconds, date=date or FIXED_DATE,
+                        name=name if name is not None else
+                        (os.path.splitext(os.path.basename(source))[0] if source else "onestroke"))
     if style in ("zigzag", "arrows") and stitch_width is None:
         # `--width 3mm` next to --style zigzag most likely meant the zigzag, not the design.
         for flag, side in (("--width", placement.width), ("--height", placement.height)):
