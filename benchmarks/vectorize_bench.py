@@ -55,7 +55,8 @@ from benchmarks.metrics import ORDER_THRESHOLD, evaluate, order_tolerance  # noq
 from benchmarks.relief import relief_set  # noqa: E402
 from benchmarks.render import render, to_uint8  # noqa: E402
 
-DEFAULT_COUNTS = {"plain": 42, "touch": 40, "hershey": 40, "hershey-retrace": 40, "relief": 40, "triple": 40}
+DEFAULT_COUNTS = {"plain": 42, "touch": 40, "hershey": 40, "hershey-retrace": 40, "relief": 40, "triple": 40,
+                  "handwriting": 40}
 SETS = tuple(DEFAULT_COUNTS)
 
 

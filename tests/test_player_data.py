@@ -69,6 +69,9 @@ def test_embroidery_page_matches_the_file(tmp_path, ext):
     change = int(np.flatnonzero(kinds == COLOR)[0])
     assert set(data["color"][:change]) == {data["color"][0]} and set(data["color"][change:]) == {data["color"][-1]}
     assert first != last
+    threads = ["#%02x%02x%02x" % (t.get_red(), t.get_green(), t.get_blue()) for t in pattern.threadlist]
+    if threads:  # the threads the file names (DST and EXP name none: filler colours)
+        assert data["palette"] == threads[:len(data["palette"])]
     if ext in ("vp3",):  # RGB kept exactly
         assert (first, last) == ("#%02x%02x%02x" % RED, "#%02x%02x%02x" % BLUE)
 
@@ -149,3 +152,37 @@ def test_script_cannot_end_early():
     plan = plan_embroidery(design(), PlanOptions(style=style_options("running")))
     html = player_html(stitch_player_data(plan, title="</script><script>alert(1)</script>"))
     assert html.count("</script>") == 2
+
+
+def test_raster_drawing_is_vectorized_then_played(tmp_path):
+    """A .png is vectorized with the defaults: one stroke for loops.png, played along its length."""
+    from vectorize import VectorizeOptions, vectorize_file
+
+    out = tmp_path / "loops.html"
+    result = _preview("examples/loops.png", "-o", out)
+    assert result.exit_code == 0, result.output
+    data = page_data(out.read_text(encoding="utf-8"))
+    drawing = vectorize_file("examples/loops.png", VectorizeOptions()).drawing
+    assert data["source"] == "drawing" and data["unit"] == "px"
+    assert data["numberTotal"] == len(drawing.strokes) == 1
+    assert data["total"] == pytest.approx(drawing.length, rel=1e-12)
+
+
+def test_gcode_dwell_is_a_pause_and_hoop_is_the_frame(tmp_path):
+    from fabrication.player import gcode_player_data
+
+    lines = ["G21 G90", "M4 S500", "G1 X10 Y0 F600", "G4 P2", "G1 X20", "M5", "G0 X0 Y0"]
+    profile = load_laser_profile()
+    data = gcode_player_data(lines, profile=profile)
+    job = estimate_gcode_time(lines, profile)
+    assert data.total == job.total_seconds and data.times[-1] == pytest.approx(job.total_seconds)
+    np.testing.assert_array_equal(data.numbers, [3, 3, 5, 7])  # start, X10, X20, back home
+    np.testing.assert_array_equal(data.kinds, [TRAVEL, DRAW, DRAW, TRAVEL])
+    # 10 mm at 600 mm/min is at least 1 s; the G4 P2 adds 2 s before the second burn starts
+    assert data.times[1] >= 1.0 and data.times[2] - data.times[1] >= 2.0 + 1.0
+
+    source = tmp_path / "two.pes"
+    write_pattern(source)
+    out = tmp_path / "two.html"
+    assert _preview(source, "-o", out, "--hoop", "100x100").exit_code == 0
+    assert page_data(out.read_text(encoding="utf-8"))["frame"] == [-50.0, -50.0, 50.0, 50.0]

@@ -14,7 +14,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from onestroke.errors import InputError
+from onestroke.errors import FabricationError, InputError
 
 # Row kinds (the JS player uses the same numbers).
 DRAW = 0      # needle, beam or pen down: a line from the previous point, in the row's colour
@@ -66,9 +66,9 @@ class PlayerData:
             raise InputError(f"{self.title!r} holds nothing to play")
         for name in ("kinds", "colors", "times", "numbers"):
             if len(getattr(self, name)) != n:
-                raise ValueError(f"PlayerData.{name} has {len(getattr(self, name))} rows, points {n}")
+                raise FabricationError(f"PlayerData.{name} has {len(getattr(self, name))} rows, points {n}")
         if len(self.palette) == 0 or int(np.max(self.colors)) >= len(self.palette):
-            raise ValueError("PlayerData.colors index past the palette")
+            raise FabricationError("PlayerData.colors index past the palette")
 
     def __len__(self) -> int:
         return len(self.points)

@@ -14,6 +14,12 @@ const KIND_TEXT = {
   gcode: ["burn", "travel", "-", "-", "-"],
   drawing: ["pen down", "pen up", "-", "-", "-"],
 };
+const LEGEND = {
+  embroidery: ["── stitches in their thread colour", "┄┄ jump (needle up)", "× trim", "◆ colour change",
+               "▪ needle points (zoomed in)", "○ needle: red sewing, blue moving"],
+  gcode: ["── burn, coloured first → last", "┄┄ travel, laser off", "○ laser head: red burning, blue moving"],
+  drawing: ["── pen, coloured start → end", "┄┄ pen up to the next stroke", "○ pen"],
+};
 const SPEEDS = [0.1, 0.25, 0.5, 1, 2, 5, 10, 20, 50, 100, 200, 500, 1000, 2000, 5000];
 const SCRUB_STEPS = 100000;
 const PLAY_SECONDS = 20;  // default speed plays the whole job in about this long
@@ -64,7 +70,9 @@ function buildDom(root) {
     time: el("span", { class: "osp-value", "data-role": "time" }),
     kind: el("span", { class: "osp-value", "data-role": "kind" }),
     swatch: el("span", { class: "osp-swatch", "data-role": "swatch" }),
-    canvas: el("canvas", { class: "osp-canvas", "data-role": "canvas" }),
+    canvas: el("canvas", { class: "osp-canvas", "data-role": "canvas", role: "img",
+                           "aria-label": "the job played in order" }),
+    where: el("span", { class: "osp-value osp-where", "data-role": "position" }),
     info: el("ul", { class: "osp-info", "data-role": "info" }),
     play: el("button", { type: "button", "data-role": "play", title: "play / pause (space)", text: "▶ Play" }),
     back: el("button", { type: "button", "data-role": "back", title: "previous move (←)", text: "◀ step" }),
@@ -77,25 +85,23 @@ function buildDom(root) {
     fit: el("button", { type: "button", "data-role": "fit", title: "fit the design", text: "fit" }),
     travel: el("input", { type: "checkbox", "data-role": "show-travel", checked: "" }),
     ghost: el("input", { type: "checkbox", "data-role": "show-all", checked: "" }),
+    follow: el("input", { type: "checkbox", "data-role": "follow", checked: "" }),
   };
   dom.numberLabel = el("span", { class: "osp-label" });
   dom.timeLabel = el("span", { class: "osp-label", text: "time" });
   const readout = el("div", { class: "osp-readout" }, [
     dom.numberLabel, dom.number, dom.timeLabel, dom.time,
-    dom.swatch, dom.kind]);
-  const legend = el("ul", { class: "osp-legend" }, [
-    el("li", { text: "── thread / burn / pen, in its colour" }),
-    el("li", { text: "┄┄ travel: jump, rapid, pen up" }),
-    el("li", { class: "osp-trim", text: "× trim   ◆ colour change" }),
-    el("li", { text: "○ needle / laser head / pen" })]);
+    dom.swatch, dom.kind, dom.where]);
+  dom.legend = el("ul", { class: "osp-legend", "data-role": "legend" });
   dom.stage = el("div", { class: "osp-stage" }, [dom.canvas]);
   root.append(
     el("div", { class: "osp-head" }, [dom.title, readout]),
-    el("div", { class: "osp-main" }, [dom.stage, el("aside", { class: "osp-side" }, [dom.info, legend])]),
+    el("div", { class: "osp-main" }, [dom.stage, el("aside", { class: "osp-side" }, [dom.info, dom.legend])]),
     el("div", { class: "osp-controls" }, [
       dom.back, dom.play, dom.next, dom.scrub, el("label", {}, ["speed ", speed]),
       dom.zoomOut, dom.zoomIn, dom.fit,
-      el("label", {}, [dom.travel, " travel"]), el("label", {}, [dom.ghost, " whole design"])]));
+      el("label", {}, [dom.travel, " travel"]), el("label", {}, [dom.ghost, " whole design"]),
+      el("label", { title: "when zoomed in, keep the head in view" }, [dom.follow, " follow"])]));
   return dom;
 }
 
@@ -107,6 +113,8 @@ export function createPlayer(root, input, options = {}) {
   let d = null, time = 0, playing = false, speed = 1, last = null, frameId = 0;
   let inkUpTo = -1, dirtyView = true, scrubbing = false;
   const view = { scale: 1, ox: 0, oy: 0 };
+  const shift = { x: 0, y: 0 };  // pan not yet applied to the layers, device px
+  let fitScale = 1;  // the scale "fit" chose: following the head only makes sense zoomed in
   let dpr = window.devicePixelRatio || 1;
 
   const sx = (i) => view.ox + d.x[i] * view.scale;
@@ -151,6 +159,14 @@ export function createPlayer(root, input, options = {}) {
     }
     flush();
     if (plain) return;
+    if (d.source === "embroidery" && view.scale >= 8) {
+      // zoomed in: the needle penetrations, where the thread goes through the fabric
+      const r = 2 * dpr;
+      c.fillStyle = "rgba(0,0,0,0.7)";
+      for (let i = from; i <= to; i++) {
+        if (d.kind[i] === DRAW || d.kind[i] === DOWN) c.fillRect(sx(i) - r, sy(i) - r, 2 * r, 2 * r);
+      }
+    }
     if (dom.travel.checked) {
       c.save();
       c.strokeStyle = "rgba(110,110,110,0.7)"; c.lineWidth = dpr; c.setLineDash([4 * dpr, 4 * dpr]);
@@ -203,7 +219,7 @@ export function createPlayer(root, input, options = {}) {
     }
     const w = dom.canvas.width, h = dom.canvas.height, pad = 0.05;
     const bw = Math.max(xmax - xmin, 1e-6), bh = Math.max(ymax - ymin, 1e-6);
-    view.scale = Math.min(w / (bw * (1 + 2 * pad)), h / (bh * (1 + 2 * pad)));
+    view.scale = fitScale = Math.min(w / (bw * (1 + 2 * pad)), h / (bh * (1 + 2 * pad)));
     view.ox = w / 2 - (xmin + bw / 2) * view.scale;
     view.oy = h / 2 - (ymin + bh / 2) * view.scale;
     dirtyView = true; request();
@@ -222,6 +238,12 @@ export function createPlayer(root, input, options = {}) {
     if (resize()) { fit(); }
     const w = dom.canvas.width, h = dom.canvas.height;
     const i = rowAt(time);
+    if (!dirtyView && (shift.x || shift.y)) {
+      for (const c of [ghostCtx, inkCtx]) {
+        c.save(); c.globalCompositeOperation = "copy"; c.drawImage(c.canvas, shift.x, shift.y); c.restore();
+      }
+    }
+    shift.x = shift.y = 0;
     if (dirtyView) {
       ghostCtx.clearRect(0, 0, w, h);
       drawRows(ghostCtx, 0, d.n - 1, { plain: "rgba(0,0,0,0.09)" });
@@ -255,6 +277,12 @@ export function createPlayer(root, input, options = {}) {
         ctx.beginPath(); ctx.moveTo(px, py); ctx.lineTo(hx, hy); ctx.stroke(); ctx.restore();
       }
     }
+    // zoomed in and the head is leaving the view: bring it back to the centre
+    if (playing && dom.follow.checked && view.scale > fitScale * 1.01
+        && (hx < 0.1 * w || hx > 0.9 * w || hy < 0.1 * h || hy > 0.9 * h)) {
+      view.ox += w / 2 - hx; view.oy += h / 2 - hy; dirtyView = true;
+      return render();
+    }
     const active = j < d.n ? d.kind[j] === DRAW : false;
     ctx.save(); ctx.lineWidth = 2 * dpr; ctx.strokeStyle = active ? "#e53935" : "#1e88e5";
     ctx.beginPath(); ctx.arc(hx, hy, 7 * dpr, 0, 2 * Math.PI);
@@ -268,6 +296,8 @@ export function createPlayer(root, input, options = {}) {
     dom.time.textContent = `${formatTime(time, d.timeUnit)} / ${formatTime(d.total, d.timeUnit)}`;
     dom.kind.textContent = (KIND_TEXT[d.source] || KIND_TEXT.drawing)[d.kind[shownRow]] || "";
     dom.swatch.style.background = d.palette[d.color[shownRow]];
+    const wx = (hx - view.ox) / view.scale, wy = (hy - view.oy) / view.scale;
+    dom.where.textContent = `x ${wx.toFixed(1)} y ${(d.yUp ? -wy : wy).toFixed(1)} ${d.unit}`;
     if (!scrubbing) dom.scrub.value = String(Math.round(d.total > 0 ? time / d.total * SCRUB_STEPS : 0));
     dom.play.textContent = playing ? "❚❚ Pause" : "▶ Play";
     root.dataset.index = String(i);
@@ -310,6 +340,7 @@ export function createPlayer(root, input, options = {}) {
       dom.numberLabel.textContent = d.numberLabel;
       dom.timeLabel.textContent = d.timeUnit === "s" ? "time" : "drawn";
       dom.info.replaceChildren(...d.info.map((line) => el("li", { text: line })));
+      dom.legend.replaceChildren(...(LEGEND[d.source] || LEGEND.drawing).map((line) => el("li", { text: line })));
       const want = d.total / PLAY_SECONDS;
       api.setSpeed(SPEEDS.find((s) => s >= want) || SPEEDS[SPEEDS.length - 1]);
       time = Math.min(time, d.total); inkUpTo = -1;
@@ -340,10 +371,14 @@ export function createPlayer(root, input, options = {}) {
   dom.canvas.addEventListener("pointerdown", (e) => { drag = { x: e.clientX, y: e.clientY }; dom.canvas.setPointerCapture(e.pointerId); });
   dom.canvas.addEventListener("pointermove", (e) => {
     if (!drag) return;
-    view.ox += (e.clientX - drag.x) * dpr; view.oy += (e.clientY - drag.y) * dpr;
-    drag = { x: e.clientX, y: e.clientY }; dirtyView = true; request();
+    const dx = (e.clientX - drag.x) * dpr, dy = (e.clientY - drag.y) * dpr;
+    view.ox += dx; view.oy += dy; shift.x += dx; shift.y += dy;
+    drag = { x: e.clientX, y: e.clientY }; request();
   });
-  dom.canvas.addEventListener("pointerup", () => { drag = null; });
+  // while dragging the layers only slide; one full redraw when the drag ends
+  for (const end of ["pointerup", "pointercancel"]) {
+    dom.canvas.addEventListener(end, () => { if (drag) { drag = null; dirtyView = true; request(); } });
+  }
   root.tabIndex = 0;
   root.addEventListener("keydown", (e) => {
     if (e.target instanceof HTMLInputElement && e.target.type !== "checkbox" && e.key !== " ") return;
