@@ -139,10 +139,7 @@ def process_file(name: str, job: BatchJob, *, path: str | None = None, data: byt
 
 
 def _named(job, name: str):
-    """The job with the design name `onestroke embroider` gives this input (its file stem),
-    for embroidery jobs that store one in the file."""
-    if "name" not in getattr(job, "__dataclass_fields__", {}):
-        return job
+    """The job with the design name `onestroke embroider` gives this input: its file stem."""
     return dataclasses.replace(job, name=os.path.splitext(os.path.basename(name))[0])
 
 
