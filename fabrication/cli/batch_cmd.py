@@ -58,7 +58,7 @@ def _progress():
     class RateColumn(ProgressColumn):
         def render(self, task) -> Text:
             speed = task.finished_speed or task.speed
-            return Text(f"{speed:.2f} files/s" if speed else "-- files/s")
+            return Text(f"{speed:.2f} drawings/s" if speed else "-- drawings/s")
 
     return Progress(TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(), RateColumn(),
                     TextColumn("left"), TimeRemainingColumn(), console=console, transient=True)
