@@ -8,6 +8,8 @@ client process) to write, which is what lets it run unchanged on a Dask worker e
 
 from __future__ import annotations
 
+import dataclasses
+
 import hashlib
 import os
 import signal
@@ -157,7 +159,9 @@ def _process(name: str, path: str, job: BatchJob, wanted: tuple[str, ...], start
             from fabrication.embroidery.pipeline import embroider
             from machines.hoops import format_for_path
 
-            sewn = embroider(drawing, target.job)
+            # The design name files store is the input's stem, as `onestroke embroider` writes it.
+            job_for_file = dataclasses.replace(target.job, name=os.path.splitext(os.path.basename(name))[0])
+            sewn = embroider(drawing, job_for_file)
             fmt = format_for_path(f"x.{extension}")
             outputs.append((extension, embroidery_bytes(sewn.plan, fmt, pes_version=target.pes_version)))
             warnings += [w for w in sewn.warnings if w not in warnings]
