@@ -83,7 +83,8 @@ def test_previews(client):
     stitches = client.post("/api/embroidery", json={"edits": state["edits"], "options": {"size": "60mm"}}).json()
     assert stitches["stitches"] > 50 and any(line.startswith("stitches") for line in stitches["stats"])
     laser = client.post("/api/laser", json={"edits": state["edits"], "options": {"size": "50mm"}}).json()
-    assert laser["seconds"] > 0 and len(laser["paths"]) == 1
+    assert laser["seconds"] > 0 and laser["player"]["source"] == "gcode" and laser["player"]["n"] > 10
+    assert stitches["player"]["source"] == "embroidery" and stitches["player"]["numberTotal"] > 50
     refused = client.post("/api/embroidery", json={"edits": state["edits"], "options": {"size": "-3mm"}})
     assert refused.status_code == 400 and "--size" in refused.json()["error"]
 

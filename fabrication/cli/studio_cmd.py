@@ -47,5 +47,7 @@ def studio(source: str, port: int, no_browser: bool, edits_path: str | None, pro
     try:
         while server.thread.is_alive():
             time.sleep(0.5)
+    except KeyboardInterrupt:
+        console.print("studio stopped")
     finally:
         server.stop()

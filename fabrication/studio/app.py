@@ -28,6 +28,8 @@ from vectorize.edits import Edits, edits_from_dict
 MAX_BODY = 1 << 20  # 1 MiB: an edits list and option values are a few kB
 COOKIE = "onestroke_studio"
 STATIC = {"app.js": "text/javascript", "style.css": "text/css", "index.html": "text/html"}
+# The toolpath player's files, served from its own package (`fabrication.player`).
+PLAYER = {"player.js": "text/javascript", "player.css": "text/css"}
 IMAGE_TYPES = {".png": "image/png", ".jpg": "image/jpeg", ".jpeg": "image/jpeg", ".svg": "image/svg+xml",
                ".gif": "image/gif", ".webp": "image/webp"}
 
@@ -123,6 +125,10 @@ def create_app(session: StudioSession, *, token: str, hosts: set[str]) -> Guard:
 
     async def static(request: Request):
         name = request.path_params["name"]
+        if name in PLAYER:
+            from fabrication.player import asset_text
+
+            return Response(asset_text(name), media_type=PLAYER[name])
         if name not in STATIC:
             return PlainTextResponse("not found", status_code=404)
         return Response(_static(name), media_type=STATIC[name])

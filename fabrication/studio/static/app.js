@@ -1,6 +1,7 @@
 // onestroke studio: the page. Plain JS, no build step; every computation is the server's
 // (the library's), the page only draws, keeps the edits history and sends edits back.
 "use strict";
+import { createPlayer } from "./player.js";
 
 const TOKEN = new URLSearchParams(location.search).get("token") || "";
 const PAIRINGS = ["crossing", "touching", "third"];
@@ -171,6 +172,7 @@ function draw() {
   });
   junctionMarkers(g);
   if (studio.pen < 1 || studio.playing) penMarker(g, t, penAt);
+  else $("where").textContent = `${Math.round(t.total)} px, ${s.strokes.length} stroke${s.strokes.length === 1 ? "" : "s"}`;
 }
 
 function arrows(g, t) {
@@ -383,60 +385,22 @@ async function refreshPanel() {
   }
 }
 
-function previewCanvas(id) {
-  const c = $(id), dpr = window.devicePixelRatio || 1;
-  c.width = Math.round(c.clientWidth * dpr); c.height = Math.round(c.clientHeight * dpr);
-  const g = c.getContext("2d");
-  g.setTransform(dpr, 0, 0, dpr, 0, 0);
-  g.clearRect(0, 0, c.clientWidth, c.clientHeight);
-  return [g, c.clientWidth, c.clientHeight];
+// Stitches and laser moves play in the project's player (fabrication/player), one per panel.
+const players = {};
+function showPlayer(kind, data) {
+  if (!players[kind]) players[kind] = createPlayer($(`${kind}-player`), data);
+  else players[kind].load(data);
+  studio.players = players;
 }
 
 function showStitches(data) {
-  const [g, w, h] = previewCanvas("stitches");
-  const hw = data.hoop.width, hh = data.hoop.height;
-  const k = 0.92 * Math.min(w / hw, h / hh);
-  const X = (x) => w / 2 + x * k, Y = (y) => h / 2 + y * k;  // hoop centred on (0, 0), +y down
-  g.strokeStyle = "#bbb"; g.setLineDash([4, 4]); g.strokeRect(X(-hw / 2), Y(-hh / 2), hw * k, hh * k); g.setLineDash([]);
-  const pts = data.points, kinds = data.kinds;
-  g.lineWidth = 1.2;
-  for (let i = 1; i < pts.length; i++) {
-    if (kinds[i] === data.trim) {
-      g.strokeStyle = "#d32f2f"; const [x, y] = [X(pts[i][0]), Y(pts[i][1])];
-      g.beginPath(); g.moveTo(x - 3, y - 3); g.lineTo(x + 3, y + 3); g.moveTo(x + 3, y - 3); g.lineTo(x - 3, y + 3); g.stroke();
-      continue;
-    }
-    const jump = kinds[i] !== data.stitch || kinds[i - 1] !== data.stitch;
-    g.strokeStyle = jump ? "rgba(120,120,120,0.6)" : data.color;
-    g.setLineDash(jump ? [3, 3] : []);
-    g.beginPath(); g.moveTo(X(pts[i - 1][0]), Y(pts[i - 1][1])); g.lineTo(X(pts[i][0]), Y(pts[i][1])); g.stroke();
-  }
-  g.setLineDash([]);
-  g.fillStyle = "#333";
-  for (let i = 0; i < pts.length; i += Math.max(1, Math.floor(pts.length / 4000))) {
-    if (kinds[i] === data.stitch) g.fillRect(X(pts[i][0]) - 0.6, Y(pts[i][1]) - 0.6, 1.2, 1.2);
-  }
+  showPlayer("embroidery", data.player);
   $("embroidery-stats").textContent = data.stats.join("\n");
   $("embroidery-warnings").innerHTML = data.warnings.map((m) => `<li>${escapeHtml(m)}</li>`).join("");
 }
 
 function showToolpath(data) {
-  const [g, w, h] = previewCanvas("toolpath");
-  const [x0, y0, x1, y1] = data.bounds;
-  const m = 0.08 * Math.max(x1 - x0, y1 - y0, 1);
-  const k = Math.min(w / (x1 - x0 + 2 * m), h / (y1 - y0 + 2 * m));
-  const X = (x) => (x - x0 + m) * k, Y = (y) => h - (y - y0 + m) * k;  // machine +y up
-  let last = [0, 0];
-  const n = data.paths.length;
-  data.paths.forEach((path, i) => {
-    g.strokeStyle = "rgba(120,120,120,0.7)"; g.setLineDash([3, 3]); g.lineWidth = 1;
-    g.beginPath(); g.moveTo(X(last[0]), Y(last[1])); g.lineTo(X(path[0][0]), Y(path[0][1])); g.stroke();
-    g.setLineDash([]); g.lineWidth = 1.6; g.strokeStyle = hue(n > 1 ? i / (n - 1) : 0);
-    g.beginPath(); g.moveTo(X(path[0][0]), Y(path[0][1]));
-    for (const p of path) g.lineTo(X(p[0]), Y(p[1]));
-    g.stroke();
-    last = path[path.length - 1];
-  });
+  showPlayer("laser", data.player);
   $("laser-time").textContent = `estimated ${data.time} (GRBL planner model; length/feed says ${data.naive}) · ` +
     `burn ${data.burn_length} mm, travel ${data.travel_length} mm · ${data.lines} lines`;
   $("laser-warnings").innerHTML = data.warnings.map((m) => `<li>${escapeHtml(m)}</li>`).join("");
