@@ -145,3 +145,17 @@ def test_send_pause_resume_abort(client):
         time.sleep(0.05)
         status = client.get("/api/send").json()
     assert status["state"] == "aborted" and status["acked"] < status["total"], status
+
+
+def test_an_svg_drawing_opens_and_exports(drawing, tmp_path):
+    from vectorize import vectorize_file
+    from vectorize.svg_write import write_drawing
+
+    svg = tmp_path / "loop.svg"
+    write_drawing(vectorize_file(drawing).drawing, svg)
+    app = create_app(StudioSession(svg), token=TOKEN, hosts={HOST})
+    with TestClient(app, base_url=f"http://{HOST}", headers={"X-Studio-Token": TOKEN}) as svg_client:
+        state = svg_client.get("/api/state").json()
+        assert state["report"]["strokes"] == 1 and state["graph"]["junctions"] == []
+        assert svg_client.get("/api/image").headers["content-type"].startswith("image/svg+xml")
+        assert svg_client.post("/api/export/svg", json={}).content.startswith(b"<?xml")
