@@ -404,7 +404,7 @@ function showStitches(data) {
 function showToolpath(data) {
   showPlayer("laser", data.player);
   $("laser-time").textContent = `estimated ${data.time} (GRBL planner model; length/feed says ${data.naive}) · ` +
-    `burn ${data.burn_length} mm, travel ${data.travel_length} mm · ${data.lines} lines`;
+    `burn ${data.burn_length} mm, travel ${data.travel_length} mm · ${data.lines} lines · profile: ${data.profile}`;
   $("laser-warnings").innerHTML = data.warnings.map((m) => `<li>${escapeHtml(m)}</li>`).join("");
 }
 
