@@ -27,7 +27,8 @@ from vectorize.edits import Edits, edits_from_dict
 
 MAX_BODY = 1 << 20  # 1 MiB: an edits list and option values are a few kB
 COOKIE = "onestroke_studio"
-STATIC = {"app.js": "text/javascript", "style.css": "text/css", "index.html": "text/html"}
+STATIC = {"app.js": "text/javascript", "api.js": "text/javascript", "panels.js": "text/javascript",
+          "style.css": "text/css", "index.html": "text/html"}
 # The toolpath player's files, served from its own package (`fabrication.player`).
 PLAYER = {"player.js": "text/javascript", "player.css": "text/css"}
 IMAGE_TYPES = {".png": "image/png", ".jpg": "image/jpeg", ".jpeg": "image/jpeg", ".svg": "image/svg+xml",
