@@ -44,6 +44,7 @@ const players = {};
 function showPlayer(kind, data) {
   if (!players[kind]) players[kind] = createPlayer($(`${kind}-player`), data);
   else players[kind].load(data);
+  players[kind].seek(data.total);  // the finished job first; Play starts it from the beginning
   window.studio.players = players;
 }
 
