@@ -28,43 +28,23 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from machines.gcode_interpreter import GcodeError, GcodeInterpreter, MachineConfig
-from machines.grbl_protocol import MAX_LINE_CHARS
-from machines.planner_model import Block, BlockBuilder, Kinematics, block_durations, exit_speed, trapezoid
+from machines.grbl_protocol import MAX_LINE_CHARS, clean_line
+from machines.grbl_settings import FIRMWARE_DEFAULTS, INTEGER_SETTINGS, settings_from_profile
+from machines.laser_profile import load_laser_profile
+from machines.planner_model import Block, BlockBuilder, Kinematics, exit_speed, plan_times, trapezoid
 
 VERSION = "1.1h"
 BUILD_DATE = "20190825"
 
-# GRBL 1.1h defaults for what a laser profile does not describe.
-_FIRMWARE_DEFAULTS: dict[int, float] = {
-    0: 10, 1: 25, 2: 0, 3: 0, 4: 0, 5: 0, 6: 0, 10: 1, 11: 0.010, 12: 0.002, 13: 0,
-    20: 0, 21: 0, 22: 0, 23: 0, 24: 25.0, 25: 500.0, 26: 250, 27: 1.0,
-    30: 1000, 31: 0, 32: 1,
-    100: 80.0, 101: 80.0, 102: 250.0, 110: 6000.0, 111: 6000.0, 112: 500.0,
-    120: 500.0, 121: 500.0, 122: 10.0, 130: 400.0, 131: 400.0, 132: 0.0,
-}
-
-
-def settings_from_profile(profile) -> dict[int, float]:
-    """`$$` settings of the machine a `LaserProfile` describes (firmware defaults elsewhere)."""
-    return {**_FIRMWARE_DEFAULTS, 11: profile.junction_deviation, 12: profile.arc_tolerance,
-            30: profile.max_power, 32: float(profile.laser_mode), 100: profile.steps_per_mm_x,
-            101: profile.steps_per_mm_y, 110: profile.max_rate_x, 111: profile.max_rate_y,
-            120: profile.acceleration_x, 121: profile.acceleration_y, 130: profile.bed_width,
-            131: profile.bed_height}
-
-
 def _default_settings() -> dict[int, float]:
     # The emulated machine is the default laser profile's machine (profiles are data).
     try:
-        from machines.laser_profile import load_laser_profile
-
         return settings_from_profile(load_laser_profile())
     except Exception:  # noqa: BLE001 - a broken profile file must not break the emulator
-        return dict(_FIRMWARE_DEFAULTS)
+        return dict(FIRMWARE_DEFAULTS)
 
 
 DEFAULT_SETTINGS: dict[int, float] = _default_settings()
-_INT_SETTINGS = {0, 1, 2, 3, 4, 5, 6, 10, 13, 20, 21, 22, 23, 26, 32}
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -194,8 +174,9 @@ class GrblEmulator:
             self.eeprom_lost = 0
             self.max_rx = 0
             self.resets = 0
-            self._ref_items: list = []
-            self._ref_builder = BlockBuilder(kin)
+            # every move executed, for the planner-limited time: (start, target, feed, rapid, stop)
+            self._ref_moves: list[tuple] = []
+            self._ref_dwell = 0.0
             self._ref_rest = True
             self._first_motion: float | None = None
             self._last_motion: float | None = None
@@ -295,7 +276,8 @@ class GrblEmulator:
     def stats(self) -> EmulatorStats:
         """A snapshot of the counters; the planner-limited time is computed here."""
         with self._cond:
-            items = list(self._ref_items)
+            moves = list(self._ref_moves)
+            dwell = self._ref_dwell
             motion = 0.0
             if self._first_motion is not None and self._last_motion is not None:
                 motion = float(self._last_motion - self._first_motion) * self.scale
@@ -304,7 +286,10 @@ class GrblEmulator:
                           eeprom_lost_bytes=self.eeprom_lost, max_rx_used=self.max_rx, state=self.state,
                           spindle=self.spindle_mode, spindle_s=self.spindle_s, resets=self.resets,
                           alarms=tuple(self.alarms))
-        limited = float(block_durations(items, window=self.options.planner_blocks).sum())
+        limited = dwell
+        if moves:
+            start, end, feed, rapid, stop = (np.array(column) for column in zip(*moves))
+            limited += float(plan_times(start, end, feed.astype(float), rapid, stop, self.kin).sum())
         return EmulatorStats(planner_limited_time=limited, **result)
 
     def wait_idle(self, timeout: float = 10.0) -> bool:
@@ -557,31 +542,9 @@ class GrblEmulator:
                             return line
                 self._cond.wait(0.05)
 
-    @staticmethod
-    def _strip(raw: bytes) -> tuple[str, bool]:
-        """GRBL's character filter: drop spaces, control bytes and comments; upper-case."""
-        out: list[str] = []
-        comment = ""
-        overflow = False
-        for byte in raw:
-            ch = chr(byte)
-            if comment:
-                if comment == "(" and ch == ")":
-                    comment = ""
-                continue
-            if byte <= 0x20 or ch == "/":
-                continue
-            if ch in "(;":
-                comment = ch
-            elif len(out) >= MAX_LINE_CHARS:
-                overflow = True
-            else:
-                out.append(ch.upper())
-        return "".join(out), overflow
-
     def _handle_line(self, raw: bytes) -> None:
-        text, overflow = self._strip(raw)
-        if overflow:
+        text = clean_line(raw.decode("latin-1"))
+        if len(text) > MAX_LINE_CHARS:
             self._reply("error:11")
             return
         if not text:
@@ -632,14 +595,14 @@ class GrblEmulator:
                     self._queue_move(action, number)
                 elif kind == "sync":
                     if not self.check_mode:
-                        self._ref_items.append(None)
                         self._ref_rest = True
                         self._wait(lambda: not self.planner and not self._motion_busy)
                 elif kind == "eeprom":
                     self._eeprom_write()
                 elif kind == "dwell":
                     if not self.check_mode:
-                        self._ref_items.append(float(action[1]))
+                        self._ref_dwell += float(action[1])
+                        self._ref_rest = True
                         deadline = time.monotonic() + action[1] / self.scale
                         self._wait(lambda: time.monotonic() >= deadline)
                 elif kind == "spindle":
@@ -653,7 +616,10 @@ class GrblEmulator:
                     if not self.check_mode:
                         self.hold, self.hold_complete = True, True
                 elif kind == "alarm":
-                    self._soft_limit()
+                    if action[1] == 5:
+                        self._probe_fail()
+                    else:
+                        self._soft_limit()
                     return False
         return True
 
@@ -662,11 +628,10 @@ class GrblEmulator:
         start = self._planned_end()
         from_rest = not self.planner and not self._motion_busy
         block = self._builder.make(start, target, feed_mm_min=feed, rapid=rapid, from_rest=from_rest)
-        ref = self._ref_builder.make(start, target, feed_mm_min=feed, rapid=rapid, from_rest=self._ref_rest)
+        self._ref_moves.append((tuple(start), tuple(target), np.nan if feed is None else feed, rapid, self._ref_rest))
+        self._ref_rest = False
         if block is None:
             return
-        self._ref_items.append(ref)
-        self._ref_rest = False
         self._adding = True
         try:
             self._wait(lambda: len(self.planner) < self.options.planner_blocks)
@@ -712,6 +677,17 @@ class GrblEmulator:
         self._reply("ALARM:2")
         self._reply("[MSG:Reset to continue]")
 
+    def _probe_fail(self) -> None:
+        """G38.2/G38.4 reached its target without touching anything (no probe here): ALARM:5."""
+        if not self.check_mode:
+            self._wait(lambda: not self.planner and not self._motion_busy)
+        self.spindle_mode, self.spindle_s = "M5", 0.0
+        self.spindle_history.append(("M5", 0.0))
+        self.alarm = True
+        self.alarms.append(5)
+        self._cond.notify_all()
+        self._reply("ALARM:5")
+
     def _unplug(self) -> None:
         """The USB cable is pulled: the board loses power (beam off) and the port vanishes."""
         with self._cond:
@@ -756,7 +732,7 @@ class GrblEmulator:
                 return self._reply("error:8")
             for number in sorted(self.settings):
                 value = self.settings[number]
-                shown = f"{int(value)}" if number in _INT_SETTINGS or number in (30, 31) else f"{value:.3f}"
+                shown = f"{int(value)}" if number in INTEGER_SETTINGS else f"{value:.3f}"
                 self._reply(f"${number}={shown}")
         elif text == "$I":
             self._reply(f"[VER:{VERSION}.{BUILD_DATE}:]")
@@ -833,7 +809,6 @@ class GrblEmulator:
                                         arc_tolerance=self.settings[12])
             self.interp.config = self.config
             self._builder = BlockBuilder(self.kin)
-            self._ref_builder = BlockBuilder(self.kin)
         self._reply("ok")
 
     def _eeprom_write(self) -> None:

@@ -62,13 +62,14 @@ def laser(source: str, output: str, size: str | None, width: str | None, height:
           classifier: str, port: str | None, baud: int) -> None:
     """Turn SOURCE (PNG/JPG/SVG) into G-code for a GRBL 1.1 laser in one continuous pass per stroke."""
     from fabrication.cli.common import read_drawing
-    from fabrication.laser.framing import framing_lines
     from fabrication.laser.gcode_write import GcodeOptions, comment_line, gcode_lines, write_gcode
-    from fabrication.laser.job_time import estimate_gcode_time, format_duration
     from fabrication.laser.raster_time import raster_time
     from fabrication.laser.toolpath import ToolpathOptions, plan_toolpath
     from fabrication.placement import PlacementOptions
+    from machines.framing import framing_lines
+    from machines.job_time import estimate_job_time, format_duration
     from machines.laser_profile import load_laser_profile
+    from onestroke.errors import OnestrokeError
     from onestroke.units import parse_fraction, parse_positive_length, parse_speed
 
     started = time.perf_counter()
@@ -121,17 +122,21 @@ def laser(source: str, output: str, size: str | None, width: str | None, height:
     with console.status("planning the toolpath"):
         toolpath = plan_toolpath(drawing, profile, toolpath_options)
         lines = gcode_lines(toolpath, profile, gcode_options)
-        job = estimate_gcode_time(lines, profile)
+        job = estimate_job_time(lines, profile)  # machines/ reads the G-code as GRBL will
+    if job.errors:  # the writer's bug, not the user's input: say so before writing anything
+        line, text = job.errors[0]
+        raise OnestrokeError(f"internal error: GRBL would refuse generated line {line}: {text}")
     w, h = toolpath.size
     comments = (
         f"onestroke laser: {Path(source).name}",
         f"{w:.1f} x {h:.1f} mm, {len(toolpath.paths)} stroke(s), {passes} pass(es)",
         f"feed {feed_mm:g} mm/min, power {power_fraction * 100:g}% (S{power_fraction * profile.max_power:g})",
-        f"estimated time {format_duration(job.total_seconds)} (GRBL planner model)",
+        f"estimated time {format_duration(job.total_seconds)} ({job.bound_text(profile)})",
         f"profile: {profile.name}",
     )
     lines = [comment_line(c) for c in comments] + lines
-    frame_lines = framing_lines(toolpath.bounds, profile, power=frame_fraction) if frame_file else None
+    frame_lines = framing_lines(toolpath.bounds, power_s=frame_fraction * profile.max_power,
+                                max_s=profile.max_power) if frame_file else None
     # everything that can refuse the input runs before the first file is written
     raster = raster_time(toolpath, profile, interval=interval, feed=raster_feed_mm)
     write_gcode(output, lines)
@@ -146,7 +151,7 @@ def laser(source: str, output: str, size: str | None, width: str | None, height:
         warn(f"{toolpath.dropped} stroke(s) of zero length left out")
     console.print(f"travel: {toolpath.travel_before:.1f} mm in drawing order -> {toolpath.travel_greedy:.1f} mm "
                   f"greedy -> {toolpath.travel_after:.1f} mm after 2-opt")
-    console.print(f"time: {format_duration(job.total_seconds)} by GRBL's planner model "
+    console.print(f"time: {format_duration(job.total_seconds)}, {job.bound_text(profile)} "
                   f"(length/feed says {format_duration(job.naive_seconds)}); as a raster at "
                   f"{interval:g} mm and {raster_feed_mm:g} mm/min: {format_duration(raster.seconds)}")
     made = [output] + ([frame_file] if frame_file else []) + ([preview_path] if preview_path else [])

@@ -14,12 +14,12 @@ import time
 from pathlib import Path
 
 import click
-import numpy as np
 from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
 
 from fabrication.cli.common import console, done, warn
-from fabrication.laser.job_time import format_duration
+from machines.framing import DEFAULT_FRAME_FEED, framing_lines
 from machines.gcode_program import Program, analyze_program, load_program, program_from_text
+from machines.job_time import estimate_program_time, format_duration
 from machines.job_check import check_job
 from machines.ports import open_port
 from machines.resume import resume_program
@@ -27,7 +27,6 @@ from machines.streamer import GrblStreamer, MachineInfo, StreamError, StreamProg
 from onestroke.errors import InputError, MachineError
 
 BAUD_RATES = (9600, 19200, 38400, 57600, 115200, 230400, 250000, 500000, 1000000)
-FRAME_FEED = 3000.0  # mm/min: slow enough to follow by eye
 
 
 def _format_seconds(seconds: float) -> str:
@@ -35,37 +34,12 @@ def _format_seconds(seconds: float) -> str:
     return format_duration(max(0.0, float(seconds)))
 
 
-def _line_seconds(path: Path, program: Program, info: MachineInfo, fallback: np.ndarray) -> np.ndarray:
-    """Cumulative planner-model seconds at the end of each program line, from the laser
-    helper's estimator when available (the same one `onestroke laser` prints), else from
-    `machines.planner_model` (what `fallback` holds)."""
-    try:
-        from fabrication.laser.job_time import estimate_gcode_time
-        from machines.laser_profile import LaserProfile
+def _machine_profile(info: MachineInfo, laser_profile):
+    """The connected machine as a profile: its `$$` settings over the given (or default) profile."""
+    from machines.grbl_settings import profile_from_settings
 
-        s = info.settings
-        default = LaserProfile()
-
-        def pick(number: int, value: float) -> float:
-            got = s.get(number)
-            return float(got) if got and got > 0 else value
-
-        profile = LaserProfile(
-            name="connected machine", bed_width=pick(130, default.bed_width), bed_height=pick(131, default.bed_height),
-            max_power=pick(30, default.max_power), laser_mode=bool(s.get(32, 1)),
-            max_rate_x=pick(110, default.max_rate_x), max_rate_y=pick(111, default.max_rate_y),
-            acceleration_x=pick(120, default.acceleration_x), acceleration_y=pick(121, default.acceleration_y),
-            junction_deviation=pick(11, default.junction_deviation), arc_tolerance=pick(12, default.arc_tolerance),
-            steps_per_mm_x=pick(100, default.steps_per_mm_x), steps_per_mm_y=pick(101, default.steps_per_mm_y),
-            rx_buffer=max(16, info.rx_buffer), planner_blocks=max(2, info.planner_blocks))
-        raw = path.read_text(encoding="utf-8").splitlines()
-        per_file_line = np.asarray(estimate_gcode_time(raw, profile).line_seconds, dtype=float)
-        index = np.array([number - 1 for number, _ in program.lines], dtype=int)
-        if len(per_file_line) >= len(raw) and len(index):
-            return per_file_line[index]
-    except Exception:  # noqa: BLE001 - the estimate is a nicety; never fail a job over it
-        pass
-    return fallback
+    return profile_from_settings(info.settings, base=laser_profile, rx_buffer=info.rx_buffer,
+                                 planner_blocks=info.planner_blocks)
 
 
 def _frame_program(stats, info: MachineInfo) -> Program:
@@ -74,12 +48,9 @@ def _frame_program(stats, info: MachineInfo) -> Program:
     if box is None:
         raise InputError("the job does not move; nothing to frame")
     (x0, y0), (x1, y1) = box
-    feed = min(FRAME_FEED, info.settings.get(110, FRAME_FEED), info.settings.get(111, FRAME_FEED))
-    px, py = info.position[0], info.position[1]
-    corners = [(x0, y0), (x1, y0), (x1, y1), (x0, y1), (x0, y0)]
-    lines = ["M5", "G21", f"G53G0X{x0:.3f}Y{y0:.3f}"]
-    lines += [f"G53G1X{x:.3f}Y{y:.3f}F{feed:.0f}" for x, y in corners[1:]]
-    lines.append(f"G53G0X{px:.3f}Y{py:.3f}")
+    feed = min(DEFAULT_FRAME_FEED, info.settings.get(110, DEFAULT_FRAME_FEED),
+               info.settings.get(111, DEFAULT_FRAME_FEED))
+    lines = framing_lines((x0, y0, x1, y1), feed=feed, machine_coordinates=True, return_to=info.position[:2])
     return program_from_text("\n".join(lines), source="frame")
 
 
@@ -171,11 +142,15 @@ def run_stream(gcode_path, *, port: str, baud: int = 115200, check: bool = False
             done(f"framed {x1 - x0:.1f} x {y1 - y0:.1f} mm at X{x0:.1f} Y{y0:.1f} (machine) with the beam off "
                  f"in {_format_seconds(result.elapsed)}")
             return
-        line_seconds = _line_seconds(path, program, info, stats.line_seconds)
-        total = float(line_seconds[-1]) if len(line_seconds) else 0.0
+        machine = _machine_profile(info, laser_profile)
+        job = estimate_program_time(program, machine, stats=stats)
+        # cumulative seconds at the end of each streamed line (for the ETA)
+        line_seconds = job.line_seconds[[max(0, number - 1) for number, _ in program.lines]]
+        total = job.total_seconds
         sim = f" (simulated, {time_scale:g}x faster)" if time_scale != 1.0 else ""
         console.print(f"GRBL {info.version}: RX {info.rx_buffer} B, planner {info.planner_blocks} blocks; "
-                      f"{len(program)} lines, estimated {_format_seconds(total)} of machine time{sim}"
+                      f"{len(program)} lines, estimated {_format_seconds(total)} of machine time{sim}, "
+                      f"{job.bound_text(machine)}"
                       + (" - check mode, nothing moves" if check else ""))
         columns = (TextColumn("[bold]{task.description}"), BarColumn(),
                    TextColumn("{task.completed}/{task.total} lines"), TimeElapsedColumn(),

@@ -38,7 +38,7 @@ def parse_sim_url(url: str) -> EmulatorOptions:
             elif key == "laser":
                 settings[32] = float(int(value))
             elif key == "profile":
-                from machines.emulator import settings_from_profile
+                from machines.grbl_settings import settings_from_profile
                 from machines.laser_profile import load_laser_profile
 
                 try:
