@@ -10,6 +10,7 @@ import numpy as np
 from onestroke.errors import InputError
 from vectorize.binarize import binarize
 from vectorize.drawing import Drawing
+from vectorize.edits import Edits
 from vectorize.fitting import TracedPoint, fit_stroke
 from vectorize.gaps import bridge_gaps, keep_largest_piece
 from vectorize.graph import MedialGraph
@@ -18,6 +19,7 @@ from vectorize.medial_axis import medial_axis
 from vectorize.outline import outline_rings
 from vectorize.pipeline import InputFrame, VectorizeOptions, VectorizeReport, VectorizeResult
 from vectorize.pruning import prune, trim_free_ends
+from vectorize.refine import Refinement, StageCache
 from vectorize.simplify import Simplified, directions, simplify, slots
 from vectorize.stroke import Stroke
 from vectorize.traversal import Ordering, order_strokes
@@ -151,21 +153,36 @@ class _Solution(NamedTuple):
     tried: int
 
 
-def _order(graph: MedialGraph, ink, options: VectorizeOptions, ends: int, clock: _Clock) -> _Solution:
-    """Simplify (in place), classify the crossings and traverse, for one count of free ends."""
+def _order(graph: MedialGraph, ink, options: VectorizeOptions, ends: int, clock: _Clock,
+           refine: Refinement | None = None) -> _Solution:
+    """Simplify (in place), classify the crossings and traverse, for one count of free ends.
+
+    With `refine`, the user's splits and merges act inside simplification, fixed pairings
+    enter the traversal as decisions it may not change, and simplified graphs with their
+    verdicts are reused from the session's cache (they depend on no later edit).
+    """
     w = ink.stroke_width
-    simple = simplify(graph, stroke_width=w, multi=options.multi, ends=ends)
-    clock.lap("simplification")
-    junction_list = _junctions(graph, simple.crossings, w)
-    junctions = dict(zip(simple.crossings, junction_list))
-    verdict_list = make_classifier(options.classifier).classify(ink.gray, junction_list, w) if junction_list else []
-    if options.classifier == "cnn" and junction_list:
-        geometry = make_classifier("geometric").classify(ink.gray, junction_list, w)
-        verdict_list = [_with_geometry(v, g) for v, g in zip(verdict_list, geometry)]
-    verdicts = dict(zip(simple.crossings, verdict_list))
+    cached = refine.lookup(ends) if refine is not None else None
+    if cached is not None:
+        graph, simple, junctions, verdicts = cached
+    else:
+        hooks = refine.simplify_hooks() if refine is not None else {}
+        simple = simplify(graph, stroke_width=w, multi=options.multi, ends=ends, **hooks)
+        clock.lap("simplification")
+        junction_list = _junctions(graph, simple.crossings, w)
+        junctions = dict(zip(simple.crossings, junction_list))
+        verdict_list = make_classifier(options.classifier).classify(ink.gray, junction_list, w) if junction_list else []
+        if options.classifier == "cnn" and junction_list:
+            geometry = make_classifier("geometric").classify(ink.gray, junction_list, w)
+            verdict_list = [_with_geometry(v, g) for v, g in zip(verdict_list, geometry)]
+        verdicts = dict(zip(simple.crossings, verdict_list))
+        if refine is not None:
+            refine.store(ends, (graph, simple, junctions, verdicts))
     clock.lap("classification")
     ranked = {n: ranked_pairings(junctions[n], verdicts[n]) for n in simple.crossings}
     costs = {n: _pairing_costs(verdicts[n]) for n in simple.crossings}
+    if refine is not None:
+        refine.fix_pairings(junctions, ranked, costs)
     ordering, tried = order_strokes(graph, simple, ranked, costs, stroke_width=w, search=not options.multi)
     clock.lap("traversal")
     return _Solution(graph, simple, junctions, verdicts, ordering, tried)
@@ -179,10 +196,9 @@ def _refuse_noise(count: int, what: str, limit: int, threshold: float) -> None:
                          f"drawing; try a --threshold below {threshold:.2f}, or --blur 1")
 
 
-def run_pipeline(image: np.ndarray, options: VectorizeOptions, *,
-                 frame: InputFrame | None = None) -> VectorizeResult:
-    """Vectorize `image`; the drawing comes out in `frame` (default: the image's pixels)."""
-    clock = _Clock()
+def _front(image: np.ndarray, options: VectorizeOptions, clock: _Clock):
+    """Binarize, outline, medial axis, pruning and (single-line) gap bridging: the stages
+    that only threshold, blur and mode change. Returns (ink, rings, graph, bridged, dropped)."""
     # Every piece of ink is kept here; in single-line mode the pieces of a line broken by
     # pen gaps are bridged below, and only then is the largest kept.
     ink = binarize(image, max_size=options.max_size, blur=options.blur, threshold=options.threshold)
@@ -203,13 +219,44 @@ def run_pipeline(image: np.ndarray, options: VectorizeOptions, *,
     if not options.multi:
         bridged = bridge_gaps(graph, stroke_width=w)
         dropped = keep_largest_piece(graph)
+    return ink, rings, graph, bridged, dropped
+
+
+def run_pipeline(image: np.ndarray, options: VectorizeOptions, *,
+                 frame: InputFrame | None = None, edits: Edits | None = None,
+                 cache: StageCache | None = None) -> VectorizeResult:
+    """Vectorize `image`; the drawing comes out in `frame` (default: the image's pixels).
+
+    edits: the user's corrections (`vectorize.edits`); cache: a `StageCache` kept between
+    calls on the same image, so that an edit re-runs only the stages after it.
+    """
+    clock = _Clock()
+    shape = np.asarray(image).shape
+    if frame is None:
+        frame = InputFrame(1.0, (0.0, 0.0), float(shape[1]), float(shape[0]))
+    refining = edits is not None or cache is not None
+    if refining:
+        edits = edits if edits is not None else Edits()
+        options = edits.applied_to(options)
+        cache = cache if cache is not None else StageCache()
+        front = cache.front_for(image, options, lambda: _front(image, options, clock))
+    else:
+        front = _front(image, options, clock)
+    ink, rings, graph, bridged, dropped = front
+    w = ink.stroke_width
+    scale = ink.scale * frame.scale  # working px per output unit
+    # Working pixel centres sit at integers (scikit-image); in SVG and in the input's pixel
+    # frame pixel i covers [i, i + 1), so its centre is at i + 0.5.
+    matrix = np.array([[1 / scale, 0, frame.offset[0] + 0.5 / scale],
+                       [0, 1 / scale, frame.offset[1] + 0.5 / scale]])
+    refine = Refinement(edits, cache, matrix, options, w) if refining else None
     stages = {"ink": ink, "rings": rings, "pruned": graph.copy()} if options.keep_stages else None
     # A single line has two free ends, or none when it closes: free ends beyond those are
     # spikes drawn out and back. Try the open reading first, the closed one if it fails.
     readings = (2,) if options.multi else (2, 0)
     best = None
     for ends in readings:
-        attempt = _order(graph.copy() if len(readings) > 1 else graph, ink, options, ends, clock)
+        attempt = _order(graph.copy() if len(readings) > 1 or refining else graph, ink, options, ends, clock, refine)
         if best is None or len(attempt.ordering.strokes) < len(best.ordering.strokes):
             best = attempt
         if len(best.ordering.strokes) <= 1:
@@ -229,15 +276,9 @@ def run_pipeline(image: np.ndarray, options: VectorizeOptions, *,
     clock.lap("fitting")
 
     # Back to the input's frame: original image pixels, or the SVG's user units.
-    shape = np.asarray(image).shape
-    if frame is None:
-        frame = InputFrame(1.0, (0.0, 0.0), float(shape[1]), float(shape[0]))
-    scale = ink.scale * frame.scale  # working px per output unit
-    # Working pixel centres sit at integers (scikit-image); in SVG and in the input's pixel
-    # frame pixel i covers [i, i + 1), so its centre is at i + 0.5.
-    matrix = np.array([[1 / scale, 0, frame.offset[0] + 0.5 / scale],
-                       [0, 1 / scale, frame.offset[1] + 0.5 / scale]])
     drawing = Drawing(tuple(s.transformed(matrix) for s in strokes), frame.width, frame.height, "px", w / scale)
+    if refine is not None:
+        drawing = refine.orient(drawing)
 
     warnings = []
     if ink.scale < 1.0 or frame.reduced_from is not None:
@@ -251,6 +292,8 @@ def run_pipeline(image: np.ndarray, options: VectorizeOptions, *,
     if simple.unresolved:
         warnings.append(f"{len(simple.unresolved)} junction(s) where three or more strokes seem to meet:"
                         " they are not resolved and the order there may be wrong")
+    if refine is not None:
+        warnings.extend(refine.unmatched())
     if not options.multi and len(strokes) > 1:
         warnings.append(f"the line could not be followed in one stroke: {len(strokes)} strokes")
     report = VectorizeReport(
@@ -260,4 +303,5 @@ def run_pipeline(image: np.ndarray, options: VectorizeOptions, *,
     if stages is not None:
         stages.update(simplified=graph, simple=simple, junctions=junctions, verdicts=verdicts,
                       ordering=ordering, working_strokes=strokes)
-    return VectorizeResult(drawing, report, stages)
+    view = refine.graph_view(best) if refine is not None else None
+    return VectorizeResult(drawing, report, stages, view)
