@@ -99,7 +99,8 @@ def test_send_response_is_slower_on_dense_work(emulator):
         times[mode] = result.elapsed * scale / emu.stats().planner_limited_time
     print(f"\nratio to planner-limited time: character counting {times[False]:.3f}, "
           f"send-response {times[True]:.3f}")
-    assert times[True] > times[False] * 1.1
+    # the size of the gap is the benchmark's (stream_bench.py); under load only its sign is sure
+    assert times[True] > times[False]
 
 
 def test_pause_and_resume_lose_and_repeat_nothing(emulator):
