@@ -58,6 +58,7 @@ class Faults:
     disconnect_at: after that line the port disappears (USB unplugged; board unpowered).
     alarm_at: that line trips a limit switch: ALARM:1, motion stops, beam off.
     error_at: that line is answered with error:20 whatever it contains.
+    drop_hold: that many feed-hold bytes (`!`) are lost on the way (noise, a busy adapter).
     """
 
     silent: bool = False
@@ -67,6 +68,7 @@ class Faults:
     disconnect_at: int | None = None
     alarm_at: int | None = None
     error_at: int | None = None
+    drop_hold: int = 0
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -141,6 +143,9 @@ class GrblEmulator:
         self.commands: list[str] = []  # '$' system lines
         self.spindle_history: list[tuple[str, float]] = []
         self.alarms: list[int] = []
+        self.hold_times: list[float] = []  # time.monotonic() of each feed hold received
+        self.reset_times: list[float] = []  # ... and of each soft reset received
+        self._holds_to_drop = options.faults.drop_hold
         self._cond = threading.Condition()
         self._write_lock = threading.Lock()
         self._out_cond = threading.Condition()
@@ -292,6 +297,11 @@ class GrblEmulator:
             limited += float(plan_times(start, end, feed.astype(float), rapid, stop, self.kin).sum())
         return EmulatorStats(planner_limited_time=limited, **result)
 
+    def wait_until(self, predicate, timeout: float = 10.0) -> bool:
+        """Block until predicate() holds (checked whenever the emulator's state changes); False on timeout."""
+        with self._cond:
+            return self._cond.wait_for(predicate, timeout)
+
     def wait_idle(self, timeout: float = 10.0) -> bool:
         """Block until the planner is empty and nothing moves; False on timeout."""
         deadline = time.monotonic() + timeout
@@ -408,12 +418,17 @@ class GrblEmulator:
     def _realtime(self, byte: int) -> None:
         """Handle a real-time byte (called with the lock held)."""
         if byte == 0x18:
+            self.reset_times.append(time.monotonic())
             self._reset_was_moving = self._moving()
             self._reset_pending = True
             self._cond.notify_all()
         elif byte == 0x3F:
             self._reply(self._status_report())
         elif byte == 0x21:
+            if self._holds_to_drop > 0:
+                self._holds_to_drop -= 1  # lost on the way: the firmware never sees it
+                return
+            self.hold_times.append(time.monotonic())
             if not self.hold and not self.alarm and not self.check_mode:
                 self.hold = True
                 self.hold_complete = not self._motion_busy
@@ -573,7 +588,9 @@ class GrblEmulator:
             return
         if not self._run_actions(actions, number):
             return
-        self.executed.append(text)
+        with self._cond:
+            self.executed.append(text)
+            self._cond.notify_all()
         if faults.drop_ok_at != number:
             self._reply("ok")
         if faults.garbage_at == number:

@@ -99,13 +99,21 @@ def _key_controls(streamer: GrblStreamer, enabled: bool):
         termios.tcsetattr(fd, termios.TCSADRAIN, saved)
 
 
+PROGRESS_EVERY = 5.0  # seconds between plain progress lines when not on a terminal
+
+
 def run_stream(gcode_path, *, port: str, baud: int = 115200, check: bool = False, frame: bool = False,
-               profile: str | os.PathLike | None = None, from_line: int | None = None) -> None:
+               profile: str | os.PathLike | None = None, from_line: int | None = None, reset: bool = True,
+               allow_settings: bool = False, progress_every: float = PROGRESS_EVERY) -> None:
     """Connect to `port`, check the job against the machine, stream it with a progress bar
     and print a summary. `check` streams in GRBL's check mode ($C, nothing moves); `frame`
     only traces the job's bounding box with the beam off. `profile`: a laser profile TOML
     to compare with the machine's settings. `from_line`: resume at this file line (after a
-    failure), moving there with the beam off first. Raises OnestrokeError on any failure."""
+    failure), moving there with the beam off first. `reset`: False attaches without a soft
+    reset (refused while the controller runs a job). `allow_settings`: let `$` lines of the
+    file through (otherwise the pre-check refuses them). `progress_every`: seconds between
+    plain progress lines when the output is not a terminal. Raises OnestrokeError on any
+    failure."""
     path = Path(gcode_path)
     program = load_program(path)
     if from_line is not None:
@@ -125,12 +133,12 @@ def run_stream(gcode_path, *, port: str, baud: int = 115200, check: bool = False
     time_scale = float(getattr(handle, "time_scale", 1.0))
     with GrblStreamer(handle, name=port) as streamer:
         console.print(f"connecting to {port} at {baud} baud ...")
-        info = streamer.connect()
+        info = streamer.connect(reset=reset)
         if info.alarm:
             raise MachineError(f"{port} is locked in ALARM (it booted or was left in alarm): home it with $H, or "
                                "unlock it with $X if it has no homing switches, then run again")
         stats = analyze_program(program, settings=info.settings, start=info.position, offsets=info.offsets,
-                                planner_blocks=info.planner_blocks)
+                                planner_blocks=info.planner_blocks, allow_settings=allow_settings)
         for problem in check_job(stats, info.settings, profile=laser_profile):
             if problem.fatal:
                 raise InputError(f"{path.name}: {problem.message}")
@@ -159,6 +167,7 @@ def run_stream(gcode_path, *, port: str, baud: int = 115200, check: bool = False
         with Progress(*columns, console=console, transient=False, disable=not console.is_terminal) as bar:
             task = bar.add_task("check" if check else "stream", total=len(program), eta="-", state="")
             last = [0.0]
+            plain_next = [time.monotonic() + progress_every]
 
             def on_progress(p: StreamProgress) -> None:
                 now = time.monotonic()
@@ -166,8 +175,13 @@ def run_stream(gcode_path, *, port: str, baud: int = 115200, check: bool = False
                     return
                 last[0] = now
                 remaining = (total - float(line_seconds[p.acked - 1])) / time_scale if p.acked else total
-                bar.update(task, completed=p.acked, eta="-" if check else _format_seconds(remaining),
-                           state=p.state or "")
+                eta = "-" if check else _format_seconds(remaining)
+                bar.update(task, completed=p.acked, eta=eta, state=p.state or "")
+                if not console.is_terminal and now >= plain_next[0]:
+                    # piped or logged: one plain line every few seconds instead of a bar
+                    plain_next[0] = now + progress_every
+                    console.print(f"{p.acked}/{p.total} lines acknowledged ({100.0 * p.acked / max(1, p.total):.0f} %), "
+                                  f"elapsed {_format_seconds(p.elapsed)}, remaining {eta}", highlight=False)
 
             if interactive:
                 console.print("keys: space pause, r resume, +/- feed, </> power, q or Ctrl-C abort")
@@ -205,12 +219,17 @@ def run_stream(gcode_path, *, port: str, baud: int = 115200, check: bool = False
 @click.option("--frame", is_flag=True, help="Only trace the job's bounding box with the beam off.")
 @click.option("--profile", type=click.Path(path_type=Path), default=None,
               help="Laser profile TOML to compare with the machine's settings.")
+@click.option("--no-reset", is_flag=True,
+              help="Attach without resetting the controller (refused while it runs a job); default: soft reset.")
+@click.option("--allow-settings", is_flag=True,
+              help="Let '$' commands of the file through (e.g. $32=1); otherwise the pre-check refuses them.")
 @click.option("--from-line", type=int, default=None,
               help="Resume at this file line after a failure (the head moves there with the beam off).")
 def stream(gcode: Path, port: str, baud: int, check: bool, frame: bool, profile: Path | None,
-           from_line: int | None) -> None:
+           no_reset: bool, allow_settings: bool, from_line: int | None) -> None:
     """Stream GCODE to a GRBL laser over USB serial (pause, resume and abort leave the beam off)."""
-    run_stream(gcode, port=port, baud=baud, check=check, frame=frame, profile=profile, from_line=from_line)
+    run_stream(gcode, port=port, baud=baud, check=check, frame=frame, profile=profile, from_line=from_line,
+               reset=not no_reset, allow_settings=allow_settings)
 
 
 @click.command("emulator")
