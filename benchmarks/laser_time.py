@@ -75,19 +75,18 @@ def row(label, lines):
           f"  [{est_seconds * 1000:.0f} ms]")
 
 
-def main() -> None:
-    print(f"{'job':44s} {'lines':>6s} {'planner':>9s} {'simulat.':>9s} {'diff':>7s} "
-          f"{'with link':>9s} {'bound':>7s} {'len/feed':>9s} (vs sim)  [estimator run time]")
+def jobs():
+    """(label, G-code lines) of every job this benchmark times (laser_estimate_vs_emulator.py too)."""
     for feed in (1500, 6000):
-        row(f"long straight line 537 mm, F{feed}", straight_line(feed))
+        yield f"long straight line 537 mm, F{feed}", straight_line(feed)
     for feed in (1500, 3000, 6000):
-        row(f"spiral of 0.05 mm segments, F{feed}", spiral(feed))
+        yield f"spiral of 0.05 mm segments, F{feed}", spiral(feed)
     drawing, how = vectorized_drawing()
     for size, feed in ((60, 1500), (60, 3000), (20, 6000)):
         for arcs in (False, True):
             tp = plan_toolpath(drawing, PROFILE, ToolpathOptions(placement=PlacementOptions(size=size), arcs=arcs))
             lines = gcode_lines(tp, PROFILE, GcodeOptions(feed=float(feed)))
-            row(f"vectorized trefoil ({how}) {size} mm, {'arcs' if arcs else 'lines'}, F{feed}", lines)
+            yield f"vectorized trefoil ({how}) {size} mm, {'arcs' if arcs else 'lines'}, F{feed}", lines
 
     from vectorize import VectorizeOptions, vectorize_file
 
@@ -98,7 +97,15 @@ def main() -> None:
             print(f"{png.name}: not vectorized ({error})")
             continue
         tp = plan_toolpath(example, PROFILE, ToolpathOptions(placement=PlacementOptions(size=60)))
-        row(f"examples/{png.name} 60 mm, F3000", gcode_lines(tp, PROFILE, GcodeOptions(feed=3000.0)))
+        yield f"examples/{png.name} 60 mm, F3000", gcode_lines(tp, PROFILE, GcodeOptions(feed=3000.0))
+
+
+def main() -> None:
+    print(f"{'job':44s} {'lines':>6s} {'planner':>9s} {'simulat.':>9s} {'diff':>7s} "
+          f"{'with link':>9s} {'bound':>7s} {'len/feed':>9s} (vs sim)  [estimator run time]")
+    for label, lines in jobs():
+        row(label, lines)
+    drawing, _ = vectorized_drawing()
 
     print()
     print("Fig. 14 comparison (same machine model):")

@@ -110,19 +110,25 @@ class EmulatorMotion:
             return self._current[0].target
         return self.position
 
+    def _alarm(self, code: int, *, critical: bool) -> None:
+        """Beam off, planner emptied, ALARM:code (lock held); critical ones need a reset."""
+        self.planner.clear()
+        self.spindle_mode, self.spindle_s = "M5", 0.0
+        self.spindle_history.append(("M5", 0.0))
+        self.alarm = True
+        self.critical = self.critical or critical
+        self.alarms.append(code)
+        self._cond.notify_all()
+        self._reply(f"ALARM:{code}")
+        if critical:
+            self._reply("[MSG:Reset to continue]")
+
     def _hard_limit(self) -> None:
         """A limit switch tripped: stop dead, beam off, ALARM:1, wait for a reset."""
         with self._cond:
             self.position = self._current_position()
-            self.planner.clear()
             self._current = None
-            self.spindle_mode, self.spindle_s = "M5", 0.0
-            self.spindle_history.append(("M5", 0.0))
-            self.alarm = self.critical = True
-            self.alarms.append(1)
-            self._cond.notify_all()
-        self._reply("ALARM:1")
-        self._reply("[MSG:Reset to continue]")
+            self._alarm(1, critical=True)
 
     def _soft_limit(self) -> None:
         """Soft limit (lock held): feed hold to a stop, then ALARM:2; position is kept."""
@@ -130,25 +136,13 @@ class EmulatorMotion:
             self.hold, self.hold_complete = True, False
             self._cond.notify_all()
             self._wait(lambda: self.hold_complete or not self._motion_busy)
-        self.planner.clear()
-        self.spindle_mode, self.spindle_s = "M5", 0.0
-        self.spindle_history.append(("M5", 0.0))
-        self.alarm = self.critical = True
-        self.alarms.append(2)
-        self._cond.notify_all()
-        self._reply("ALARM:2")
-        self._reply("[MSG:Reset to continue]")
+        self._alarm(2, critical=True)
 
     def _probe_fail(self) -> None:
         """G38.2/G38.4 reached its target without touching anything (no probe here): ALARM:5."""
         if not self.check_mode:
             self._wait(lambda: not self.planner and not self._motion_busy)
-        self.spindle_mode, self.spindle_s = "M5", 0.0
-        self.spindle_history.append(("M5", 0.0))
-        self.alarm = True
-        self.alarms.append(5)
-        self._cond.notify_all()
-        self._reply("ALARM:5")
+        self._alarm(5, critical=False)
 
     def _motion_loop(self) -> None:
         v = 0.0

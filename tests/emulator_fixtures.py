@@ -56,3 +56,20 @@ def link():
 
 def answered(line):
     return line == "ok" or line.startswith("error:")
+
+
+@pytest.fixture
+def emulator():
+    """make(**EmulatorOptions) -> a started emulator on a pty (default 40x), stopped afterwards."""
+    made = []
+
+    def make(**options):
+        options.setdefault("time_scale", 40.0)
+        emu = GrblEmulator(EmulatorOptions(**options))
+        emu.start_pty()
+        made.append(emu)
+        return emu
+
+    yield make
+    for emu in made:
+        emu.stop()

@@ -17,30 +17,15 @@ import time
 import pytest
 from click.testing import CliRunner
 
+from emulator_fixtures import emulator  # noqa: F401 - pytest fixture
 from fabrication.cli import main
 from fabrication.cli.stream_cmd import run_stream
-from machines.emulator import EmulatorOptions, Faults, GrblEmulator
+from machines.emulator import Faults
 from machines.gcode_program import program_from_text
 from machines.ports import open_port
 from machines.streamer import GrblStreamer, StreamInterrupted
 from onestroke.errors import MachineError
 from test_machines_stream import hear_ctrl_c, job_text, last_acked
-
-
-@pytest.fixture
-def emulator():
-    made = []
-
-    def make(**options):
-        options.setdefault("time_scale", 5.0)
-        emu = GrblEmulator(EmulatorOptions(**options))
-        emu.start_pty()
-        made.append(emu)
-        return emu
-
-    yield make
-    for emu in made:
-        emu.stop()
 
 
 # long moves: the planner holds seconds of motion, so only a feed hold stops the machine
@@ -110,7 +95,7 @@ def _start_foreign_job(emu, lines: int) -> int:
 
 
 def test_no_reset_refuses_a_running_job_then_attaches_without_reset(tmp_path, emulator):
-    emu = emulator()
+    emu = emulator(time_scale=5.0)
     fd = _start_foreign_job(emu, 20)
     path = tmp_path / "job.gcode"
     path.write_text(job_text(30))
@@ -140,7 +125,7 @@ def test_plain_progress_lines_when_not_on_a_terminal(tmp_path, emulator, capsys)
 
 
 def test_dollar_lines_need_allow_settings(tmp_path, emulator):
-    emu = emulator()
+    emu = emulator(time_scale=5.0)
     path = tmp_path / "job.gcode"
     path.write_text("$32=1\n" + job_text(20))
     result = CliRunner().invoke(main, ["stream", str(path), "--port", emu.device])
@@ -151,7 +136,7 @@ def test_dollar_lines_need_allow_settings(tmp_path, emulator):
 
 
 def test_attach_without_reset_needs_an_answer(emulator):
-    emu = emulator(faults=Faults(silent=True))
+    emu = emulator(time_scale=5.0, faults=Faults(silent=True))
     streamer = GrblStreamer(open_port(emu.device))
     try:
         with pytest.raises(MachineError, match="no status"):
