@@ -7,65 +7,64 @@ import time
 
 import click
 
-from fabrication.cli.common import console, done, edits_option
-from onestroke.atomic import check_writable
+from fabrication.cli.common import console, done, edits_option, warn
+from fabrication.cli.options import (Integer, Length, Number, drawing_input_options, input_argument,
+                                     output_option, placement_options)
 from onestroke.errors import InputError
+from onestroke.paths import check_distinct
 
-
-def warn(message: str) -> None:
-    """A one-line warning (soft wrap: long messages stay on one line in logs)."""
-    console.print(f"[yellow]warning:[/yellow] {message}", soft_wrap=True)
 
 @click.command()
-@click.argument("source", type=click.Path(path_type=str))
-@click.option("-o", "--output", required=True, type=click.Path(path_type=str),
-              help="Embroidery file to write: .pes, .dst, .jef, .exp or .vp3.")
-@click.option("--style", default="running", show_default=True,
-              help="Stitch style: running, triple, zigzag or arrows.")
-@click.option("--size", default=None, help="Longest side of the design, e.g. 90mm, 3.5in [default: 90mm].")
-@click.option("--width", default=None, help="Width of the design instead of --size.")
-@click.option("--height", default=None, help="Height of the design instead of --size.")
-@click.option("--rotate", type=float, default=0.0, show_default=True, help="Degrees, counter-clockwise.")
+@input_argument()
+@output_option(help="Embroidery file to write: .pes, .dst, .jef, .exp or .vp3.")
+@click.option("--style", type=click.Choice(["running", "triple", "zigzag", "arrows"]), default="running",
+              show_default=True, help="Stitch style.")
+@placement_options(default_size="90mm")
 @click.option("--hoop", default="100x100", show_default=True,
               help="Hoop: 100x100 (4x4), 130x180 (5x7), 150x250, 160x260 (6x10), 200x200, or WxH in mm.")
 @click.option("--fit", is_flag=True, help="Scale the design down to fit the hoop instead of refusing it.")
-@click.option("--stitch-length", default=None,
-              help="Running/triple stitch and the arrows' centre walk [default: 2.5mm].")
-@click.option("--tolerance", default=None, help="Largest chord-to-curve distance [default: 0.2mm].")
-@click.option("--stitch-width", "--zigzag-width", "stitch_width", default=None,
-              help="Zigzag width rail to rail [2mm] or arrow spread [2.5mm].")
-@click.option("--spacing", default=None, help="Zigzag peak-to-peak spacing [0.4mm] or arrow spacing [5mm].")
-@click.option("--pull-comp", default=None, help="Zigzag pull compensation added to the width [default: 0.2mm].")
-@click.option("--repeats", type=int, default=None, help="Triple stitch: back-and-forth passes [default: 1].")
-@click.option("--arrow-size", default=None, help="Arrows: arm length along the curve [default: 2mm].")
-@click.option("--min-stitch", default="0.3mm", show_default=True,
-              help="Shorter stitches are merged away (locks excepted).")
-@click.option("--max-stitch", default="12.1mm", show_default=True,
-              help="Longest needle-down stitch per axis (never above the format's limit).")
-@click.option("--trim-distance", default="3mm", show_default=True,
-              help="Strokes further apart are joined by lock, trim and jump.")
-@click.option("--lock", "lock_form", default="half", show_default=True, help="Lock/tack form: half or back_forth.")
+@click.option("--stitch-length", type=Length(0.1, 12.7), default=None,
+              help="Running/triple stitch and the arrows' centre walk, 0.1-12.7 mm and at least --min-stitch "
+                   "[default: 2.5mm].")
+@click.option("--tolerance", type=Length(0.1, 5.0), default=None,
+              help="Largest chord-to-curve distance, 0.1-5 mm [default: 0.2mm].")
+@click.option("--stitch-width", "--zigzag-width", "stitch_width", type=Length(0.1, 12.0), default=None,
+              help="Zigzag width rail to rail [2mm] or arrow spread [2.5mm]; 0.1-12 mm.")
+@click.option("--spacing", type=Length(0.1, 50.0), default=None,
+              help="Zigzag peak-to-peak spacing [0.4mm] or arrow spacing [5mm]; 0.1-50 mm.")
+@click.option("--pull-comp", type=Length(0.0, 2.0), default=None,
+              help="Zigzag pull compensation added to the width, 0-2 mm [default: 0.2mm].")
+@click.option("--repeats", type=Integer(1, 5), default=None,
+              help="Triple stitch: back-and-forth passes, 1-5 [default: 1].")
+@click.option("--arrow-size", type=Length(0.1, 20.0), default=None,
+              help="Arrows: arm length along the curve, 0.1-20 mm [default: 2mm].")
+@click.option("--min-stitch", type=Length(0.1, 3.0), default="0.3mm", show_default=True,
+              help="Shorter stitches are merged away (locks excepted); 0.1-3 mm.")
+@click.option("--max-stitch", type=Length(1.0, 12.7), default="12.1mm", show_default=True,
+              help="Longest needle-down stitch per axis, 1-12.7 mm (never above the format's limit).")
+@click.option("--trim-distance", type=Length(0.0, 1000.0), default="3mm", show_default=True,
+              help="Strokes further apart are joined by lock, trim and jump; 0-1000 mm.")
+@click.option("--lock", "lock_form", type=click.Choice(["half", "back_forth"]), default="half",
+              show_default=True, help="Lock/tack form.")
 @click.option("--color", "--colour", "color", default="#000000", show_default=True,
               help="Thread colour: #rrggbb or a name.")
-@click.option("--pes-version", type=int, default=None,
+@click.option("--pes-version", type=Integer(1, 6), default=None,
               help="PES version: 6 (default; keeps RGB colours) or 1 (Brother's 64-colour palette).")
-@click.option("--spm", type=float, default=None, help="Machine speed in stitches per minute [default: 600].")
-@click.option("--preview", "preview_path", default=None, type=click.Path(path_type=str),
-              help="Also write a preview image (.png or .svg).")
-@click.option("--preview-width", type=int, default=1000, show_default=True, help="Preview width in px.")
-@click.option("--multi", is_flag=True, help="Raster input: multi-stroke vectorization.")
-@click.option("--threshold", type=float, default=None, help="Raster input: ink threshold in (0, 1).")
-@click.option("--blur", type=float, default=0.0, show_default=True, help="Raster input: Gaussian blur sigma in px.")
-@click.option("--classifier", default="cnn", show_default=True,
-              help="Raster input: crossing classifier, cnn or geometric.")
+@click.option("--spm", type=Number(100, 3000), default=None,
+              help="Machine speed in stitches per minute, 100-3000 [default: 600].")
+@output_option(".png", ".svg", flags=("--preview",), dest="preview_path", required=False,
+               help="Also write a preview image (.png or .svg).")
+@click.option("--preview-width", type=Integer(64, 8000), default=1000, show_default=True,
+              help="Preview width in px, 64-8000.")
+@drawing_input_options(prefix="Raster input: ")
 @edits_option
-def embroider(source: str, output: str, style: str, size: str | None, width: str | None, height: str | None,
-              rotate: float, hoop: str, fit: bool, stitch_length: str | None, tolerance: str | None,
-              stitch_width: str | None, spacing: str | None, pull_comp: str | None, repeats: int | None,
-              arrow_size: str | None, min_stitch: str, max_stitch: str, trim_distance: str, lock_form: str,
-              color: str, pes_version: int | None, spm: float | None, preview_path: str | None,
-              preview_width: int, multi: bool, threshold: float | None, blur: float,
-              classifier: str, edits: str | None) -> None:
+def embroider(source: str, output: str, style: str, size: float | None, width: float | None,
+              height: float | None, rotate: float, hoop: str, fit: bool, stitch_length: float | None,
+              tolerance: float | None, stitch_width: float | None, spacing: float | None,
+              pull_comp: float | None, repeats: int | None, arrow_size: float | None, min_stitch: float,
+              max_stitch: float, trim_distance: float, lock_form: str, color: str, pes_version: int | None,
+              spm: float | None, preview_path: str | None, preview_width: int, multi: bool,
+              threshold: float | None, blur: float, classifier: str, edits: str | None) -> None:
     """Sew SOURCE (PNG/JPG/SVG/JSON drawing) along its curve into an embroidery file."""
     from fabrication.cli.job_options import embroidery_settings
     from fabrication.embroidery.canvas import check_preview_path
@@ -81,13 +80,14 @@ def embroider(source: str, output: str, style: str, size: str | None, width: str
         pull_comp=pull_comp, repeats=repeats, arrow_size=arrow_size, min_stitch=min_stitch,
         max_stitch=max_stitch, trim_distance=trim_distance, lock_form=lock_form, color=color,
         pes_version=pes_version, spm=spm)
-    check_writable(output)
+    check_distinct(inputs=[("input", source), ("--edits file", edits)],
+                   outputs=[("output", output), ("--preview", preview_path)])
+    if stitch_length is not None and stitch_length < min_stitch:
+        raise InputError(f"--stitch-length {stitch_length:g} mm is shorter than --min-stitch {min_stitch:g} mm, "
+                         "so every stitch would be merged away; lengthen it or lower --min-stitch")
     if preview_path is not None:
         check_preview_path(preview_path)
-        check_writable(preview_path)
         preview_options = PreviewOptions(width=preview_width)
-    if not os.path.isfile(source):
-        raise InputError(f"input file {source!r} does not exist")
     job = settings.job
     the_hoop = job.hoop
     for message in settings.warnings:

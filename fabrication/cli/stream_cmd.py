@@ -17,6 +17,7 @@ import click
 from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
 
 from fabrication.cli.common import console, done, warn
+from fabrication.cli.options import BAUD_RATES, Integer, Number, input_argument, machine_options, output_option
 from machines.framing import DEFAULT_FRAME_FEED, framing_lines
 from machines.gcode_program import Program, analyze_program, load_program, program_from_text
 from machines.job_time import estimate_program_time, format_duration
@@ -26,7 +27,6 @@ from machines.resume import resume_program
 from machines.streamer import GrblStreamer, MachineInfo, StreamError, StreamProgress
 from onestroke.errors import InputError, MachineError
 
-BAUD_RATES = (9600, 19200, 38400, 57600, 115200, 230400, 250000, 500000, 1000000)
 
 
 def _format_seconds(seconds: float) -> str:
@@ -212,39 +212,36 @@ def run_stream(gcode_path, *, port: str, baud: int = 115200, check: bool = False
 
 
 @click.command("stream")
-@click.argument("gcode", type=click.Path(dir_okay=True, path_type=Path))
-@click.option("--port", required=True, help="Serial port (/dev/ttyUSB0, COM3) or sim:// for a dry run on an emulator.")
-@click.option("--baud", type=int, default=115200, show_default=True, help="Serial baud rate.")
+@input_argument("gcode")
+@machine_options(port_required=True)
 @click.option("--check", is_flag=True, help="Dry run in GRBL's check mode ($C): parse everything, move nothing.")
 @click.option("--frame", is_flag=True, help="Only trace the job's bounding box with the beam off.")
-@click.option("--profile", type=click.Path(path_type=Path), default=None,
-              help="Laser profile TOML to compare with the machine's settings.")
 @click.option("--no-reset", is_flag=True,
               help="Attach without resetting the controller (refused while it runs a job); default: soft reset.")
 @click.option("--allow-settings", is_flag=True,
               help="Let '$' commands of the file through (e.g. $32=1); otherwise the pre-check refuses them.")
-@click.option("--from-line", type=int, default=None,
+@click.option("--from-line", type=Integer(1, 100_000_000), default=None,
               help="Resume at this file line after a failure (the head moves there with the beam off).")
-def stream(gcode: Path, port: str, baud: int, check: bool, frame: bool, profile: Path | None,
+def stream(gcode: str, port: str, baud: int, check: bool, frame: bool, profile_path: str | None,
            no_reset: bool, allow_settings: bool, from_line: int | None) -> None:
     """Stream GCODE to a GRBL laser over USB serial (pause, resume and abort leave the beam off)."""
-    run_stream(gcode, port=port, baud=baud, check=check, frame=frame, profile=profile, from_line=from_line,
+    if check and frame:
+        raise InputError("--check and --frame cannot be combined: --frame only traces the bounding box; "
+                         "run --check first, then --frame")
+    run_stream(gcode, port=port, baud=baud, check=check, frame=frame, profile=profile_path, from_line=from_line,
                reset=not no_reset, allow_settings=allow_settings)
 
 
 @click.command("emulator")
-@click.option("--speed", type=float, default=1.0, show_default=True, help="Time scale (1 = a real machine's pace).")
-@click.option("--log", "log_path", type=click.Path(dir_okay=False, path_type=Path), default=None,
-              help="On exit, write every line the emulator executed to this file.")
+@click.option("--speed", type=Number(0.0, 1000.0, low_open=True), default=1.0, show_default=True,
+              help="Time scale, above 0 to 1000 (1 = a real machine's pace).")
+@output_option(flags=("--log",), dest="log_path", required=False,
+               help="On exit, write every line the emulator executed to this file.")
 def emulator(speed: float, log_path: Path | None) -> None:
     """Serve a GRBL 1.1 emulator on a pseudo-terminal until Ctrl-C (for any sender, or tests)."""
     from machines.emulator import EmulatorOptions, GrblEmulator
-    from onestroke.atomic import atomic_write_text, check_writable
+    from onestroke.atomic import atomic_write_text
 
-    if not speed > 0:
-        raise InputError(f"--speed {speed:g} must be greater than zero (1 = real time)")
-    if log_path is not None:
-        check_writable(log_path)
     emu = GrblEmulator(EmulatorOptions(time_scale=speed))
     device = emu.start_pty()
     click.echo(device)
