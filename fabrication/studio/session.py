@@ -107,7 +107,8 @@ class StudioSession:
         values = _clean(values, EMBROIDERY_FIELDS)
         if extension != "pes":
             values.pop("pes_version", None)
-        settings = embroidery_settings(output=f"design.{extension}", **values)
+        # The input's stem names the design in the file, as `onestroke embroider` does.
+        settings = embroidery_settings(output=f"design.{extension}", source=str(self.drawing_path), **values)
         drawing = self.vectorize(edits).drawing
         return settings, embroider(drawing, settings.job)
 
