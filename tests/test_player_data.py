@@ -135,7 +135,7 @@ def test_refuses_to_overwrite_its_input_and_bad_inputs(tmp_path):
     assert result.exit_code == 2 and "cannot play" in result.output
     pes = tmp_path / "two.pes"
     write_pattern(pes)
-    with pytest.raises(InputError, match="is the input file"):
+    with pytest.raises(InputError, match="is the same file as the input"):
         from fabrication.player import player_data_for_file
 
         write_player_html(player_data_for_file(pes), pes.with_suffix(".html"), source=pes.with_suffix(".html"))

@@ -16,6 +16,9 @@ from pathlib import Path
 
 import numpy as np
 
+# Imported here, in the importing (main) thread: the package installs a Ctrl-C handler when
+# imported, which Python allows only there, and the API calls run in worker threads.
+from fabrication.cli.job_options import embroidery_settings, laser_settings
 from onestroke.atomic import atomic_write_text
 from onestroke.errors import InputError
 from vectorize import VectorizeOptions, vectorize_file
@@ -99,7 +102,6 @@ class StudioSession:
     # -- make it ---------------------------------------------------------------------
     def embroidery(self, edits: Edits, values: dict, extension: str = "pes"):
         """(settings, result) of `onestroke embroider` for these option values."""
-        from fabrication.cli.job_options import embroidery_settings
         from fabrication.embroidery.pipeline import embroider
 
         if extension not in EMBROIDERY_FORMATS:
@@ -126,7 +128,6 @@ class StudioSession:
 
     def laser(self, edits: Edits, values: dict):
         """(settings, program) of `onestroke laser` for these option values."""
-        from fabrication.cli.job_options import laser_settings
         from fabrication.laser.program import laser_program
 
         values = _clean(values, LASER_FIELDS)
@@ -149,7 +150,8 @@ class StudioSession:
         return {"player": json.loads(data.to_json()), "seconds": time.total_seconds,
                 "time": format_duration(time.total_seconds), "naive": format_duration(time.naive_seconds),
                 "burn_length": round(float(time.burn_length), 1), "travel_length": round(float(time.travel_length), 1),
-                "lines": len(program.lines), "warnings": list(settings.warnings)}
+                "lines": len(program.lines), "profile": settings.profile.name,
+                "warnings": list(settings.warnings)}
 
     def export(self, kind: str, edits: Edits, values: dict) -> tuple[str, str, bytes]:
         """(file name, media type, content) of one download."""

@@ -68,8 +68,10 @@ async function apply(edits, push = true) {
   updateButtons();
   const ticket = ++studio.requests;
   busy(true);
+  const started = performance.now();
   try {
     const state = await call("api/state", { edits });
+    state.answered = (performance.now() - started) / 1000;
     if (ticket === studio.requests) show(state);
   } catch (error) {
     report(error);
@@ -238,7 +240,7 @@ function show(state) {
   const r = state.report;
   $("summary").textContent = `${r.strokes} stroke${r.strokes === 1 ? "" : "s"}, ${r.intersections} crossing` +
     `${r.intersections === 1 ? "" : "s"}, ${state.edits.edits.length} edit${state.edits.edits.length === 1 ? "" : "s"}` +
-    ` · ${r.seconds.toFixed(2)} s`;
+    ` · ${(state.answered ?? r.seconds).toFixed(2)} s`;
   $("summary").dataset.order = JSON.stringify(state.strokes.map((s) => s.points[0]));
   const list = $("junctions"); list.innerHTML = "";
   for (const j of state.graph.junctions.filter((j) => j.role === "crossing")) {
@@ -402,7 +404,7 @@ function showStitches(data) {
 function showToolpath(data) {
   showPlayer("laser", data.player);
   $("laser-time").textContent = `estimated ${data.time} (GRBL planner model; length/feed says ${data.naive}) · ` +
-    `burn ${data.burn_length} mm, travel ${data.travel_length} mm · ${data.lines} lines`;
+    `burn ${data.burn_length} mm, travel ${data.travel_length} mm · ${data.lines} lines · profile: ${data.profile}`;
   $("laser-warnings").innerHTML = data.warnings.map((m) => `<li>${escapeHtml(m)}</li>`).join("");
 }
 
