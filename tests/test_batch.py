@@ -153,6 +153,40 @@ def test_dask_local_cluster_gives_the_same_bytes(first_run, tmp_path):
     assert all(content == reference[name] for name, content in made.items())
 
 
+def _child_env() -> dict:
+    return {**os.environ, "PYTHONPATH": os.pathsep.join([str(Path(__file__).resolve().parents[1]),
+                                                         os.environ.get("PYTHONPATH", "")])}
+
+
+def test_a_terminal_gets_a_progress_bar_with_count_rate_and_time_left(first_run, tmp_path):
+    import pty
+
+    root, drawings, _, _ = first_run
+    folder = tmp_path / "in"
+    folder.mkdir()
+    for drawing in [d for d in drawings if d.name.startswith("glyph-")][:2]:
+        (folder / drawing.name).write_bytes(drawing.read_bytes())
+    master, slave = pty.openpty()
+    process = subprocess.Popen([sys.executable, "-m", "fabrication.cli", "batch", str(folder), "-o",
+                                str(tmp_path / "out"), "--to", "svg", "--jobs", "1"],
+                               stdin=slave, stdout=slave, stderr=slave, env=_child_env())
+    os.close(slave)
+    seen = b""
+    while True:
+        try:
+            chunk = os.read(master, 4096)
+        except OSError:  # the child closed the terminal
+            break
+        if not chunk:
+            break
+        seen += chunk
+    os.close(master)
+    assert process.wait(timeout=60) == 0
+    text = seen.decode("utf-8", "replace")
+    assert "drawings" in text and "2/2" in text and "drawings/s" in text and "left" in text
+    assert "2 drawings: 2 made, 0 skipped, 0 failed" in text
+
+
 def _take_ctrl_c() -> None:
     # a suite run as a background job starts children with SIGINT ignored
     signal.signal(signal.SIGINT, signal.SIG_DFL)
@@ -161,8 +195,7 @@ def _take_ctrl_c() -> None:
 def test_ctrl_c_keeps_finished_outputs_and_leaves_no_partial_file(first_run, tmp_path):
     root, _, out, _ = first_run
     mine = tmp_path / "out"
-    env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(Path(__file__).resolve().parents[1]),
-                                                        os.environ.get("PYTHONPATH", "")])}
+    env = _child_env()
     process = subprocess.Popen([sys.executable, "-m", "fabrication.cli", "batch", str(root / "in"), "-o", str(mine),
                                 "--to", "svg", "--jobs", "1"], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
                                env=env, preexec_fn=_take_ctrl_c)

@@ -73,7 +73,7 @@ def _dask(todo: Todo, job: BatchJob, address: str, workers_seen: list) -> Iterat
         pending: dict = {}
         running = as_completed()
 
-        def hand_out() -> FileResult | None:
+        def hand_out() -> tuple[BatchItem, FileResult] | None:
             item, needed = next(queue)
             try:
                 data = item.source.read_bytes()
@@ -127,11 +127,12 @@ def run_batch(items: list[BatchItem], job: BatchJob, out_dir: str | os.PathLike,
     records: dict[str, FileRecord] = {}
     todo: Todo = []
     keys: dict[str, str] = {}
+    target_keys = {t.extension: job.key(t.extension) for t in job.targets}
     for item in items:
         needed = tuple(ext for ext, path in item.outputs
-                       if not manifest.is_current(item.source, item.name, path, job.key(ext)))
+                       if not manifest.is_current(item.source, item.name, path, target_keys[ext]))
         outputs = tuple(path.relative_to(manifest.root).as_posix() for _, path in item.outputs)
-        keys[item.name] = "+".join(job.key(ext) for ext in needed)
+        keys[item.name] = "+".join(target_keys[ext] for ext in needed)
         earlier = None if retry_failed or not needed else manifest.earlier_failure(
             item.source, item.name, keys[item.name])
         if not needed:
@@ -154,7 +155,7 @@ def run_batch(items: list[BatchItem], job: BatchJob, out_dir: str | os.PathLike,
             workers = min(jobs or os.cpu_count() or 1, len(todo))
             results = _in_process(todo, job) if workers <= 1 else _process_pool(todo, job, workers)
         for item, result in results:
-            record = _store(item, result, job, manifest, keys[item.name])
+            record = _store(item, result, target_keys, manifest, keys[item.name])
             records[item.name] = record
             if on_file:
                 on_file(record)
@@ -178,7 +179,8 @@ def run_batch(items: list[BatchItem], job: BatchJob, out_dir: str | os.PathLike,
     return summary
 
 
-def _store(item: BatchItem, result: FileResult, job: BatchJob, manifest: Manifest, key: str) -> FileRecord:
+def _store(item: BatchItem, result: FileResult, target_keys: dict[str, str], manifest: Manifest,
+           key: str) -> FileRecord:
     """Write one file's outputs (atomically) and record them; a write error fails that file."""
     error = result.error
     if error is None:
@@ -187,7 +189,7 @@ def _store(item: BatchItem, result: FileResult, job: BatchJob, manifest: Manifes
                 path = item.output(extension)
                 path.parent.mkdir(parents=True, exist_ok=True)
                 atomic_write_bytes(path, content)
-                manifest.made(item.name, path, job.key(extension))
+                manifest.made(item.name, path, target_keys[extension])
         except OSError as failure:
             error = f"cannot write {str(failure.filename or item.name)!r}: {failure.strerror}"
     if error is not None:

@@ -8,6 +8,7 @@ client process) to write, which is what lets it run unchanged on a Dask worker e
 
 from __future__ import annotations
 
+import dataclasses
 import hashlib
 import os
 import signal
@@ -137,6 +138,11 @@ def process_file(name: str, job: BatchJob, *, path: str | None = None, data: byt
                           error=" ".join(text.split()))
 
 
+def _named(job, name: str):
+    """The job with the design name `onestroke embroider` gives this input: its file stem."""
+    return dataclasses.replace(job, name=os.path.splitext(os.path.basename(name))[0])
+
+
 def _process(name: str, path: str, job: BatchJob, wanted: tuple[str, ...], started: float) -> FileResult:
     from vectorize.pipeline import vectorize_file
 
@@ -157,7 +163,7 @@ def _process(name: str, path: str, job: BatchJob, wanted: tuple[str, ...], start
             from fabrication.embroidery.pipeline import embroider
             from machines.hoops import format_for_path
 
-            sewn = embroider(drawing, target.job)
+            sewn = embroider(drawing, _named(target.job, name))
             fmt = format_for_path(f"x.{extension}")
             outputs.append((extension, embroidery_bytes(sewn.plan, fmt, pes_version=target.pes_version)))
             warnings += [w for w in sewn.warnings if w not in warnings]

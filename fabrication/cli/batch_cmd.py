@@ -7,7 +7,7 @@ import sys
 import click
 
 from fabrication.cli.common import console, done, warn
-from fabrication.cli.embroider_cmd import embroider
+from fabrication.cli.embroider_cmd import embroider, source_date
 from fabrication.cli.job_options import embroidery_settings, laser_settings
 from fabrication.cli.laser_cmd import laser
 from fabrication.cli.options import Integer, drawing_input_options, placement_options
@@ -58,7 +58,7 @@ def _progress():
     class RateColumn(ProgressColumn):
         def render(self, task) -> Text:
             speed = task.finished_speed or task.speed
-            return Text(f"{speed:.2f} files/s" if speed else "-- files/s")
+            return Text(f"{speed:.2f} drawings/s" if speed else "-- drawings/s")
 
     return Progress(TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(), RateColumn(),
                     TextColumn("left"), TimeRemainingColumn(), console=console, transient=True)
@@ -115,7 +115,8 @@ def batch(inputs: tuple[str, ...], out_dir: str, to: str, jobs: int | None, sche
     from fabrication.batch.work import INPUT_EXTENSIONS
 
     placement = dict(size=size, width=width, height=height, rotate=rotate)
-    embroidery = {o.name: options[o.name] for o in EMBROIDERY_OPTIONS}
+    # the date JEF files store, as `onestroke embroider` sets it; the design name is each input's stem
+    embroidery = {**{o.name: options[o.name] for o in EMBROIDERY_OPTIONS}, "date": source_date()}
     laser = {o.name: options[o.name] for o in LASER_OPTIONS}
     laser["tolerance"] = laser.pop("laser_tolerance")
     job, warnings = batch_job(to, multi=multi, threshold=threshold, blur=blur, classifier=classifier,

@@ -60,7 +60,8 @@ def preview(source: str, output: str, width_px: int, hoop: str | None, spm: floa
     check_preview_path(output)
     from fabrication.embroidery.preview import PreviewOptions
 
-    options = PreviewOptions(width=width_px)
+    # A file's preview tells the truth (needle points, jumps, trims, order), as before.
+    options = PreviewOptions(width=width_px, style="diagnostic")
     if suffix in DRAWING_SUFFIXES:
         from fabrication.embroidery.preview import render_drawing_preview
 
@@ -113,7 +114,7 @@ def _player_page(source: str, output: str, hoop: str | None, spm: float | None) 
     for message in data.warnings:
         warn(message)
     write_player_html(data, output, source=source)
-    from fabrication.laser.job_time import format_duration
+    from machines.job_time import format_duration
 
     span = (format_duration(data.total) if data.time_unit == "s"
             else f"{data.total:.1f} {data.time_unit} drawn")

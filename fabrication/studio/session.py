@@ -16,6 +16,9 @@ from pathlib import Path
 
 import numpy as np
 
+# Imported here, in the importing (main) thread: the package installs a Ctrl-C handler when
+# imported, which Python allows only there, and the API calls run in worker threads.
+from fabrication.cli.job_options import embroidery_settings, laser_settings
 from onestroke.atomic import atomic_write_text
 from onestroke.errors import InputError
 from vectorize import VectorizeOptions, vectorize_file
@@ -99,7 +102,6 @@ class StudioSession:
     # -- make it ---------------------------------------------------------------------
     def embroidery(self, edits: Edits, values: dict, extension: str = "pes"):
         """(settings, result) of `onestroke embroider` for these option values."""
-        from fabrication.cli.job_options import embroidery_settings
         from fabrication.embroidery.pipeline import embroider
 
         if extension not in EMBROIDERY_FORMATS:
@@ -107,7 +109,8 @@ class StudioSession:
         values = _clean(values, EMBROIDERY_FIELDS)
         if extension != "pes":
             values.pop("pes_version", None)
-        settings = embroidery_settings(output=f"design.{extension}", **values)
+        # The input's stem names the design in the file, as `onestroke embroider` does.
+        settings = embroidery_settings(output=f"design.{extension}", source=str(self.drawing_path), **values)
         drawing = self.vectorize(edits).drawing
         return settings, embroider(drawing, settings.job)
 
@@ -125,7 +128,6 @@ class StudioSession:
 
     def laser(self, edits: Edits, values: dict):
         """(settings, program) of `onestroke laser` for these option values."""
-        from fabrication.cli.job_options import laser_settings
         from fabrication.laser.program import laser_program
 
         values = _clean(values, LASER_FIELDS)
@@ -139,7 +141,7 @@ class StudioSession:
 
     def laser_preview(self, edits: Edits, values: dict) -> dict:
         """The G-code's moves for the player on the planner's time axis, and the estimate."""
-        from fabrication.laser.job_time import format_duration
+        from machines.job_time import format_duration
         from fabrication.player import gcode_player_data
 
         settings, program = self.laser(edits, values)
@@ -148,7 +150,8 @@ class StudioSession:
         return {"player": json.loads(data.to_json()), "seconds": time.total_seconds,
                 "time": format_duration(time.total_seconds), "naive": format_duration(time.naive_seconds),
                 "burn_length": round(float(time.burn_length), 1), "travel_length": round(float(time.travel_length), 1),
-                "lines": len(program.lines), "warnings": list(settings.warnings)}
+                "lines": len(program.lines), "profile": settings.profile.name,
+                "warnings": list(settings.warnings)}
 
     def export(self, kind: str, edits: Edits, values: dict) -> tuple[str, str, bytes]:
         """(file name, media type, content) of one download."""
