@@ -83,7 +83,7 @@ def test_previews(client):
     stitches = client.post("/api/embroidery", json={"edits": state["edits"], "options": {"size": "60mm"}}).json()
     assert stitches["stitches"] > 50 and any(line.startswith("stitches") for line in stitches["stats"])
     laser = client.post("/api/laser", json={"edits": state["edits"], "options": {"size": "50mm"}}).json()
-    assert laser["seconds"] > 0 and laser["player"]["source"] == "gcode" and laser["player"]["n"] > 10
+    assert laser["profile"] and laser["seconds"] > 0 and laser["player"]["source"] == "gcode" and laser["player"]["n"] > 10
     assert stitches["player"]["source"] == "embroidery" and stitches["player"]["numberTotal"] > 50
     refused = client.post("/api/embroidery", json={"edits": state["edits"], "options": {"size": "-3mm"}})
     assert refused.status_code == 400 and "--size" in refused.json()["error"]
@@ -94,6 +94,10 @@ def test_previews(client):
     ("pes", "embroider", {"style": "zigzag", "size": "70mm", "color": "#1f3a93"},
      ["--style", "zigzag", "--size", "70mm", "--color", "#1f3a93"]),
     ("dst", "embroider", {"style": "triple", "size": "50mm"}, ["--style", "triple", "--size", "50mm"]),
+    ("jef", "embroider", {"style": "arrows", "hoop": "130x180", "size": "120mm"},
+     ["--style", "arrows", "--hoop", "130x180", "--size", "120mm"]),
+    ("exp", "embroider", {"stitch_length": "3mm"}, ["--stitch-length", "3mm"]),
+    ("vp3", "embroider", {"color": "#c01020"}, ["--color", "#c01020"]),
     ("gcode", "laser", {"size": "40mm", "feed": "1200mm/min", "power": "35%", "passes": "2"},
      ["--size", "40mm", "--feed", "1200mm/min", "--power", "35%", "--passes", "2"]),
 ])

@@ -164,3 +164,54 @@ def test_page_refine_play_and_export(page, studio, tmp_path):
     run = CliRunner().invoke(main, ["vectorize", str(drawing), "--edits", str(saved), "-o", str(tmp_path / "r.svg")])
     assert run.exit_code == 0, run.output
     assert svg == (tmp_path / "r.svg").read_bytes()
+
+
+def click_at(page, at) -> None:
+    x, y = page.evaluate(f"window.studio.toScreen({at[0]}, {at[1]})")
+    page.mouse.click(x, y)
+
+
+def test_page_split_merge_blur_start_reverse_load(page, studio):
+    _, drawing = studio
+    count = page.evaluate("window.studio.state.edits.edits.length")
+    crossings = page.evaluate("window.studio.state.report.intersections")
+    target = page.evaluate("window.studio.state.graph.junctions.find(j => j.role === 'crossing' && !j.fixed)")
+
+    # Split a crossing into its two degree-3 halves, then merge them back by their branch.
+    page.check("input[name=tool][value=split]")
+    click_at(page, target["at"])
+    settle(page, count + 1)
+    assert page.evaluate("window.studio.state.report.intersections") == crossings - 1
+    page.check("input[name=tool][value=merge]")
+    branch = page.evaluate(f"""window.studio.state.graph.branches.reduce((best, b) =>
+        Math.hypot(b.at[0] - {target['at'][0]}, b.at[1] - {target['at'][1]}) <
+        Math.hypot(best.at[0] - {target['at'][0]}, best.at[1] - {target['at'][1]}) ? b : best)""")
+    page.screenshot(path=str(ARTIFACTS / "studio-6-split-merge-handles.png"))
+    click_at(page, branch["at"])
+    settle(page, count + 2)
+    assert page.evaluate("window.studio.state.report.intersections") == crossings
+
+    # Blur re-runs from binarization.
+    page.eval_on_selector("#blur", "e => { e.value = 1; e.dispatchEvent(new Event('change')); }")
+    page.wait_for_function("window.studio.state.settings.blur === 1 && !document.body.classList.contains('busy')")
+
+    # Start at the other end, then reverse: back where it started.
+    strokes = page.evaluate("window.studio.state.strokes.map(s => [s.points[0], s.points[s.points.length - 1]])")
+    end = strokes[0][1]
+    page.check("input[name=tool][value=start]")
+    click_at(page, end)
+    settle(page, count + 3)
+    first = page.evaluate("window.studio.state.strokes[0].points[0]")
+    assert abs(first[0] - end[0]) < 3 and abs(first[1] - end[1]) < 3
+    page.click("#reverse-all")
+    settle(page, count + 4)
+    last = page.evaluate("window.studio.state.strokes[0].points.slice(-1)[0]")
+    assert abs(last[0] - end[0]) < 3 and abs(last[1] - end[1]) < 3
+    page.screenshot(path=str(ARTIFACTS / "studio-7-after-edits.png"))
+
+    # Load edits: back to the file saved by the first test.
+    page.click("#load")
+    page.wait_for_function(f"window.studio.state.edits.edits.length === {count} && "
+                           "!document.body.classList.contains('busy')")
+    saved = json.loads(drawing.with_suffix(".edits.json").read_text())
+    assert page.evaluate("window.studio.state.edits.edits") == saved["edits"]

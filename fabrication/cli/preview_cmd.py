@@ -114,7 +114,7 @@ def _player_page(source: str, output: str, hoop: str | None, spm: float | None) 
     for message in data.warnings:
         warn(message)
     write_player_html(data, output, source=source)
-    from fabrication.laser.job_time import format_duration
+    from machines.job_time import format_duration
 
     span = (format_duration(data.total) if data.time_unit == "s"
             else f"{data.total:.1f} {data.time_unit} drawn")

@@ -141,7 +141,7 @@ class StudioSession:
 
     def laser_preview(self, edits: Edits, values: dict) -> dict:
         """The G-code's moves for the player on the planner's time axis, and the estimate."""
-        from fabrication.laser.job_time import format_duration
+        from machines.job_time import format_duration
         from fabrication.player import gcode_player_data
 
         settings, program = self.laser(edits, values)
@@ -150,7 +150,8 @@ class StudioSession:
         return {"player": json.loads(data.to_json()), "seconds": time.total_seconds,
                 "time": format_duration(time.total_seconds), "naive": format_duration(time.naive_seconds),
                 "burn_length": round(float(time.burn_length), 1), "travel_length": round(float(time.travel_length), 1),
-                "lines": len(program.lines), "warnings": list(settings.warnings)}
+                "lines": len(program.lines), "profile": settings.profile.name,
+                "warnings": list(settings.warnings)}
 
     def export(self, kind: str, edits: Edits, values: dict) -> tuple[str, str, bytes]:
         """(file name, media type, content) of one download."""

@@ -1,12 +1,11 @@
 // onestroke studio: the page. Plain JS, no build step; every computation is the server's
 // (the library's), the page only draws, keeps the edits history and sends edits back.
 "use strict";
-import { createPlayer } from "./player.js";
+import { $, busy, call, report } from "./api.js";
+import { refreshPanel, setupPanels } from "./panels.js";
 
-const TOKEN = new URLSearchParams(location.search).get("token") || "";
 const PAIRINGS = ["crossing", "touching", "third"];
 const COLORS = { crossing: "#1565c0", touching: "#ef6c00", third: "#8e24aa", other: "#757575", start: "#2e7d32" };
-const $ = (id) => document.getElementById(id);
 
 const studio = {
   state: null,            // last answer of /api/state
@@ -21,44 +20,8 @@ const studio = {
 };
 window.studio = studio;
 
-// ---------------------------------------------------------------- server calls
-async function call(path, body, raw = false) {
-  const init = { headers: { "X-Studio-Token": TOKEN } };
-  if (body !== undefined) {
-    init.method = "POST";
-    init.headers["Content-Type"] = "application/json";
-    init.body = JSON.stringify(body);
-  }
-  const response = await fetch(path, init);
-  if (!response.ok) {
-    let message = response.statusText;
-    try { message = (await response.json()).error || message; } catch (e) { /* not JSON */ }
-    throw new Error(message);
-  }
-  return raw ? response : response.json();
-}
-
-let busyCount = 0;
-function busy(on) {
-  busyCount += on ? 1 : -1;
-  $("busy").hidden = busyCount <= 0;
-  document.body.classList.toggle("busy", busyCount > 0);
-}
-
-function report(error) {
-  $("warnings").innerHTML = "";
-  const li = document.createElement("li");
-  li.textContent = "error: " + error.message;
-  $("warnings").appendChild(li);
-}
-
 // ---------------------------------------------------------------- edits and history
 function currentEdits() { return studio.history[studio.at]; }
-
-function blankEdits() {
-  return { format: "onestroke-edits", version: 1, threshold: null, blur: null, multi: null, tolerance: 8, edits: [] };
-}
-
 async function apply(edits, push = true) {
   if (push) {
     studio.history = studio.history.slice(0, studio.at + 1);
@@ -68,8 +31,10 @@ async function apply(edits, push = true) {
   updateButtons();
   const ticket = ++studio.requests;
   busy(true);
+  const started = performance.now();
   try {
     const state = await call("api/state", { edits });
+    state.answered = (performance.now() - started) / 1000;
     if (ticket === studio.requests) show(state);
   } catch (error) {
     report(error);
@@ -238,7 +203,7 @@ function show(state) {
   const r = state.report;
   $("summary").textContent = `${r.strokes} stroke${r.strokes === 1 ? "" : "s"}, ${r.intersections} crossing` +
     `${r.intersections === 1 ? "" : "s"}, ${state.edits.edits.length} edit${state.edits.edits.length === 1 ? "" : "s"}` +
-    ` · ${r.seconds.toFixed(2)} s`;
+    ` · ${(state.answered ?? r.seconds).toFixed(2)} s`;
   $("summary").dataset.order = JSON.stringify(state.strokes.map((s) => s.points[0]));
   const list = $("junctions"); list.innerHTML = "";
   for (const j of state.graph.junctions.filter((j) => j.role === "crossing")) {
@@ -352,107 +317,6 @@ function play() {
   requestAnimationFrame(frame);
 }
 
-// ---------------------------------------------------------------- make-it panels
-function formValues(id) {
-  const values = {};
-  for (const el of $(id).elements) {
-    if (!el.name) continue;
-    values[el.name] = el.type === "checkbox" ? el.checked : el.value;
-  }
-  return values;
-}
-function panelOptions(kind) {
-  if (kind === "embroidery") return formValues("embroidery-form");
-  if (kind === "laser") return formValues("laser-form");
-  return {};
-}
-function activeTab() { return document.querySelector("nav .tab.active").dataset.tab; }
-
-let panelTicket = 0;
-async function refreshPanel() {
-  const tab = activeTab();
-  if (tab === "refine" || !studio.state) return;
-  const ticket = ++panelTicket;
-  busy(true);
-  try {
-    const data = await call(`api/${tab}`, { edits: currentEdits(), options: panelOptions(tab) });
-    if (ticket !== panelTicket) return;
-    if (tab === "embroidery") showStitches(data); else showToolpath(data);
-  } catch (error) {
-    $(`${tab}-warnings`).innerHTML = `<li>error: ${error.message}</li>`;
-  } finally {
-    busy(false);
-  }
-}
-
-// Stitches and laser moves play in the project's player (fabrication/player), one per panel.
-const players = {};
-function showPlayer(kind, data) {
-  if (!players[kind]) players[kind] = createPlayer($(`${kind}-player`), data);
-  else players[kind].load(data);
-  studio.players = players;
-}
-
-function showStitches(data) {
-  showPlayer("embroidery", data.player);
-  $("embroidery-stats").textContent = data.stats.join("\n");
-  $("embroidery-warnings").innerHTML = data.warnings.map((m) => `<li>${escapeHtml(m)}</li>`).join("");
-}
-
-function showToolpath(data) {
-  showPlayer("laser", data.player);
-  $("laser-time").textContent = `estimated ${data.time} (GRBL planner model; length/feed says ${data.naive}) · ` +
-    `burn ${data.burn_length} mm, travel ${data.travel_length} mm · ${data.lines} lines`;
-  $("laser-warnings").innerHTML = data.warnings.map((m) => `<li>${escapeHtml(m)}</li>`).join("");
-}
-
-function escapeHtml(text) {
-  return text.replace(/[&<>"]/g, (c) => ({ "&": "&amp;", "<": "&lt;", ">": "&gt;", '"': "&quot;" }[c]));
-}
-
-async function download(kind) {
-  busy(true);
-  try {
-    const tab = ["pes", "dst", "jef", "exp", "vp3"].includes(kind) ? "embroidery" : kind === "gcode" ? "laser" : "refine";
-    const response = await call(`api/export/${kind}`, { edits: currentEdits(), options: panelOptions(tab) }, true);
-    const blob = await response.blob();
-    const name = /filename="([^"]+)"/.exec(response.headers.get("Content-Disposition") || "")?.[1] || `drawing.${kind}`;
-    const a = document.createElement("a");
-    a.href = URL.createObjectURL(blob); a.download = name;
-    document.body.appendChild(a); a.click(); a.remove();
-    setTimeout(() => URL.revokeObjectURL(a.href), 10000);
-  } catch (error) {
-    report(error);
-  } finally {
-    busy(false);
-  }
-}
-
-// ---------------------------------------------------------------- send to laser
-let sendTimer = null;
-async function sendAction(action) {
-  try {
-    const status = action === "send"
-      ? await call("api/send", { edits: currentEdits(), options: panelOptions("laser"), port: $("port").value })
-      : await call(`api/send/${action}`, {});
-    showSend(status);
-    if (!sendTimer) sendTimer = setInterval(pollSend, 300);
-  } catch (error) {
-    $("send-status").textContent = "error: " + error.message;
-  }
-}
-async function pollSend() {
-  const status = await call("api/send");
-  showSend(status);
-  if (!["connecting", "streaming", "paused", "aborting"].includes(status.state)) { clearInterval(sendTimer); sendTimer = null; }
-}
-function showSend(s) {
-  $("send-progress").max = s.total || 1; $("send-progress").value = s.acked || 0;
-  $("send-status").textContent = `${s.state}${s.total ? ` · ${s.acked}/${s.total} lines` : ""}` +
-    `${s.machine ? ` · ${s.machine}` : ""}${s.message ? ` · ${s.message}` : ""}`;
-  $("send-status").dataset.state = s.state;
-}
-
 // ---------------------------------------------------------------- wiring
 function settingsEdit(change) {
   const edits = JSON.parse(JSON.stringify(currentEdits()));
@@ -484,15 +348,7 @@ function setup() {
   $("multi").onchange = () => settingsEdit({ multi: $("multi").checked });
   $("play").onclick = play;
   $("scrub").oninput = () => { studio.playing = false; $("play").textContent = "▶ Play"; studio.pen = $("scrub").value / 1000; draw(); };
-  for (const tab of document.querySelectorAll("nav .tab")) {
-    tab.onclick = () => {
-      document.querySelectorAll("nav .tab").forEach((t) => t.classList.toggle("active", t === tab));
-      document.querySelectorAll(".panel").forEach((p) => { p.hidden = p.id !== `tab-${tab.dataset.tab}`; });
-      refreshPanel();
-    };
-  }
-  for (const form of ["embroidery-form", "laser-form"]) $(form).addEventListener("change", refreshPanel);
-  for (const button of document.querySelectorAll("[data-export]")) button.onclick = () => download(button.dataset.export);
+  setupPanels(() => (studio.state ? currentEdits() : null));
   $("save").onclick = async () => {
     try { const r = await call("api/edits", { edits: currentEdits() }); $("summary").textContent += ` · saved ${r.saved}`; }
     catch (error) { report(error); }
@@ -505,7 +361,6 @@ function setup() {
     try { apply(JSON.parse(await file.text())); } catch (error) { report(error); }
     $("open").value = "";
   };
-  for (const action of ["send", "pause", "resume", "abort"]) $(action).onclick = () => sendAction(action);
   studio.image.onload = draw;
   studio.image.src = "api/image";
   (async () => {
