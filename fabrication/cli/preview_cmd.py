@@ -102,9 +102,7 @@ def _player_page(source: str, output: str, hoop: str | None, spm: float | None) 
     from fabrication.player import player_data_for_file, write_player_html
     from machines.hoops import load_embroidery_profile
 
-    profile = load_embroidery_profile()
-    if spm is not None and not spm > 0:
-        raise InputError(f"--spm {spm:g} must be greater than zero")
+    profile = load_embroidery_profile()  # --spm is range-checked by its option type
     frame = None
     if hoop is not None:
         field = profile.hoop(hoop)
