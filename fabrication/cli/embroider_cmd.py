@@ -147,9 +147,6 @@ def embroider(source: str, output: str, style: str, size: float | None, width: f
 
     for message in result.warnings:
         warn(message)
-    if color is not None and len(job.plan.colors) > len(result.drawing.strokes):
-        warn(f"--color lists {len(job.plan.colors)} colours for {len(result.drawing.strokes)} "
-             "stroke(s); the extra colours are unused")
     stats = result.stats
     for line in stats.lines():
         console.print(line, soft_wrap=True)
