@@ -174,14 +174,15 @@ def test_thread_colours():
 
 
 def _dots(n):
-    return tuple(_line([i * 5.0, 0.0], [i * 5.0 + 0.5, 0.0]) for i in range(n))
+    return tuple(_line([i * 5.0, 0.0], [i * 5.0 + 1.5, 0.0]) for i in range(n))
 
 
 EDGE_CASES = {
     "no strokes": (Drawing((), 10, 10, "mm"), InputError),
     "one point": (Drawing((Stroke(np.zeros((1, 4, 2))),), 1, 1, "mm"), InputError),
     "shorter than a stitch": (Drawing((_line([0, 0], [0.2, 0]),), 1, 1, "mm"), InputError),
-    "just over the minimum": (Drawing((_line([0, 0], [0.35, 0]),), 1, 1, "mm"), None),
+    "a lone speck": (Drawing((_line([0, 0], [0.35, 0]),), 1, 1, "mm"), InputError),
+    "just over the minimum stroke": (Drawing((_line([0, 0], [1.05, 0]),), 1, 1, "mm"), None),
     "closed loop": (Drawing((spiral(0, 0, 10, 10, 1.0),), 20, 20, "mm"), None),
     "300 short strokes": (Drawing(_dots(300), 1500, 1, "mm"), None),
     "pixels, not placed": (Drawing((_line([0, 0], [10, 0]),), 10, 1, "px"), InputError),
@@ -214,10 +215,10 @@ def test_embroider_pipeline_places_fits_stitches_and_measures():
     assert max(xmax - xmin, ymax - ymin) == pytest.approx(90.0, abs=1e-6)
     assert result.fit_scale == 1.0 and result.stats.stitches == int((result.plan.kinds == STITCH).sum())
     job = EmbroideryJob(placement=PlacementOptions(size=150.0), hoop=hoop_named("4x4"), fit=True,
-                        plan=PlanOptions(style=ZigzagOptions(width=8.0)), stitches_per_minute=800)
+                        plan=PlanOptions(style=ZigzagOptions(width=11.0)), stitches_per_minute=800)
     fitted = embroider(px, job)
     assert fitted.fit_scale < 0.7 and any("scaled down" in w for w in fitted.warnings)
-    assert any("lie loose" in w for w in fitted.warnings)
+    assert any("lie loose" in w and "--stitch-width" in w for w in fitted.warnings)
     check_plan_in_hoop(fitted.plan, hoop_named("4x4"))
     assert fitted.stats.stitches_per_minute == 800
     with pytest.raises(InputError, match="hoop 100x100"):

@@ -87,6 +87,19 @@ def test_stitch_plan_from_the_pipeline(tmp_path):
     assert int((data.kinds == DRAW).sum()) == len(plan.stitches()[0])  # sewn stitches are lines
 
 
+def test_two_colour_plan_from_the_pipeline():
+    """A plan with its own colour blocks (COLOR rows): colours, changes and time as the stats say."""
+    plan = plan_embroidery(design(), PlanOptions(style=style_options("running"), colors=(RED, BLUE)))
+    stats = embroidery_stats(plan, stitches_per_minute=700, trim_seconds=12)
+    data = stitch_player_data(plan, stitches_per_minute=700, trim_seconds=12)
+    assert data.palette == ("#%02x%02x%02x" % RED, "#%02x%02x%02x" % BLUE)
+    np.testing.assert_array_equal(data.colors, plan.blocks)
+    assert int((data.kinds == COLOR).sum()) == plan.color_changes == stats.color_changes == 1
+    assert int((data.kinds == TRIM).sum()) == stats.trims
+    assert data.times[-1] == data.total == stats.seconds
+    assert data.number_total == stats.stitches
+
+
 def test_gcode_page_matches_the_estimate(tmp_path):
     out = tmp_path / "rose.html"
     result = _preview(ROSE, "-o", out)
@@ -135,7 +148,7 @@ def test_refuses_to_overwrite_its_input_and_bad_inputs(tmp_path):
     assert result.exit_code == 2 and "cannot play" in result.output
     pes = tmp_path / "two.pes"
     write_pattern(pes)
-    with pytest.raises(InputError, match="is the input file"):
+    with pytest.raises(InputError, match="is the same file as the input"):
         from fabrication.player import player_data_for_file
 
         write_player_html(player_data_for_file(pes), pes.with_suffix(".html"), source=pes.with_suffix(".html"))

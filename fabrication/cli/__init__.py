@@ -103,6 +103,7 @@ COMMANDS = {
     "vectorize": "fabrication.cli.vectorize_cmd:vectorize",
     "embroider": "fabrication.cli.embroider_cmd:embroider",
     "laser": "fabrication.cli.laser_cmd:laser",
+    "batch": "fabrication.cli.batch_cmd:batch",
     "stream": "fabrication.cli.stream_cmd:stream",
     "preview": "fabrication.cli.preview_cmd:preview",
     "studio": "fabrication.cli.studio_cmd:studio",

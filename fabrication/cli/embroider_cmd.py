@@ -14,6 +14,22 @@ from onestroke.errors import InputError
 from onestroke.paths import check_distinct
 
 
+def source_date() -> str:
+    """JEF's date: SOURCE_DATE_EPOCH (reproducible builds) when set, else a fixed value."""
+    import datetime
+
+    from fabrication.embroidery.plan import FIXED_DATE
+
+    value = os.environ.get("SOURCE_DATE_EPOCH")
+    if value is None or not value.strip():
+        return FIXED_DATE
+    try:
+        moment = datetime.datetime.fromtimestamp(int(value), tz=datetime.timezone.utc)
+    except (ValueError, OverflowError, OSError):
+        raise InputError(f"SOURCE_DATE_EPOCH {value!r} is not a number of seconds since 1970") from None
+    return moment.strftime("%Y%m%d%H%M%S")
+
+
 @click.command()
 @input_argument()
 @output_option(help="Embroidery file to write: .pes, .dst, .jef, .exp or .vp3.")
@@ -38,6 +54,11 @@ from onestroke.paths import check_distinct
               help="Triple stitch: back-and-forth passes, 1-5 [default: 1].")
 @click.option("--arrow-size", type=Length(0.1, 20.0), default=None,
               help="Arrows: arm length along the curve, 0.1-20 mm [default: 2mm].")
+@click.option("--underlay", type=click.Choice(["center", "edge", "zigzag", "none"]), default=None,
+              help="Zigzag underlay [default: center when wider than 1.5mm].")
+@click.option("--min-stroke", type=Length(0.0, 100.0), default="1mm", show_default=True,
+              help="Shorter strokes join a neighbour within --trim-distance by travel stitches, or are "
+                   "left out with a warning; 0-100 mm.")
 @click.option("--min-stitch", type=Length(0.1, 3.0), default="0.3mm", show_default=True,
               help="Shorter stitches are merged away (locks excepted); 0.1-3 mm.")
 @click.option("--max-stitch", type=Length(1.0, 12.7), default="12.1mm", show_default=True,
@@ -46,8 +67,15 @@ from onestroke.paths import check_distinct
               help="Strokes further apart are joined by lock, trim and jump; 0-1000 mm.")
 @click.option("--lock", "lock_form", type=click.Choice(["half", "back_forth"]), default="half",
               show_default=True, help="Lock/tack form.")
-@click.option("--color", "--colour", "color", default="#000000", show_default=True,
-              help="Thread colour: #rrggbb or a name.")
+@click.option("--color", "--colour", "color", default=None,
+              help="Thread colour (#rrggbb or a name), or a comma-separated list, one per stroke in "
+                   "drawing order [default: the SVG's stroke colours, else black].")
+@click.option("--thread-chart", type=click.Choice(["brother", "janome", "husqvarna", "viking", "janome-sew"]),
+              default=None, help="Pick the nearest thread of one of pyembroidery's catalogues and print its number.")
+@click.option("--name", "design_name", default=None,
+              help="Design name stored in .pes/.dst [default: the input file's stem].")
+@click.option("--start", default=None,
+              help="Where sewing starts: X,Y in mm from the design centre (y down), or 'reverse'.")
 @click.option("--pes-version", type=Integer(1, 6), default=None,
               help="PES version: 6 (default; keeps RGB colours) or 1 (Brother's 64-colour palette).")
 @click.option("--spm", type=Number(100, 3000), default=None,
@@ -56,15 +84,21 @@ from onestroke.paths import check_distinct
                help="Also write a preview image (.png or .svg).")
 @click.option("--preview-width", type=Integer(64, 8000), default=1000, show_default=True,
               help="Preview width in px, 64-8000.")
+@click.option("--preview-style", type=click.Choice(["realistic", "diagnostic"]), default="realistic",
+              show_default=True,
+              help="realistic: thread on fabric; diagnostic: needle points, jumps, trims, order, hoop.")
+@click.option("--preview-hoop", is_flag=True, help="Draw the hoop in the realistic preview too.")
 @drawing_input_options(prefix="Raster input: ")
 @edits_option
 def embroider(source: str, output: str, style: str, size: float | None, width: float | None,
               height: float | None, rotate: float, hoop: str, fit: bool, stitch_length: float | None,
               tolerance: float | None, stitch_width: float | None, spacing: float | None,
-              pull_comp: float | None, repeats: int | None, arrow_size: float | None, min_stitch: float,
-              max_stitch: float, trim_distance: float, lock_form: str, color: str, pes_version: int | None,
-              spm: float | None, preview_path: str | None, preview_width: int, multi: bool,
-              threshold: float | None, blur: float, classifier: str, edits: str | None) -> None:
+              pull_comp: float | None, repeats: int | None, arrow_size: float | None, underlay: str | None,
+              min_stroke: float, min_stitch: float, max_stitch: float, trim_distance: float, lock_form: str,
+              color: str | None, thread_chart: str | None, design_name: str | None, start: str | None,
+              pes_version: int | None, spm: float | None, preview_path: str | None, preview_width: int,
+              preview_style: str, preview_hoop: bool, multi: bool, threshold: float | None, blur: float,
+              classifier: str, edits: str | None) -> None:
     """Sew SOURCE (PNG/JPG/SVG/JSON drawing) along its curve into an embroidery file."""
     from fabrication.cli.job_options import embroidery_settings
     from fabrication.embroidery.canvas import check_preview_path
@@ -77,9 +111,10 @@ def embroider(source: str, output: str, style: str, size: float | None, width: f
     settings = embroidery_settings(
         output=output, style=style, size=size, width=width, height=height, rotate=rotate, hoop=hoop, fit=fit,
         stitch_length=stitch_length, tolerance=tolerance, stitch_width=stitch_width, spacing=spacing,
-        pull_comp=pull_comp, repeats=repeats, arrow_size=arrow_size, min_stitch=min_stitch,
-        max_stitch=max_stitch, trim_distance=trim_distance, lock_form=lock_form, color=color,
-        pes_version=pes_version, spm=spm)
+        pull_comp=pull_comp, repeats=repeats, arrow_size=arrow_size, underlay=underlay,
+        min_stroke=min_stroke, min_stitch=min_stitch, max_stitch=max_stitch, trim_distance=trim_distance,
+        lock_form=lock_form, color=color, thread_chart=thread_chart, start=start, name=design_name,
+        source=source, date=source_date(), pes_version=pes_version, spm=spm)
     check_distinct(inputs=[("input", source), ("--edits file", edits)],
                    outputs=[("output", output), ("--preview", preview_path)])
     if stitch_length is not None and stitch_length < min_stitch:
@@ -87,7 +122,8 @@ def embroider(source: str, output: str, style: str, size: float | None, width: f
                          "so every stitch would be merged away; lengthen it or lower --min-stitch")
     if preview_path is not None:
         check_preview_path(preview_path)
-        preview_options = PreviewOptions(width=preview_width)
+        preview_options = PreviewOptions(width=preview_width, style=preview_style,
+                                         hoop=preview_hoop or preview_style == "diagnostic")
     job = settings.job
     the_hoop = job.hoop
     for message in settings.warnings:
@@ -111,6 +147,9 @@ def embroider(source: str, output: str, style: str, size: float | None, width: f
 
     for message in result.warnings:
         warn(message)
+    if color is not None and len(job.plan.colors) > len(result.drawing.strokes):
+        warn(f"--color lists {len(job.plan.colors)} colours for {len(result.drawing.strokes)} "
+             "stroke(s); the extra colours are unused")
     stats = result.stats
     for line in stats.lines():
         console.print(line, soft_wrap=True)

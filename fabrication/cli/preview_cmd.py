@@ -60,7 +60,8 @@ def preview(source: str, output: str, width_px: int, hoop: str | None, spm: floa
     check_preview_path(output)
     from fabrication.embroidery.preview import PreviewOptions
 
-    options = PreviewOptions(width=width_px)
+    # A file's preview tells the truth (needle points, jumps, trims, order), as before.
+    options = PreviewOptions(width=width_px, style="diagnostic")
     if suffix in DRAWING_SUFFIXES:
         from fabrication.embroidery.preview import render_drawing_preview
 
