@@ -7,7 +7,7 @@ import time
 
 import click
 
-from fabrication.cli.common import console, done, edits_option, warn
+from fabrication.cli.common import console, done, edits_option, step, warn
 from fabrication.cli.options import (Integer, Length, Number, drawing_input_options, input_argument,
                                      output_option, placement_options)
 from onestroke.errors import InputError
@@ -137,13 +137,17 @@ def embroider(source: str, output: str, style: str, size: float | None, width: f
     else:
         from fabrication.cli.common import read_drawing
 
-        drawing = read_drawing(source, multi=multi, threshold=threshold, blur=blur, classifier=classifier,
-                               edits=edits)
-    result = embroider_drawing(drawing, job)
-    write_embroidery(result.plan, output, pes_version=pes_version)
+        with step(f"reading {os.path.basename(source)}"):
+            drawing = read_drawing(source, multi=multi, threshold=threshold, blur=blur,
+                                   classifier=classifier, edits=edits)
+    with step("planning the stitches"):
+        result = embroider_drawing(drawing, job)
+    with step(f"writing {os.path.basename(output)}"):
+        write_embroidery(result.plan, output, pes_version=pes_version)
     if preview_path is not None:
-        render_stitch_preview(result.plan, preview_path, hoop=the_hoop, stats=result.stats,
-                              options=preview_options)
+        with step("drawing the preview"):
+            render_stitch_preview(result.plan, preview_path, hoop=the_hoop, stats=result.stats,
+                                  options=preview_options)
 
     for message in result.warnings:
         warn(message)
