@@ -368,3 +368,24 @@ def test_relief_glyphs_load_with_their_licence():
     gts = relief_set(6)
     assert len(gts) == 6 and all(g.kind.startswith("relief-") for g in gts)
     assert all(evaluate(g, g.drawing).correct for g in gts[:2])
+
+
+def test_new_sets_run_through_the_command_and_their_ground_truth_is_perfect(capsys):
+    from benchmarks import vectorize_bench
+    from benchmarks.bench_tables import failure_kind
+
+    for set_name in ("hershey-retrace", "triple"):
+        vectorize_bench.TASKS.clear()
+        assert vectorize_bench.main(["--ground-truth-as-output", "--set", set_name, "--count", "2",
+                                     "--classifier", "cnn"]) == 0
+        row = next(line for line in capsys.readouterr().out.splitlines() if line.startswith(set_name + " "))
+        cells = row.split()
+        assert cells[4] == "100.0"  # correct %
+        assert cells[-7] == "100.0" and cells[-2] == "100.0" and cells[-1] == "0"  # one stroke, in the ink
+    vectorize_bench.TASKS.clear()
+    base = {"error": "", "strokes": 1, "within": True, "uncovered": 1.0, "cover_tolerance": 5.0, "fair": True,
+            "out_length": 1000.0, "min_length": 900.0, "width": 5.0}
+    assert failure_kind(base) == "extra retrace"  # 1000 > 1.01 * 900 + 2 * 5
+    assert failure_kind({**base, "out_length": 915.0}) == "wrong order"
+    assert failure_kind({**base, "strokes": 2}) == "split"
+    assert failure_kind({**base, "within": False}) == "leaves the ink"

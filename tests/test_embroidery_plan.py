@@ -144,19 +144,22 @@ def test_stats_count_time_thread_and_size():
     assert any(line.startswith("stitches") for line in stats.lines())
 
 
-def test_density_warning_at_six_needle_points_within_half_a_millimetre():
-    def plan_of(points):
+def test_density_warning_above_six_needle_points_within_half_a_millimetre():
+    def plan_of(points, roles=None):
         n = len(points)
         return StitchPlan(points=np.asarray(points, float), kinds=np.zeros(n, np.uint8),
-                          roles=np.full(n, BODY, np.uint8), params=np.linspace(0, 1, n),
-                          strokes=np.zeros(n, int))
-    five = [[0, 0], [0.3, 0], [0, 0.3], [0.3, 0.3], [0.2, 0.1], [5, 5]]
-    six = five[:5] + [[0.1, 0.4], [5, 5]]
-    assert embroidery_stats(plan_of(five)).max_density == 5
-    assert not embroidery_stats(plan_of(five)).too_dense
-    stats = embroidery_stats(plan_of(six))
-    assert stats.too_dense and stats.max_density == 6 and stats.dense_points == 6
+                          roles=np.full(n, BODY, np.uint8) if roles is None else np.asarray(roles, np.uint8),
+                          params=np.linspace(0, 1, n), strokes=np.zeros(n, int))
+    six = [[0, 0], [0.3, 0], [0, 0.3], [0.3, 0.3], [0.2, 0.1], [0.1, 0.4], [5, 5]]
+    seven = six[:6] + [[0.15, 0.15], [5, 5]]
+    assert embroidery_stats(plan_of(six)).max_density == 6
+    assert not embroidery_stats(plan_of(six)).too_dense
+    stats = embroidery_stats(plan_of(seven))
+    assert stats.too_dense and stats.max_density == 7 and stats.dense_points == 7
     assert "too dense" in stats.warnings[0]
+    # Tacks and locks are dense on purpose: they are left out of the count.
+    locked = embroidery_stats(plan_of(seven, [TACK, TACK, LOCK, LOCK, BODY, BODY, BODY, BODY]))
+    assert not locked.too_dense and locked.max_density == 3
     # A zigzag at 0.1 mm spacing is too dense; the default 0.4 mm on a straight line is not.
     line = Drawing((_line([0, 0], [20, 0]),), 20, 1, "mm")
     assert embroidery_stats(plan_embroidery(line, PlanOptions(style=ZigzagOptions(spacing=0.1)))).too_dense

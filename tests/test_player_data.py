@@ -15,8 +15,8 @@ from fabrication.cli import main
 from fabrication.embroidery.plan import PlanOptions, plan_embroidery, style_options
 from fabrication.embroidery.read import read_embroidery
 from fabrication.embroidery.stats import embroidery_stats
-from fabrication.laser.gcode_read import parse_gcode, read_gcode_file
-from fabrication.laser.job_time import estimate_gcode_time
+from machines.job_time import estimate_job_time as estimate_gcode_time
+from machines.job_time import read_moves
 from fabrication.player import player_html, stitch_player_data, write_player_html
 from fabrication.player.data import COLOR, DOWN, DRAW, TRAVEL, TRIM
 from machines.laser_profile import load_laser_profile
@@ -108,13 +108,13 @@ def test_gcode_page_matches_the_estimate(tmp_path):
     assert_self_contained(html)
     data = page_data(html)
     profile = load_laser_profile()
-    lines = read_gcode_file(ROSE)
+    lines = open(ROSE, encoding="utf-8").read().splitlines()
     job = estimate_gcode_time(lines, profile)
-    moves = parse_gcode(lines, laser_mode=profile.laser_mode)
+    moves = read_moves(lines, profile)[0]
     assert data["total"] == job.total_seconds
     assert data["t"][-1] == pytest.approx(job.total_seconds, rel=1e-12)
     assert np.all(np.diff(data["t"]) >= 0) and data["yUp"]
-    assert data["numberTotal"] == moves.n_lines == len(lines)
+    assert data["numberTotal"] == len(job.line_seconds) == len(lines)
     # each move ends at its line's planner time, on its end point
     end_rows = np.r_[np.flatnonzero(np.diff(data["num"].astype(int)) != 0), len(data["num"]) - 1]
     last_move = {int(line): k for k, line in enumerate(moves.line)}

@@ -65,11 +65,11 @@ def laser(source: str, output: str, size: float | None, width: float | None, hei
     """Turn SOURCE (PNG/JPG/SVG) into G-code for a GRBL 1.1 laser in one continuous pass per stroke."""
     from fabrication.cli.common import read_drawing
     from fabrication.cli.job_options import laser_settings
-    from fabrication.laser.framing import framing_lines
     from fabrication.laser.gcode_write import write_gcode
-    from fabrication.laser.job_time import format_duration
     from fabrication.laser.program import laser_program
     from fabrication.laser.raster_time import raster_time
+    from machines.framing import framing_lines
+    from machines.job_time import format_duration
 
     started = time.perf_counter()
     # every option is checked before anything is read or written
@@ -96,7 +96,8 @@ def laser(source: str, output: str, size: float | None, width: float | None, hei
         program = laser_program(drawing, profile, settings.toolpath, settings.gcode, name=Path(source).name)
     toolpath, job, lines = program.toolpath, program.time, list(program.lines)
     w, h = toolpath.size
-    frame_lines = framing_lines(toolpath.bounds, profile, power=frame_fraction) if frame_file else None
+    frame_lines = framing_lines(toolpath.bounds, power_s=frame_fraction * profile.max_power,
+                                max_s=profile.max_power) if frame_file else None
     # everything that can refuse the input runs before the first file is written
     raster = raster_time(toolpath, profile, interval=interval, feed=raster_feed_mm)
     write_gcode(output, lines)
@@ -111,7 +112,7 @@ def laser(source: str, output: str, size: float | None, width: float | None, hei
         warn(f"{toolpath.dropped} stroke(s) of zero length left out")
     console.print(f"travel: {toolpath.travel_before:.1f} mm in drawing order -> {toolpath.travel_greedy:.1f} mm "
                   f"greedy -> {toolpath.travel_after:.1f} mm after 2-opt")
-    console.print(f"time: {format_duration(job.total_seconds)} by GRBL's planner model "
+    console.print(f"time: {format_duration(job.total_seconds)}, {job.bound_text(profile)} "
                   f"(length/feed says {format_duration(job.naive_seconds)}); as a raster at "
                   f"{interval:g} mm and {raster_feed_mm:g} mm/min: {format_duration(raster.seconds)}")
     made = [output] + ([frame_file] if frame_file else []) + ([preview_path] if preview_path else [])

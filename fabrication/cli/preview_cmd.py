@@ -107,9 +107,7 @@ def _player_page(source: str, output: str, hoop: str | None, spm: float | None) 
     from fabrication.player import player_data_for_file, write_player_html
     from machines.hoops import load_embroidery_profile
 
-    profile = load_embroidery_profile()
-    if spm is not None and not spm > 0:
-        raise InputError(f"--spm {spm:g} must be greater than zero")
+    profile = load_embroidery_profile()  # --spm is range-checked by its option type
     frame = None
     if hoop is not None:
         field = profile.hoop(hoop)
@@ -120,7 +118,7 @@ def _player_page(source: str, output: str, hoop: str | None, spm: float | None) 
     for message in data.warnings:
         warn(message)
     write_player_html(data, output, source=source)
-    from fabrication.laser.job_time import format_duration
+    from machines.job_time import format_duration
 
     span = (format_duration(data.total) if data.time_unit == "s"
             else f"{data.total:.1f} {data.time_unit} drawn")

@@ -29,8 +29,8 @@ class EmbroideryStats:
     the lead-in to the first point not at all); trims; color_changes; thread_length: sum
     of needle-down stitch lengths, mm; width / height: extent of the needle points, mm;
     seconds: estimated sewing time; max_density: most needle points within
-    `density_radius` of one needle point outside tacks and locks (itself included);
-    dense_points: such needle points with `density_limit` or more; colors: per block."""
+    `density_radius` of one needle point, both outside tacks and locks (itself included);
+    dense_points: needle points with more than `density_limit`; colors: per block."""
 
     stitches: int
     jumps: int
@@ -55,7 +55,7 @@ class EmbroideryStats:
     def warnings(self) -> tuple[str, ...]:
         if not self.too_dense:
             return ()
-        return (f"{self.dense_points} needle points have {self.density_limit} or more needle points "
+        return (f"{self.dense_points} needle points have more than {self.density_limit} needle points "
                 f"within {self.density_radius:g} mm (up to {self.max_density}): too dense, the thread "
                 "may pile up or break; use a longer stitch or a wider spacing",)
 
@@ -99,13 +99,13 @@ def embroidery_stats(plan: StitchPlan, *, stitches_per_minute: float = 600.0,
     jumps = int(run_start[first_needle:].sum())
     trims = int((kinds == TRIM).sum())
     if len(needles):
-        # Tacks and locks are dense on purpose; every other needle point is a centre.
+        # Tacks and locks are dense on purpose: density is measured outside them.
         roles = plan.roles[plan.kinds == STITCH]
-        centres = needles[(roles != TACK) & (roles != LOCK)]
-        if not len(centres):
-            centres = needles
-        counts = cKDTree(needles).query_ball_point(centres, density_radius, return_length=True)
-        max_density, dense = int(counts.max()), int((counts >= density_limit).sum())
+        sewn = needles[(roles != TACK) & (roles != LOCK)]
+        if not len(sewn):
+            sewn = needles
+        counts = cKDTree(sewn).query_ball_point(sewn, density_radius, return_length=True)
+        max_density, dense = int(counts.max()), int((counts > density_limit).sum())
         lo, hi = needles.min(axis=0), needles.max(axis=0)
     else:
         max_density, dense, lo, hi = 0, 0, np.zeros(2), np.zeros(2)

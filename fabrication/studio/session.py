@@ -141,7 +141,7 @@ class StudioSession:
 
     def laser_preview(self, edits: Edits, values: dict) -> dict:
         """The G-code's moves for the player on the planner's time axis, and the estimate."""
-        from fabrication.laser.job_time import format_duration
+        from machines.job_time import format_duration
         from fabrication.player import gcode_player_data
 
         settings, program = self.laser(edits, values)
