@@ -16,12 +16,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from machines.gcode_interpreter import GcodeInterpreter
+from machines.gcode_interpreter import _SIMPLE, GcodeInterpreter
 
-_NUM = r"([-+]?(?:\d+\.?\d*|\.\d+))"
-# one match per line: a plain line fills groups 1-5 and leaves group 6 empty; any other
-# line (never empty in a Program) lands whole in group 6
-_LINES = re.compile(rf"^(?:G0?([01]))?(?:X{_NUM})?(?:Y{_NUM})?(?:F{_NUM})?(?:S{_NUM})?$|^(.+)$", re.MULTILINE)
+# one match per line: a plain line (the interpreter's own pattern) fills groups 1-5 and
+# leaves group 6 empty; any other line (never empty in a Program) lands whole in group 6
+_LINES = re.compile(_SIMPLE.pattern + "|^(.+)$", re.MULTILINE)
 
 
 def split_plain(texts: Sequence[str]) -> list[tuple[str, ...]] | None:
