@@ -13,11 +13,13 @@ from vectorize.drawing import Drawing
 from vectorize.fitting import TracedPoint, fit_stroke
 from vectorize.gaps import bridge_gaps, keep_largest_piece
 from vectorize.graph import MedialGraph
-from vectorize.intersections import Junction, JunctionVerdict, make_classifier, ranked_pairings
+from vectorize.classifiers import make_classifier
+from vectorize.intersections import Junction, JunctionVerdict, ranked_pairings
 from vectorize.medial_axis import medial_axis
 from vectorize.outline import outline_rings
-from vectorize.pipeline import InputFrame, VectorizeOptions, VectorizeReport, VectorizeResult
+from vectorize.options import InputFrame, VectorizeOptions, VectorizeReport, VectorizeResult
 from vectorize.pruning import prune, trim_free_ends
+from vectorize.route_inspection import connect_pairings, plan_route
 from vectorize.simplify import Simplified, directions, simplify, slots
 from vectorize.stroke import Stroke
 from vectorize.traversal import Ordering, order_strokes
@@ -117,9 +119,12 @@ def _trace(graph: MedialGraph, simple: Simplified, ordering: Ordering, junctions
             far_node = branch.b if step.start == "a" else branch.a
             points = points if index == 0 else points[1:]
             on_foot = step.branch in foot_branches
+            # The pen turns back on itself: a cusp (the fit splits there, never loops).
+            turns_back = (index + 1 < len(passes) and passes[index + 1].branch == step.branch
+                          and passes[index + 1].start != step.start)
             for k, xy in enumerate(points):
                 last = k == len(points) - 1
-                tip = last and far_node in simple.y_tips
+                tip = last and (far_node in simple.y_tips or turns_back)
                 keep = (not on_foot) or tip
                 traced.append(TracedPoint(xy, keep, tip))
         xy = np.array([t.xy for t in traced])
@@ -166,9 +171,28 @@ def _order(graph: MedialGraph, ink, options: VectorizeOptions, ends: int, clock:
     clock.lap("classification")
     ranked = {n: ranked_pairings(junctions[n], verdicts[n]) for n in simple.crossings}
     costs = {n: _pairing_costs(verdicts[n]) for n in simple.crossings}
-    ordering, tried = order_strokes(graph, simple, ranked, costs, stroke_width=w, search=not options.multi)
+    if options.multi:
+        ordering, tried = order_strokes(graph, simple, ranked, costs, stroke_width=w, search=False)
+    else:
+        ordering, tried = _single_route(graph, simple, ranked, costs, w)
     clock.lap("traversal")
     return _Solution(graph, simple, junctions, verdicts, ordering, tried)
+
+
+def _single_route(graph: MedialGraph, simple: Simplified, ranked: dict, costs: dict,
+                  w: float) -> tuple[Ordering, int]:
+    """Single-line mode: one stroke over the whole (connected) graph, retracing the least."""
+    pairing, tried = connect_pairings(graph, ranked, costs)
+    dirs = {n: directions(graph, n, 2.5 * w) for n in graph.incident if graph.degree(n) >= 3}
+    # The tip of a sharp corner's spur is not where a pen starts; a junction is a poorer
+    # place than a free end, all else equal.
+    v_tips = {graph.branches[slots(graph, n)[f][0]].other(n) for n, f in simple.y_feet.items()
+              if n not in simple.retraced}
+    end_cost = {n: 3.0 * w for n in v_tips}
+    end_cost.update({n: 0.1 * w for n in dirs})
+    route = plan_route(graph, pairing, stroke_width=w, directions=dirs, end_cost=end_cost)
+    choice = tuple(pairing.get(n, ranked[n][0]) for n in simple.crossings)
+    return Ordering((route.passes,), (route.closed,), choice), tried
 
 
 def _refuse_noise(count: int, what: str, limit: int, threshold: float) -> None:
