@@ -8,6 +8,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.interpolate import splev, splprep
 
+from vectorize.ink_guard import InkGuard, keep_in_ink
 from vectorize.stroke import Stroke
 
 
@@ -145,8 +146,15 @@ def _corner_point(before: np.ndarray, after: np.ndarray, fallback: np.ndarray, l
     return point
 
 
-def fit_stroke(traced: list[TracedPoint], *, closed: bool, sigma: float, stroke_width: float) -> Stroke:
-    """Filter, split at sharp features (Y-feet tips, corners) and fit one traversed stroke."""
+def _open_fit(points: np.ndarray, sigma: float) -> np.ndarray:
+    return fit_piece(points, closed=False, sigma=sigma, anchor=True)
+
+
+def fit_stroke(traced: list[TracedPoint], *, closed: bool, sigma: float, stroke_width: float,
+               guard: InkGuard | None = None) -> Stroke:
+    """Filter, split at sharp features (Y-feet tips, cusps, corners) and fit one traversed
+    stroke; with `guard`, every piece is brought back inside the ink where it strays
+    (`vectorize.ink_guard`)."""
     xy = np.array([p.xy for p in traced])
     keep = np.array([p.keep for p in traced])
     split = np.array([p.split for p in traced])
@@ -185,6 +193,12 @@ def fit_stroke(traced: list[TracedPoint], *, closed: bool, sigma: float, stroke_
         else:
             control = fit_piece(piece, closed=closed and len(cuts) == 2, sigma=sigma,
                                 anchor=not (corner[lo] or corner[hi]))
+            if guard is not None:
+                # Measured against every traced point of the piece, the uncertain ones too.
+                whole = xy[lo:hi + 1]
+                if closed and len(cuts) == 2:
+                    whole = np.vstack([whole, whole[:1]])
+                control = keep_in_ink(whole, control, guard, _open_fit, sigma)
         previous = piece
         pieces.append(np.array(control))  # writable: the joints move its ends
     # Join the pieces: at corners where their sides meet, elsewhere where they end.
@@ -195,9 +209,11 @@ def fit_stroke(traced: list[TracedPoint], *, closed: bool, sigma: float, stroke_
         before, after = pieces[k], pieces[m]
         if corner[at]:
             point = _corner_point(before, after, xy[at], 2.0 * stroke_width)
+            if guard is not None and guard.excess(point)[0] > 0.0:
+                point = xy[at]
         else:
             point = (before[-1, 3] + after[0, 0]) / 2.0
-        if not corner[at]:
+        if not corner[at] or np.array_equal(point, xy[at]):
             # Elsewhere move the inner handles along, keeping both end tangents; at a
             # corner the point lies on the tangents already.
             before[-1, 2] += point - before[-1, 3]

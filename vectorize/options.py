@@ -76,11 +76,14 @@ class VectorizeReport:
 
 @dataclass(frozen=True)
 class VectorizeResult:
-    """The drawing (px, in the input image's frame) and the report; `stages` for --debug."""
+    """The drawing (px, in the input image's frame) and the report; `stages` for --debug;
+    `graph`: the junctions and branches the edits act on (`vectorize.refine.GraphView`),
+    when the run was given edits or a stage cache."""
 
     drawing: Drawing
     report: VectorizeReport
     stages: dict | None = None
+    graph: object | None = None
 
 
 @dataclass(frozen=True)

@@ -20,8 +20,13 @@ __all__ = ["InputFrame", "VectorizeOptions", "VectorizeReport", "VectorizeResult
            "vectorize_image"]
 
 
-def vectorize_file(path: str | os.PathLike, options: VectorizeOptions = VectorizeOptions()) -> VectorizeResult:
-    """Vectorize a raster image or read an SVG (strokes as they are; outlines to centre lines)."""
+def vectorize_file(path: str | os.PathLike, options: VectorizeOptions = VectorizeOptions(), *,
+                   edits=None, cache=None) -> VectorizeResult:
+    """Vectorize a raster image or read an SVG (strokes as they are; outlines to centre lines).
+
+    edits: a `vectorize.edits.Edits` to apply; cache: a `vectorize.refine.StageCache`
+    reused between calls on the same file (each edit then re-runs only later stages).
+    """
     path = str(path)
     if not os.path.exists(path):
         raise InputError(f"input file {path!r} does not exist")
@@ -29,14 +34,19 @@ def vectorize_file(path: str | os.PathLike, options: VectorizeOptions = Vectoriz
         raise InputError(f"input {path!r} is a directory, not an image")
     suffix = os.path.splitext(path)[1].lower()
     if suffix in (".svg", ".svgz"):
-        return _vectorize_svg(path, options)
-    from vectorize.image_io import load_image
+        return _vectorize_svg(path, options, edits, cache)
+    if cache is not None and cache.loaded is not None and cache.loaded[0] == (path, options.max_size):
+        image, frame = cache.loaded[1]
+    else:
+        from vectorize.image_io import load_image
 
-    image, frame = load_image(path, max_size=options.max_size)
-    return vectorize_image(image, options, frame=frame)
+        image, frame = load_image(path, max_size=options.max_size)
+        if cache is not None:
+            cache.loaded = ((path, options.max_size), (image, frame))
+    return vectorize_image(image, options, frame=frame, edits=edits, cache=cache)
 
 
-def _vectorize_svg(path: str, options: VectorizeOptions) -> VectorizeResult:
+def _vectorize_svg(path: str, options: VectorizeOptions, edits=None, cache=None) -> VectorizeResult:
     from vectorize.svg_read import read_svg
 
     start = time.perf_counter()
@@ -46,15 +56,17 @@ def _vectorize_svg(path: str, options: VectorizeOptions) -> VectorizeResult:
 
         gray, scale, offset = rasterize_rings(content.outline_rings, size=options.max_size)
         frame = InputFrame(scale, (float(offset[0]), float(offset[1])), content.width, content.height)
-        return vectorize_image(gray, options, frame=frame)
+        return vectorize_image(gray, options, frame=frame, edits=edits, cache=cache)
     drawing = content.as_drawing()
+    ignored = ("edits apply to raster drawings only: the SVG's strokes were kept as they are",) \
+        if edits is not None and edits.items else ()
     report = VectorizeReport(strokes=len(drawing.strokes), stroke_width=drawing.stroke_width,
-                             seconds={"read svg": time.perf_counter() - start})
+                             warnings=ignored, seconds={"read svg": time.perf_counter() - start})
     return VectorizeResult(drawing, report)
 
 
 def vectorize_image(image: np.ndarray, options: VectorizeOptions = VectorizeOptions(), *,
-                    frame: InputFrame | None = None) -> VectorizeResult:
+                    frame: InputFrame | None = None, edits=None, cache=None) -> VectorizeResult:
     """Vectorize a raster image: (H, W) gray or (H, W, 3|4) colour, uint8, uint16 or float in
     [0, 1] (1 = paper), or an (H, W) bool ink mask (True = ink; note that a PIL mode "1"
     image as an array is the opposite, True = white: convert it to "L" first).
@@ -63,4 +75,4 @@ def vectorize_image(image: np.ndarray, options: VectorizeOptions = VectorizeOpti
     """
     from vectorize.vectorizer import run_pipeline
 
-    return run_pipeline(image, options, frame=frame)
+    return run_pipeline(image, options, frame=frame, edits=edits, cache=cache)

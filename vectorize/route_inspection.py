@@ -291,20 +291,34 @@ def _fleury(multi: _Multigraph, start: int, first_slot: int | None, turn) -> lis
     return walk
 
 
-def plan_route(graph: MedialGraph, pairings: dict, *, stroke_width: float, directions: dict,
-               end_cost: dict[int, float] | None = None) -> Route:
-    """The single stroke over every branch of a connected graph, retracing as little as it can.
+def plan_routes(graph: MedialGraph, pairings: dict, *, stroke_width: float, directions: dict,
+                end_cost: dict[int, float] | None = None) -> list[Route]:
+    """One stroke per piece of the graph over all its branches, retracing as little as it can.
 
     pairings: node -> slot pairs of its through-paths (decided junctions); directions: node
     -> (D, 2) unit tangents per slot, leaving the node (for junctions of degree >= 3);
     end_cost: px added when the pen starts or ends at a node (default 0): makes some nodes,
-    such as the tip of a sharp corner's spur, poor places to start.
+    such as the tip of a sharp corner's spur, poor places to start. A graph that is one
+    piece under the pairings (see `connect_pairings`) gives exactly one route.
     """
-    end_cost = end_cost or {}
     chain_list = chains(graph, pairings)
-    closed_only = [c for c in chain_list if c.u < 0]
-    if len(chain_list) == 1 and closed_only:
-        return Route(closed_only[0].passes, True, 0.0)
+    nodes = sorted({c.u for c in chain_list if c.u >= 0} | {c.v for c in chain_list if c.v >= 0})
+    where = {n: i for i, n in enumerate(nodes)}
+    open_chains = [c for c in chain_list if c.u >= 0]
+    links = coo_matrix((np.ones(len(open_chains)), ([where[c.u] for c in open_chains], [where[c.v] for c in open_chains])),
+                       shape=(len(nodes), len(nodes)))
+    _, label = connected_components(links, directed=False)
+    groups: dict[int, list[Chain]] = {}
+    for c in open_chains:
+        groups.setdefault(int(label[where[c.u]]), []).append(c)
+    routes = [_route(graph, group, stroke_width, directions, end_cost or {}) for _, group in sorted(groups.items())]
+    routes += [Route(c.passes, True, 0.0) for c in chain_list if c.u < 0]
+    return routes
+
+
+def _route(graph: MedialGraph, chain_list: list[Chain], stroke_width: float, directions: dict,
+           end_cost: dict[int, float]) -> Route:
+    """The route over one connected piece of chains (none of them closed on its own)."""
     nodes = sorted({c.u for c in chain_list if c.u >= 0} | {c.v for c in chain_list if c.v >= 0})
     where = {n: i for i, n in enumerate(nodes)}
     degree = np.zeros(len(nodes), dtype=int)
@@ -384,7 +398,9 @@ def plan_route(graph: MedialGraph, pairings: dict, *, stroke_width: float, direc
             multi.add(k)
             retraced += chain_list[k].length
     if ends:
-        start = nodes[odd[ends[0]]]
+        # Start at the free end if one of the two is one: the walk then reaches every
+        # junction along a branch and can go on as straight as the drawing allows.
+        start = min((nodes[odd[i]] for i in ends), key=lambda n: (len(multi.at[n]), n))
     else:
         # A closed walk: begin at the top-left node (any node would do).
         start = min(nodes, key=lambda n: (float(graph.positions[n].sum()), n))
@@ -439,9 +455,9 @@ def connect_pairings(graph: MedialGraph, ranked: dict, costs: dict, *,
     pairing = assign(best_ranks)
     count = best_key[0]
     if count > 1:
-        # Least sure first: the node whose second choice costs least; a pairing the user
-        # fixed (its only choice) last.
-        for node in sorted(nodes, key=lambda n: (costs[n][1] if len(costs[n]) > 1 else np.inf, n)):
+        # Least sure first: the node whose second choice costs least.
+        # A pairing the user fixed (its only choice) stays, even if the line then falls apart.
+        for node in sorted((n for n in nodes if len(ranked[n]) > 1), key=lambda n: (costs[n][1], n)):
             trial = {n: p for n, p in pairing.items() if n != node}
             now = pieces(graph, trial)
             if now < count:

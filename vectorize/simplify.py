@@ -134,11 +134,14 @@ def _merge(graph: MedialGraph, a: int, b: int, bid: int) -> int:
     return node
 
 
-def simplify(graph: MedialGraph, *, stroke_width: float, multi: bool, ends: int = 2) -> Simplified:
+def simplify(graph: MedialGraph, *, stroke_width: float, multi: bool, ends: int = 2,
+             may_merge=None, after_merging=None) -> Simplified:
     """Merge crossing halves into degree-4 nodes in place and classify the other nodes.
 
     ends: free ends the single line is taken to have (2 open, 0 closed); free ends beyond
-    those may be read as spikes drawn out and back.
+    those may be read as spikes drawn out and back. The user's edits hook in here
+    (`vectorize.refine`): may_merge(branch) -> False keeps the two nodes it joins apart (a
+    split); after_merging(graph) makes the user's own merges before the nodes are typed.
     """
     reach = 2.5 * stroke_width
     merged = 0
@@ -212,7 +215,8 @@ def simplify(graph: MedialGraph, *, stroke_width: float, multi: bool, ends: int 
             pool = set(candidates())
             picks = {n: joining(n, lambda far: far in pool)[rule] for n in pool}
             pairs = sorted({tuple(sorted((n, p[1]))) + (p[0],) for n, p in picks.items()
-                            if p is not None and picks.get(p[1]) is not None and picks[p[1]][0] == p[0]})
+                            if p is not None and picks.get(p[1]) is not None and picks[p[1]][0] == p[0]
+                            and (may_merge is None or may_merge(graph.branches[p[0]]))})
             if not pairs:
                 break
             done: set[int] = set()
@@ -232,6 +236,8 @@ def simplify(graph: MedialGraph, *, stroke_width: float, multi: bool, ends: int 
             pick = joining(node, lambda far: far in pool and far in graph.incident and graph.degree(far) == 3)["widest"]
             if pick is None or graph.branches[pick[0]].length > 2.0 * stroke_width:
                 continue
+            if may_merge is not None and not may_merge(graph.branches[pick[0]]):
+                continue
             _merge(graph, node, pick[1], pick[0])
             pool -= {node, pick[1]}
             merged += 1
@@ -239,6 +245,8 @@ def simplify(graph: MedialGraph, *, stroke_width: float, multi: bool, ends: int 
         if not progress:
             break
 
+    if after_merging is not None:
+        merged += after_merging(graph)
     y_feet, y_tips, t_ends, unresolved, retraced = {}, set(), [], [], set()
     for node in sorted(graph.incident):
         degree = graph.degree(node)
@@ -251,7 +259,7 @@ def simplify(graph: MedialGraph, *, stroke_width: float, multi: bool, ends: int 
                 if not _v_spike(graph, node, reach):
                     retraced.add(node)  # a T: the spike runs back over itself
                 y_tips.add(graph.branches[node_slots[spike][0]].other(node))
-            elif _is_t_shape(dirs):
+            elif is_t_shape(dirs):
                 # A stroke ending on another line: an end of the drawing (paper 3.3, 4.5).
                 t_ends.append(node)
             else:
@@ -267,7 +275,7 @@ def simplify(graph: MedialGraph, *, stroke_width: float, multi: bool, ends: int 
                       frozenset(retraced))
 
 
-def _is_t_shape(dirs: np.ndarray) -> bool:
+def is_t_shape(dirs: np.ndarray) -> bool:
     """Largest angle between branches near 180 degrees and the other two alike (paper 4.5)."""
     pairs = [(0, 1), (0, 2), (1, 2)]
     angles = sorted(float(np.degrees(np.arccos(np.clip(np.dot(dirs[i], dirs[j]), -1, 1)))) for i, j in pairs)

@@ -10,17 +10,20 @@ import numpy as np
 from onestroke.errors import InputError
 from vectorize.binarize import binarize
 from vectorize.drawing import Drawing
+from vectorize.edits import Edits
 from vectorize.fitting import TracedPoint, fit_stroke
 from vectorize.gaps import bridge_gaps, keep_largest_piece
 from vectorize.graph import MedialGraph
+from vectorize.ink_guard import InkGuard
 from vectorize.classifiers import make_classifier
 from vectorize.intersections import Junction, JunctionVerdict, ranked_pairings
 from vectorize.medial_axis import medial_axis
 from vectorize.outline import outline_rings
 from vectorize.options import InputFrame, VectorizeOptions, VectorizeReport, VectorizeResult
 from vectorize.pruning import prune, trim_free_ends
-from vectorize.route_inspection import connect_pairings, plan_route
-from vectorize.simplify import Simplified, directions, simplify, slots
+from vectorize.refine import Refinement, StageCache
+from vectorize.route_inspection import connect_pairings, plan_routes
+from vectorize.simplify import Simplified, is_t_shape, directions, simplify, slots
 from vectorize.stroke import Stroke
 from vectorize.traversal import Ordering, order_strokes
 
@@ -156,27 +159,62 @@ class _Solution(NamedTuple):
     tried: int
 
 
-def _order(graph: MedialGraph, ink, options: VectorizeOptions, ends: int, clock: _Clock) -> _Solution:
-    """Simplify (in place), classify the crossings and traverse, for one count of free ends."""
+def _order(graph: MedialGraph, ink, options: VectorizeOptions, ends: int, clock: _Clock,
+           refine: Refinement | None = None) -> _Solution:
+    """Simplify (in place), classify the crossings and traverse, for one count of free ends.
+
+    With `refine`, the user's splits and merges act inside simplification, fixed pairings
+    enter the traversal as decisions it may not change, and simplified graphs with their
+    verdicts are reused from the session's cache (they depend on no later edit).
+    """
     w = ink.stroke_width
-    simple = simplify(graph, stroke_width=w, multi=options.multi, ends=ends)
-    clock.lap("simplification")
-    junction_list = _junctions(graph, simple.crossings, w)
-    junctions = dict(zip(simple.crossings, junction_list))
-    verdict_list = make_classifier(options.classifier).classify(ink.gray, junction_list, w) if junction_list else []
-    if options.classifier == "cnn" and junction_list:
-        geometry = make_classifier("geometric").classify(ink.gray, junction_list, w)
-        verdict_list = [_with_geometry(v, g) for v, g in zip(verdict_list, geometry)]
-    verdicts = dict(zip(simple.crossings, verdict_list))
+    cached = refine.lookup(ends) if refine is not None else None
+    if cached is not None:
+        graph, simple, junctions, verdicts = cached
+    else:
+        hooks = refine.simplify_hooks() if refine is not None else {}
+        simple = simplify(graph, stroke_width=w, multi=options.multi, ends=ends, **hooks)
+        clock.lap("simplification")
+        junction_list = _junctions(graph, simple.crossings, w)
+        junctions = dict(zip(simple.crossings, junction_list))
+        verdict_list = make_classifier(options.classifier).classify(ink.gray, junction_list, w) if junction_list else []
+        if options.classifier == "cnn" and junction_list:
+            geometry = make_classifier("geometric").classify(ink.gray, junction_list, w)
+            verdict_list = [_with_geometry(v, g) for v, g in zip(verdict_list, geometry)]
+        verdicts = dict(zip(simple.crossings, verdict_list))
+        if refine is not None:
+            refine.store(ends, (graph, simple, junctions, verdicts))
     clock.lap("classification")
     ranked = {n: ranked_pairings(junctions[n], verdicts[n]) for n in simple.crossings}
     costs = {n: _pairing_costs(verdicts[n]) for n in simple.crossings}
+    if refine is not None:
+        refine.fix_pairings(junctions, ranked, costs)
     if options.multi:
         ordering, tried = order_strokes(graph, simple, ranked, costs, stroke_width=w, search=False)
     else:
         ordering, tried = _single_route(graph, simple, ranked, costs, w)
     clock.lap("traversal")
     return _Solution(graph, simple, junctions, verdicts, ordering, tried)
+
+
+# Cost (in stroke widths) of the pen starting or ending at a junction that is not a line
+# ending on another line: a whole spike of up to this length is retraced rather.
+JUNCTION_END = 20.0
+
+
+def _junction_end_cost(graph: MedialGraph, node: int, dirs: np.ndarray, w: float) -> float:
+    """How poor a place `node` is for the pen to start or end (px).
+
+    Plausible only where a line comes in and stops on another (a T whose stem is not a
+    free branch: the tail of a 6 closing its loop). A junction where a stub or spike
+    leaves a line is not: the pen would have drawn the stub first from its far end.
+    """
+    if len(dirs) == 3 and is_t_shape(dirs):
+        cos = [(float(np.dot(dirs[i], dirs[j])), k) for i, j, k in ((0, 1, 2), (0, 2, 1), (1, 2, 0))]
+        stem = min(cos)[1]
+        if graph.degree(graph.branches[slots(graph, node)[stem][0]].other(node)) != 1:
+            return 0.1 * w
+    return JUNCTION_END * w
 
 
 def _single_route(graph: MedialGraph, simple: Simplified, ranked: dict, costs: dict,
@@ -189,10 +227,10 @@ def _single_route(graph: MedialGraph, simple: Simplified, ranked: dict, costs: d
     v_tips = {graph.branches[slots(graph, n)[f][0]].other(n) for n, f in simple.y_feet.items()
               if n not in simple.retraced}
     end_cost = {n: 3.0 * w for n in v_tips}
-    end_cost.update({n: 0.1 * w for n in dirs})
-    route = plan_route(graph, pairing, stroke_width=w, directions=dirs, end_cost=end_cost)
+    end_cost.update({n: _junction_end_cost(graph, n, dirs[n], w) for n in dirs})
+    routes = plan_routes(graph, pairing, stroke_width=w, directions=dirs, end_cost=end_cost)
     choice = tuple(pairing.get(n, ranked[n][0]) for n in simple.crossings)
-    return Ordering((route.passes,), (route.closed,), choice), tried
+    return Ordering(tuple(r.passes for r in routes), tuple(r.closed for r in routes), choice), tried
 
 
 def _refuse_noise(count: int, what: str, limit: int, threshold: float) -> None:
@@ -203,10 +241,9 @@ def _refuse_noise(count: int, what: str, limit: int, threshold: float) -> None:
                          f"drawing; try a --threshold below {threshold:.2f}, or --blur 1")
 
 
-def run_pipeline(image: np.ndarray, options: VectorizeOptions, *,
-                 frame: InputFrame | None = None) -> VectorizeResult:
-    """Vectorize `image`; the drawing comes out in `frame` (default: the image's pixels)."""
-    clock = _Clock()
+def _front(image: np.ndarray, options: VectorizeOptions, clock: _Clock):
+    """Binarize, outline, medial axis, pruning and (single-line) gap bridging: the stages
+    that only threshold, blur and mode change. Returns (ink, rings, graph, bridged, dropped)."""
     # Every piece of ink is kept here; in single-line mode the pieces of a line broken by
     # pen gaps are bridged below, and only then is the largest kept.
     ink = binarize(image, max_size=options.max_size, blur=options.blur, threshold=options.threshold)
@@ -227,13 +264,44 @@ def run_pipeline(image: np.ndarray, options: VectorizeOptions, *,
     if not options.multi:
         bridged = bridge_gaps(graph, stroke_width=w)
         dropped = keep_largest_piece(graph)
+    return ink, rings, graph, bridged, dropped
+
+
+def run_pipeline(image: np.ndarray, options: VectorizeOptions, *,
+                 frame: InputFrame | None = None, edits: Edits | None = None,
+                 cache: StageCache | None = None) -> VectorizeResult:
+    """Vectorize `image`; the drawing comes out in `frame` (default: the image's pixels).
+
+    edits: the user's corrections (`vectorize.edits`); cache: a `StageCache` kept between
+    calls on the same image, so that an edit re-runs only the stages after it.
+    """
+    clock = _Clock()
+    shape = np.asarray(image).shape
+    if frame is None:
+        frame = InputFrame(1.0, (0.0, 0.0), float(shape[1]), float(shape[0]))
+    refining = edits is not None or cache is not None
+    if refining:
+        edits = edits if edits is not None else Edits()
+        options = edits.applied_to(options)
+        cache = cache if cache is not None else StageCache()
+        front = cache.front_for(image, options, lambda: _front(image, options, clock))
+    else:
+        front = _front(image, options, clock)
+    ink, rings, graph, bridged, dropped = front
+    w = ink.stroke_width
+    scale = ink.scale * frame.scale  # working px per output unit
+    # Working pixel centres sit at integers (scikit-image); in SVG and in the input's pixel
+    # frame pixel i covers [i, i + 1), so its centre is at i + 0.5.
+    matrix = np.array([[1 / scale, 0, frame.offset[0] + 0.5 / scale],
+                       [0, 1 / scale, frame.offset[1] + 0.5 / scale]])
+    refine = Refinement(edits, cache, matrix, options, w) if refining else None
     stages = {"ink": ink, "rings": rings, "pruned": graph.copy()} if options.keep_stages else None
     # A single line has two free ends, or none when it closes: free ends beyond those are
     # spikes drawn out and back. Try the open reading first, the closed one if it fails.
     readings = (2,) if options.multi else (2, 0)
     best = None
     for ends in readings:
-        attempt = _order(graph.copy() if len(readings) > 1 else graph, ink, options, ends, clock)
+        attempt = _order(graph.copy() if len(readings) > 1 or refining else graph, ink, options, ends, clock, refine)
         if best is None or len(attempt.ordering.strokes) < len(best.ordering.strokes):
             best = attempt
         if len(best.ordering.strokes) <= 1:
@@ -243,25 +311,20 @@ def run_pipeline(image: np.ndarray, options: VectorizeOptions, *,
     # Smoothing allowance: the medial axis wobbles by ~0.07 px per px of stroke width (pixel
     # grid, anti-aliasing); fitting tighter follows that wobble, looser cuts corners.
     sigma = float(np.clip(0.065 * w, 0.15, 0.8))
+    guard = InkGuard(graph, ink.gray, ink.threshold)
     strokes = []
     for traced, closed in _trace(graph, simple, ordering, junctions, verdicts, w):
         if len(traced) < 2:
             continue
-        strokes.append(_orient(fit_stroke(traced, closed=closed, sigma=sigma, stroke_width=w), closed))
+        strokes.append(_orient(fit_stroke(traced, closed=closed, sigma=sigma, stroke_width=w, guard=guard), closed))
     strokes = [s for s in strokes if s.length > 0.5 * w or len(strokes) == 1]
     strokes.sort(key=lambda s: (round(float(s.start.sum()) / (4 * w)), float(s.start[0])))
     clock.lap("fitting")
 
     # Back to the input's frame: original image pixels, or the SVG's user units.
-    shape = np.asarray(image).shape
-    if frame is None:
-        frame = InputFrame(1.0, (0.0, 0.0), float(shape[1]), float(shape[0]))
-    scale = ink.scale * frame.scale  # working px per output unit
-    # Working pixel centres sit at integers (scikit-image); in SVG and in the input's pixel
-    # frame pixel i covers [i, i + 1), so its centre is at i + 0.5.
-    matrix = np.array([[1 / scale, 0, frame.offset[0] + 0.5 / scale],
-                       [0, 1 / scale, frame.offset[1] + 0.5 / scale]])
     drawing = Drawing(tuple(s.transformed(matrix) for s in strokes), frame.width, frame.height, "px", w / scale)
+    if refine is not None:
+        drawing = refine.orient(drawing)
 
     warnings = []
     if ink.scale < 1.0 or frame.reduced_from is not None:
@@ -275,6 +338,8 @@ def run_pipeline(image: np.ndarray, options: VectorizeOptions, *,
     if simple.unresolved:
         warnings.append(f"{len(simple.unresolved)} junction(s) where three or more strokes seem to meet:"
                         " they are not resolved and the order there may be wrong")
+    if refine is not None:
+        warnings.extend(refine.unmatched())
     if not options.multi and len(strokes) > 1:
         warnings.append(f"the line could not be followed in one stroke: {len(strokes)} strokes")
     report = VectorizeReport(
@@ -284,4 +349,5 @@ def run_pipeline(image: np.ndarray, options: VectorizeOptions, *,
     if stages is not None:
         stages.update(simplified=graph, simple=simple, junctions=junctions, verdicts=verdicts,
                       ordering=ordering, working_strokes=strokes)
-    return VectorizeResult(drawing, report, stages)
+    view = refine.graph_view(best) if refine is not None else None
+    return VectorizeResult(drawing, report, stages, view)

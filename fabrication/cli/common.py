@@ -20,12 +20,24 @@ def done(message: str) -> None:
 
 
 def read_drawing(path: str, *, multi: bool = False, threshold: float | None = None,
-                 blur: float = 0.0, classifier: str = "cnn"):
-    """Read a drawing from a raster image or SVG, printing the vectorizer's warnings."""
-    from vectorize import VectorizeOptions, vectorize_file
+                 blur: float = 0.0, classifier: str = "cnn", edits: str | None = None):
+    """Read a drawing from a raster image or SVG, printing the vectorizer's warnings.
 
+    edits: path of an edits file (the studio's corrections) to replay.
+    """
+    from vectorize import VectorizeOptions, vectorize_file
+    from vectorize.edits import read_edits
+
+    replay = read_edits(edits) if edits is not None else None
     result = vectorize_file(path, VectorizeOptions(multi=multi, threshold=threshold, blur=blur,
-                                                   classifier=classifier))
+                                                   classifier=classifier), edits=replay)
     for message in result.report.warnings:
         warn(message)
     return result.drawing
+
+
+def edits_option(function):
+    """The `--edits FILE` option: replay the studio's corrections of the vectorization."""
+    return click.option("--edits", "edits", default=None, type=click.Path(dir_okay=False, path_type=str),
+                        help="Raster input: replay the corrections saved by `onestroke studio` "
+                             "(edits JSON; its threshold, blur and mode win over the flags).")(function)

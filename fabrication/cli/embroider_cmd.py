@@ -7,7 +7,7 @@ import time
 
 import click
 
-from fabrication.cli.common import console, done
+from fabrication.cli.common import console, done, edits_option
 from onestroke.atomic import check_writable
 from onestroke.errors import InputError
 
@@ -15,22 +15,6 @@ from onestroke.errors import InputError
 def warn(message: str) -> None:
     """A one-line warning (soft wrap: long messages stay on one line in logs)."""
     console.print(f"[yellow]warning:[/yellow] {message}", soft_wrap=True)
-
-# A design side this small (mm) given with --width/--height in a zigzag or arrows job is
-# worth a hint that --stitch-width is the stitch's width.
-SMALL_DESIGN_MM = 15.0
-
-# CLI option -> field name in the style options; which styles use it (for warnings).
-_STYLE_FIELDS = {
-    "stitch_length": ("stitch_length", "--stitch-length"),
-    "tolerance": ("tolerance", "--tolerance"),
-    "stitch_width": ("width", "--stitch-width"),
-    "spacing": ("spacing", "--spacing"),
-    "pull_comp": ("pull_compensation", "--pull-comp"),
-    "repeats": ("repeats", "--repeats"),
-    "arrow_size": ("size", "--arrow-size"),
-}
-
 
 @click.command()
 @click.argument("source", type=click.Path(path_type=str))
@@ -74,83 +58,40 @@ _STYLE_FIELDS = {
 @click.option("--blur", type=float, default=0.0, show_default=True, help="Raster input: Gaussian blur sigma in px.")
 @click.option("--classifier", default="cnn", show_default=True,
               help="Raster input: crossing classifier, cnn or geometric.")
+@edits_option
 def embroider(source: str, output: str, style: str, size: str | None, width: str | None, height: str | None,
               rotate: float, hoop: str, fit: bool, stitch_length: str | None, tolerance: str | None,
               stitch_width: str | None, spacing: str | None, pull_comp: str | None, repeats: int | None,
               arrow_size: str | None, min_stitch: str, max_stitch: str, trim_distance: str, lock_form: str,
               color: str, pes_version: int | None, spm: float | None, preview_path: str | None,
               preview_width: int, multi: bool, threshold: float | None, blur: float,
-              classifier: str) -> None:
+              classifier: str, edits: str | None) -> None:
     """Sew SOURCE (PNG/JPG/SVG/JSON drawing) along its curve into an embroidery file."""
+    from fabrication.cli.job_options import embroidery_settings
     from fabrication.embroidery.canvas import check_preview_path
-    from fabrication.embroidery.export import PES_VERSIONS, write_embroidery
-    from fabrication.embroidery.locks import LockOptions
-    from fabrication.embroidery.pipeline import EmbroideryJob, embroider as embroider_drawing
-    from fabrication.embroidery.plan import PlanOptions, style_options
+    from fabrication.embroidery.export import write_embroidery
+    from fabrication.embroidery.pipeline import embroider as embroider_drawing
     from fabrication.embroidery.preview import PreviewOptions, render_stitch_preview
-    from fabrication.embroidery.thread import parse_color
-    from fabrication.placement import PlacementOptions
-    from machines.hoops import load_embroidery_profile
-    from onestroke.units import parse_length, parse_positive_length
 
     started = time.perf_counter()
     # Every option is checked before anything is read or written.
-    profile = load_embroidery_profile()
-    fmt = profile.format_for(output)
+    settings = embroidery_settings(
+        output=output, style=style, size=size, width=width, height=height, rotate=rotate, hoop=hoop, fit=fit,
+        stitch_length=stitch_length, tolerance=tolerance, stitch_width=stitch_width, spacing=spacing,
+        pull_comp=pull_comp, repeats=repeats, arrow_size=arrow_size, min_stitch=min_stitch,
+        max_stitch=max_stitch, trim_distance=trim_distance, lock_form=lock_form, color=color,
+        pes_version=pes_version, spm=spm)
     check_writable(output)
-    if pes_version is not None:
-        if fmt.extension != "pes":
-            raise InputError(f"--pes-version applies to .pes output only, not .{fmt.extension}")
-        if pes_version not in PES_VERSIONS:
-            raise InputError(f"--pes-version {pes_version} is not supported; use 1 or 6")
     if preview_path is not None:
         check_preview_path(preview_path)
         check_writable(preview_path)
         preview_options = PreviewOptions(width=preview_width)
     if not os.path.isfile(source):
         raise InputError(f"input file {source!r} does not exist")
-
-    lengths = {name: parse_positive_length(value, what=flag)
-               for name, value, flag in (("stitch_length", stitch_length, "--stitch-length"),
-                                         ("tolerance", tolerance, "--tolerance"),
-                                         ("stitch_width", stitch_width, "--stitch-width"),
-                                         ("spacing", spacing, "--spacing"),
-                                         ("arrow_size", arrow_size, "--arrow-size")) if value is not None}
-    if pull_comp is not None:
-        lengths["pull_comp"] = parse_length(pull_comp, what="--pull-comp")
-    if repeats is not None:
-        lengths["repeats"] = repeats
-    style_values = {_STYLE_FIELDS[k][0]: v for k, v in lengths.items()}
-    stitch_options = style_options(style, **style_values)
-    unused = [_STYLE_FIELDS[k][1] for k in lengths
-              if _STYLE_FIELDS[k][0] not in type(stitch_options).__dataclass_fields__]
-    if not any(v is not None for v in (size, width, height)):
-        size = "90mm"
-    placement = PlacementOptions(
-        size=parse_positive_length(size, what="--size") if size is not None else None,
-        width=parse_positive_length(width, what="--width") if width is not None else None,
-        height=parse_positive_length(height, what="--height") if height is not None else None,
-        rotate=rotate)
-    the_hoop = profile.hoop(hoop)
-    limit = min(parse_positive_length(max_stitch, what="--max-stitch"), fmt.max_stitch, profile.max_stitch)
-    plan_options = PlanOptions(style=stitch_options, lock=LockOptions(form=lock_form),
-                               min_stitch=parse_positive_length(min_stitch, what="--min-stitch"),
-                               max_stitch=limit,
-                               trim_distance=parse_length(trim_distance, what="--trim-distance"),
-                               color=parse_color(color))
-    if spm is not None and not spm > 0:
-        raise InputError(f"--spm {spm:g} must be greater than zero")
-    job = EmbroideryJob(placement=placement, hoop=the_hoop, fit=fit, plan=plan_options,
-                        stitches_per_minute=spm or profile.stitches_per_minute,
-                        trim_seconds=profile.trim_seconds)
-    for flag in unused:
-        warn(f"{flag} has no effect with --style {style}")
-    if style in ("zigzag", "arrows") and stitch_width is None:
-        # `--width 3mm` next to --style zigzag most likely meant the zigzag, not the design.
-        for flag, side in (("--width", placement.width), ("--height", placement.height)):
-            if side is not None and side < SMALL_DESIGN_MM:
-                warn(f"{flag} {side:g} mm sizes the whole design; the {style}'s own width is "
-                     f"--stitch-width")
+    job = settings.job
+    the_hoop = job.hoop
+    for message in settings.warnings:
+        warn(message)
 
     if source.lower().endswith(".json"):
         from vectorize.svg_write import drawing_from_json
@@ -160,7 +101,8 @@ def embroider(source: str, output: str, style: str, size: str | None, width: str
     else:
         from fabrication.cli.common import read_drawing
 
-        drawing = read_drawing(source, multi=multi, threshold=threshold, blur=blur, classifier=classifier)
+        drawing = read_drawing(source, multi=multi, threshold=threshold, blur=blur, classifier=classifier,
+                               edits=edits)
     result = embroider_drawing(drawing, job)
     write_embroidery(result.plan, output, pes_version=pes_version)
     if preview_path is not None:

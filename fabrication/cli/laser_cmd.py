@@ -8,7 +8,7 @@ from pathlib import Path
 
 import click
 
-from fabrication.cli.common import console, done, warn
+from fabrication.cli.common import console, done, edits_option, warn
 from onestroke.atomic import check_writable
 from onestroke.errors import InputError
 
@@ -55,20 +55,20 @@ def frame_path_for(output: str) -> str:
               help="Raster input: how the vectorizer tells crossings from touchings.")
 @click.option("--port", default=None, help="After writing, stream the job to this serial port (sim:// for a dry run).")
 @click.option("--baud", type=int, default=115200, show_default=True, help="Baud rate for --port.")
+@edits_option
 def laser(source: str, output: str, size: str | None, width: str | None, height: str | None, rotate: float,
           origin: str, feed: str, power: str, passes: int, tolerance: str, arcs: bool, keep_order: bool,
           profile_path: str | None, air_assist: bool | None, return_home: bool, frame: bool, frame_power: str,
           preview_path: str | None, raster_interval: str, raster_feed: str | None, multi: bool, threshold: float | None,
-          classifier: str, port: str | None, baud: int) -> None:
+          classifier: str, port: str | None, baud: int, edits: str | None) -> None:
     """Turn SOURCE (PNG/JPG/SVG) into G-code for a GRBL 1.1 laser in one continuous pass per stroke."""
     from fabrication.cli.common import read_drawing
+    from fabrication.cli.job_options import laser_settings
     from fabrication.laser.framing import framing_lines
-    from fabrication.laser.gcode_write import GcodeOptions, comment_line, gcode_lines, write_gcode
-    from fabrication.laser.job_time import estimate_gcode_time, format_duration
+    from fabrication.laser.gcode_write import write_gcode
+    from fabrication.laser.job_time import format_duration
+    from fabrication.laser.program import laser_program
     from fabrication.laser.raster_time import raster_time
-    from fabrication.laser.toolpath import ToolpathOptions, plan_toolpath
-    from fabrication.placement import PlacementOptions
-    from machines.laser_profile import load_laser_profile
     from onestroke.units import parse_fraction, parse_positive_length, parse_speed
 
     started = time.perf_counter()
@@ -87,50 +87,27 @@ def laser(source: str, output: str, size: str | None, width: str | None, height:
     if len(set(outputs)) < len(outputs):
         twice = next(str(p) for p in outputs if outputs.count(p) > 1)
         raise InputError(f"input, output, preview and frame files must all differ ({twice!r} is given twice)")
-    feed_mm = parse_speed(feed, what="--feed")
-    if not feed_mm > 0:
-        raise InputError(f"--feed {feed!r} must be greater than 0 mm/min")
-    power_fraction = parse_fraction(power, what="--power")
-    if power_fraction <= 0:
-        raise InputError(f"--power {power!r} must be above 0% (and at most 100%)")
+    settings = laser_settings(size=size, width=width, height=height, rotate=rotate, origin=origin, feed=feed,
+                              power=power, passes=passes, tolerance=tolerance, arcs=arcs, keep_order=keep_order,
+                              profile_path=profile_path, air_assist=air_assist, return_home=return_home)
+    profile = settings.profile
     frame_fraction = parse_fraction(frame_power, what="--frame-power")
-    tol = parse_positive_length(tolerance, what="--tolerance")
     interval = parse_positive_length(raster_interval, what="--raster-interval")
+    feed_mm = settings.gcode.feed
     raster_feed_mm = feed_mm if raster_feed is None else parse_speed(raster_feed, what="--raster-feed")
     if not raster_feed_mm > 0:
         raise InputError(f"--raster-feed {raster_feed!r} must be greater than 0 mm/min")
-    if passes < 1:
-        raise InputError(f"--passes {passes} must be at least 1")
-    placement = PlacementOptions(
-        size=parse_positive_length(size, what="--size") if size is not None else None,
-        width=parse_positive_length(width, what="--width") if width is not None else None,
-        height=parse_positive_length(height, what="--height") if height is not None else None,
-        rotate=rotate)
-    profile = load_laser_profile(profile_path)
-    toolpath_options = ToolpathOptions(placement=placement, origin=origin, tolerance=tol, arcs=arcs,
-                                       optimize=not keep_order)
-    gcode_options = GcodeOptions(feed=feed_mm, power=power_fraction, passes=passes, return_home=return_home,
-                                 air_assist=air_assist)
-    if feed_mm > min(profile.max_rate_x, profile.max_rate_y):
-        warn(f"--feed {feed_mm:g} mm/min is above the profile's max rate; GRBL will cap it")
+    for message in settings.warnings:
+        warn(message)
     if not os.path.exists(source):
         raise InputError(f"input file {source!r} does not exist")
 
     with console.status(f"reading {os.path.basename(source)}"):
-        drawing = read_drawing(source, multi=multi, threshold=threshold, classifier=classifier)
+        drawing = read_drawing(source, multi=multi, threshold=threshold, classifier=classifier, edits=edits)
     with console.status("planning the toolpath"):
-        toolpath = plan_toolpath(drawing, profile, toolpath_options)
-        lines = gcode_lines(toolpath, profile, gcode_options)
-        job = estimate_gcode_time(lines, profile)
+        program = laser_program(drawing, profile, settings.toolpath, settings.gcode, name=Path(source).name)
+    toolpath, job, lines = program.toolpath, program.time, list(program.lines)
     w, h = toolpath.size
-    comments = (
-        f"onestroke laser: {Path(source).name}",
-        f"{w:.1f} x {h:.1f} mm, {len(toolpath.paths)} stroke(s), {passes} pass(es)",
-        f"feed {feed_mm:g} mm/min, power {power_fraction * 100:g}% (S{power_fraction * profile.max_power:g})",
-        f"estimated time {format_duration(job.total_seconds)} (GRBL planner model)",
-        f"profile: {profile.name}",
-    )
-    lines = [comment_line(c) for c in comments] + lines
     frame_lines = framing_lines(toolpath.bounds, profile, power=frame_fraction) if frame_file else None
     # everything that can refuse the input runs before the first file is written
     raster = raster_time(toolpath, profile, interval=interval, feed=raster_feed_mm)

@@ -7,7 +7,7 @@ import time
 
 import click
 
-from fabrication.cli.common import console, done, warn
+from fabrication.cli.common import console, done, edits_option, warn
 from onestroke.atomic import check_writable
 from onestroke.errors import InputError
 
@@ -26,21 +26,24 @@ from onestroke.errors import InputError
               help="How crossings are told from touchings.")
 @click.option("--debug", "debug_dir", type=click.Path(file_okay=False, path_type=str), default=None,
               help="Write a PNG overlay of every stage into this folder.")
+@edits_option
 def vectorize(source: str, output: str, multi: bool, threshold: float | None, blur: float,
-              classifier: str, debug_dir: str | None) -> None:
+              classifier: str, debug_dir: str | None, edits: str | None) -> None:
     """Vectorize SOURCE into one ordered cubic Bézier curve (or several with --multi)."""
     from vectorize import VectorizeOptions, vectorize_file
+    from vectorize.edits import read_edits
     from vectorize.svg_write import write_drawing
 
     suffix = os.path.splitext(output)[1].lower()
     if suffix not in (".svg", ".json"):
         raise InputError(f"cannot write {output!r}: use an .svg or .json output file")
     check_writable(output)
+    replay = read_edits(edits) if edits is not None else None
     started = time.perf_counter()
     options = VectorizeOptions(multi=multi, threshold=threshold, blur=blur, classifier=classifier,
                                keep_stages=debug_dir is not None)
     with console.status(f"vectorizing {os.path.basename(source)}"):
-        result = vectorize_file(source, options)
+        result = vectorize_file(source, options, edits=replay)
     for message in result.report.warnings:
         warn(message)
     write_drawing(result.drawing, output)

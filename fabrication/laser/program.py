@@ -1,0 +1,49 @@
+"""A drawing to a whole laser program: toolpath, G-code lines with their header, job time.
+
+What `onestroke laser` and `onestroke batch` both write, made by one function so that the
+two give the same bytes.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from fabrication.laser.gcode_write import GcodeOptions, comment_line, gcode_lines, gcode_text
+from fabrication.laser.job_time import JobTime, estimate_gcode_time, format_duration
+from fabrication.laser.toolpath import Toolpath, ToolpathOptions, plan_toolpath
+from vectorize.drawing import Drawing
+
+
+@dataclass(frozen=True, kw_only=True, eq=False)
+class LaserProgram:
+    """toolpath: the planned burn (mm, machine frame); lines: the program without line
+    endings, header comments first; time: GRBL planner model estimate of `lines`."""
+
+    toolpath: Toolpath
+    lines: tuple[str, ...]
+    time: JobTime
+
+    @property
+    def text(self) -> str:
+        """The file content (`\\n` line endings)."""
+        return gcode_text(list(self.lines))
+
+
+def laser_program(drawing: Drawing, profile, toolpath_options: ToolpathOptions,
+                  gcode_options: GcodeOptions, *, name: str) -> LaserProgram:
+    """Plan `drawing` for the laser `profile` and write its program; `name` (the input's file
+    name) goes into the header comment."""
+    toolpath = plan_toolpath(drawing, profile, toolpath_options)
+    lines = gcode_lines(toolpath, profile, gcode_options)
+    job = estimate_gcode_time(lines, profile)
+    w, h = toolpath.size
+    power = gcode_options.power
+    comments = (
+        f"onestroke laser: {name}",
+        f"{w:.1f} x {h:.1f} mm, {len(toolpath.paths)} stroke(s), {gcode_options.passes} pass(es)",
+        f"feed {gcode_options.feed:g} mm/min, power {power * 100:g}% (S{power * profile.max_power:g})",
+        f"estimated time {format_duration(job.total_seconds)} (GRBL planner model)",
+        f"profile: {profile.name}",
+    )
+    return LaserProgram(toolpath=toolpath, lines=tuple(comment_line(c) for c in comments) + tuple(lines),
+                        time=job)

@@ -1,0 +1,121 @@
+"""The studio's edits as plain data: JSON round trip, cached replay equal to a fresh run,
+each edit kind acting where it should, and `--edits` on the command line."""
+
+from __future__ import annotations
+
+import json
+
+import pytest
+from click.testing import CliRunner
+
+from fabrication.cli import main
+from tests.conftest import alpha_loop, render_polylines
+from vectorize import VectorizeOptions, vectorize_file
+from vectorize.edits import PAIRINGS, Edit, Edits, edits_from_json
+from vectorize.refine import StageCache
+from vectorize.svg_write import drawing_to_svg
+
+OPTIONS = VectorizeOptions(classifier="geometric")
+
+
+@pytest.fixture(scope="module")
+def loop_png(tmp_path_factory):
+    from PIL import Image
+
+    path = tmp_path_factory.mktemp("studio") / "loop.png"
+    Image.fromarray(render_polylines([alpha_loop()])).save(path)
+    return path
+
+
+def crossing(result):
+    return next(j for j in result.graph.junctions if j.role == "crossing")
+
+
+def test_edits_json_round_trip():
+    edits = Edits(threshold=0.4, blur=1.5, multi=False, tolerance=5.0,
+                  items=(Edit(kind="pairing", at=(10.5, 20.25), pairing="third"), Edit(kind="split", at=(1, 2)),
+                         Edit(kind="merge", at=(3, 4)), Edit(kind="reverse", at=(5, 6)), Edit(kind="start", at=(7, 8))))
+    again = edits_from_json(edits.to_json())
+    assert again == edits
+    assert json.loads(edits.to_json())["edits"][0] == {"kind": "pairing", "at": [10.5, 20.25], "pairing": "third"}
+
+
+@pytest.mark.parametrize("text, message", [
+    ("{", "not JSON"), ('{"format": "x"}', "not an onestroke edits file"),
+    ('{"format": "onestroke-edits", "version": 1, "edits": [{"kind": "fold", "at": [1, 2]}]}', "unknown edit kind"),
+    ('{"format": "onestroke-edits", "version": 1, "edits": [{"kind": "pairing", "at": [1, 2]}]}', "pairing"),
+    ('{"format": "onestroke-edits", "version": 1, "threshold": 2, "edits": []}', "threshold"),
+])
+def test_bad_edits_files_name_the_problem(text, message):
+    from onestroke.errors import InputError
+
+    with pytest.raises(InputError, match=message):
+        edits_from_json(text)
+
+
+def test_each_edit_kind_and_cached_replay_equal_fresh(loop_png):
+    cache = StageCache()
+    base = vectorize_file(loop_png, OPTIONS, edits=Edits(), cache=cache)
+    plain = vectorize_file(loop_png, OPTIONS)
+    assert drawing_to_svg(base.drawing) == drawing_to_svg(plain.drawing)
+    junction = crossing(base)
+    assert junction.merged and junction.decision in PAIRINGS
+    other = PAIRINGS[(PAIRINGS.index(junction.decision) + 1) % 3]
+    cases = {
+        "pairing": Edits(items=(Edit(kind="pairing", at=junction.at, pairing=other),)),
+        "split": Edits(items=(Edit(kind="split", at=junction.at),)),
+        "reverse": Edits(items=(Edit(kind="reverse", at=junction.at),)),
+        "threshold": Edits(threshold=0.3, blur=1.0),
+    }
+    results = {}
+    for name, edits in cases.items():
+        cached = vectorize_file(loop_png, OPTIONS, edits=edits, cache=cache)
+        fresh = vectorize_file(loop_png, OPTIONS, edits=edits)
+        assert drawing_to_svg(cached.drawing) == drawing_to_svg(fresh.drawing), name
+        assert not any("matched nothing" in w for w in cached.report.warnings), name
+        results[name] = cached
+    fixed = crossing(results["pairing"])
+    assert fixed.fixed and fixed.decision == other
+    assert drawing_to_svg(results["pairing"].drawing) != drawing_to_svg(base.drawing)
+    # Split: the crossing is gone, two degree-3 nodes and the branch between them remain.
+    split = results["split"].graph
+    assert not [j for j in split.junctions if j.role == "crossing"]
+    bridge = min(split.branches, key=lambda b: (b.at[0] - junction.at[0]) ** 2 + (b.at[1] - junction.at[1]) ** 2)
+    # Merge by that branch: the crossing is back and the drawing is the automatic one again.
+    merged = vectorize_file(loop_png, OPTIONS, edits=Edits(items=(Edit(kind="split", at=junction.at),
+                                                                  Edit(kind="merge", at=bridge.at))), cache=cache)
+    assert len([j for j in merged.graph.junctions if j.role == "crossing"]) == 1
+    assert drawing_to_svg(merged.drawing) == drawing_to_svg(base.drawing)
+    stroke, reversed_ = base.drawing.strokes[0], results["reverse"].drawing.strokes[0]
+    assert (reversed_.start == stroke.end).all() and (reversed_.end == stroke.start).all()
+    # Start at the current end: the same as reversing an open line.
+    start = vectorize_file(loop_png, OPTIONS, edits=Edits(items=(Edit(kind="start", at=tuple(stroke.end)),)), cache=cache)
+    assert drawing_to_svg(start.drawing) == drawing_to_svg(results["reverse"].drawing)
+
+
+def test_unmatched_edit_is_a_warning(loop_png):
+    result = vectorize_file(loop_png, OPTIONS, edits=Edits(items=(Edit(kind="split", at=(2.0, 2.0)),)))
+    assert any("matched nothing" in w for w in result.report.warnings)
+
+
+def test_cli_replays_edits_byte_for_byte(loop_png, tmp_path):
+    cache = StageCache()
+    base = vectorize_file(loop_png, OPTIONS, edits=Edits(), cache=cache)
+    junction = crossing(base)
+    other = PAIRINGS[(PAIRINGS.index(junction.decision) + 1) % 3]
+    edits = Edits(blur=0.5, items=(Edit(kind="pairing", at=junction.at, pairing=other),
+                                   Edit(kind="reverse", at=junction.at)))
+    page = vectorize_file(loop_png, OPTIONS, edits=edits, cache=cache)
+    (tmp_path / "edits.json").write_text(edits.to_json())
+    run = CliRunner().invoke(main, ["vectorize", str(loop_png), "--classifier", "geometric",
+                                    "--edits", str(tmp_path / "edits.json"), "-o", str(tmp_path / "out.svg")])
+    assert run.exit_code == 0, run.output
+    assert (tmp_path / "out.svg").read_text() == drawing_to_svg(page.drawing)
+
+
+def test_cli_bad_edits_file_exit_2(loop_png, tmp_path):
+    (tmp_path / "edits.json").write_text('{"format": "onestroke-edits", "version": 9}')
+    run = CliRunner().invoke(main, ["vectorize", str(loop_png), "--edits", str(tmp_path / "edits.json"),
+                                    "-o", str(tmp_path / "out.svg")])
+    assert run.exit_code == 2 and "version" in run.output and "Traceback" not in run.output
+    assert not (tmp_path / "out.svg").exists()

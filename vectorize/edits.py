@@ -1,0 +1,146 @@
+"""A user's corrections to a vectorization (paper 4.4), as plain data that survives a file.
+
+The studio page makes them and `onestroke vectorize --edits FILE` replays them. Every edit
+names its place by position (x, y in the output frame: the input image's pixels), not by
+an internal node id: the nearest junction or branch within `tolerance` px is meant, so an
+edits file still applies after small changes to the algorithm. An edit that matches
+nothing is reported as a warning, never an error.
+
+Kinds, and the stage each one re-runs from:
+- settings `threshold`, `blur`, `multi`: from binarization;
+- `split` (a degree-4 node back into its two degree-3 halves), `merge` (two degree-3 nodes
+  joined by the branch at the position): from simplification;
+- `pairing` (how the pen went through a degree-4 node: "crossing", "touching" = the
+  smoother touching pairing, "third" = the other one): from traversal, as a fixed decision;
+- `reverse` (the stroke through the position runs the other way), `start` (the stroke
+  with an end at the position starts there, and comes first): after fitting.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import dataclass, field, replace
+
+from onestroke.errors import InputError
+
+FORMAT = "onestroke-edits"
+PAIRINGS = ("crossing", "touching", "third")
+KINDS = ("pairing", "split", "merge", "reverse", "start")
+# Default match radius in output px: a click lands within a few pixels of a marker.
+TOLERANCE = 8.0
+
+
+@dataclass(frozen=True, kw_only=True)
+class Edit:
+    """One correction at position `at` = (x, y) px of the input image.
+
+    kind: one of KINDS; pairing: for kind "pairing", one of PAIRINGS.
+    """
+
+    kind: str
+    at: tuple[float, float]
+    pairing: str | None = None
+
+    def __post_init__(self) -> None:
+        if self.kind not in KINDS:
+            raise InputError(f"unknown edit kind {self.kind!r}; use one of {', '.join(KINDS)}")
+        try:
+            x, y = (float(v) for v in self.at)
+        except (TypeError, ValueError):
+            raise InputError(f"edit position {self.at!r} must be two numbers (x, y)") from None
+        if not (math.isfinite(x) and math.isfinite(y)):
+            raise InputError(f"edit position {self.at!r} must be finite")
+        object.__setattr__(self, "at", (x, y))
+        if self.kind == "pairing":
+            if self.pairing not in PAIRINGS:
+                raise InputError(f"pairing {self.pairing!r} must be one of {', '.join(PAIRINGS)}")
+        elif self.pairing is not None:
+            raise InputError(f"a {self.kind!r} edit takes no pairing")
+
+    def to_dict(self) -> dict:
+        data = {"kind": self.kind, "at": [round(self.at[0], 3), round(self.at[1], 3)]}
+        if self.pairing is not None:
+            data["pairing"] = self.pairing
+        return data
+
+
+@dataclass(frozen=True, kw_only=True)
+class Edits:
+    """Settings that override the vectorizer's options (None: keep the option) and the
+    ordered list of corrections; `tolerance` is the match radius in output px."""
+
+    threshold: float | None = None
+    blur: float | None = None
+    multi: bool | None = None
+    tolerance: float = TOLERANCE
+    items: tuple[Edit, ...] = field(default_factory=tuple)
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "items", tuple(self.items))
+        if self.threshold is not None and not 0.0 < self.threshold < 1.0:
+            raise InputError(f"threshold {self.threshold!r} must lie strictly between 0 and 1")
+        if self.blur is not None and not self.blur >= 0:
+            raise InputError(f"blur sigma {self.blur!r} must be >= 0")
+        if not self.tolerance > 0:
+            raise InputError(f"edit tolerance {self.tolerance!r} must be greater than 0 px")
+
+    def of(self, *kinds: str) -> tuple[Edit, ...]:
+        """The corrections of these kinds, in order."""
+        return tuple(e for e in self.items if e.kind in kinds)
+
+    def applied_to(self, options):
+        """`options` (VectorizeOptions) with this file's threshold, blur and mode."""
+        changes = {name: getattr(self, name) for name in ("blur", "multi") if getattr(self, name) is not None}
+        if self.threshold is not None:
+            changes["threshold"] = self.threshold
+        return replace(options, **changes) if changes else options
+
+    def to_dict(self) -> dict:
+        return {"format": FORMAT, "version": 1, "threshold": self.threshold, "blur": self.blur,
+                "multi": self.multi, "tolerance": self.tolerance,
+                "edits": [e.to_dict() for e in self.items]}
+
+    def to_json(self) -> str:
+        return json.dumps(self.to_dict(), indent=1) + "\n"
+
+
+def edits_from_dict(data) -> Edits:
+    """Parse what `Edits.to_dict` made (an `InputError` names what is wrong)."""
+    if not isinstance(data, dict) or data.get("format") != FORMAT:
+        raise InputError(f"not an onestroke edits file (expected \"format\": \"{FORMAT}\")")
+    if data.get("version") != 1:
+        raise InputError(f"edits file version {data.get('version')!r} is not supported (expected 1)")
+    items = data.get("edits", [])
+    if not isinstance(items, list):
+        raise InputError("\"edits\" must be a list")
+    try:
+        edits = tuple(Edit(kind=e["kind"], at=tuple(e["at"]), pairing=e.get("pairing")) for e in items)
+        multi = data.get("multi")
+        return Edits(threshold=_number(data.get("threshold")), blur=_number(data.get("blur")),
+                     multi=None if multi is None else bool(multi),
+                     tolerance=float(data.get("tolerance", TOLERANCE)), items=edits)
+    except (KeyError, TypeError, ValueError) as error:
+        if isinstance(error, InputError):
+            raise
+        raise InputError(f"edits file: malformed edit ({error})") from None
+
+
+def _number(value) -> float | None:
+    return None if value is None else float(value)
+
+
+def edits_from_json(text: str) -> Edits:
+    """Parse an edits file's text."""
+    try:
+        data = json.loads(text)
+    except json.JSONDecodeError as error:
+        raise InputError(f"edits file is not JSON: {error}") from None
+    return edits_from_dict(data)
+
+
+def read_edits(path) -> Edits:
+    """Read an edits file (`InputError` when missing, not text or malformed)."""
+    from onestroke.textfile import read_text
+
+    return edits_from_json(read_text(path, what="edits file"))

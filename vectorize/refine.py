@@ -1,0 +1,265 @@
+"""Applying a user's edits (`vectorize.edits`) at the pipeline's stage boundaries, and the
+view of the graph they act on.
+
+`StageCache` keeps what earlier stages made for one image, keyed by what they depend on,
+so that an edit re-runs only the stages after it: a pairing re-runs traversal and
+fitting; a split or merge re-runs simplification and classification as well; threshold,
+blur and mode re-run everything. The cached path makes the same calls on the same inputs
+as a fresh run, so both give the same bytes.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from vectorize.drawing import Drawing
+from vectorize.edits import PAIRINGS, Edits
+from vectorize.intersections import crossing_pairing, touching_pairings
+from vectorize.simplify import _merge
+
+# Cached entries per stage: a session goes back and forth between a few states (undo).
+KEEP = 12
+
+
+class StageCache:
+    """Results of the early stages for one image (the studio keeps one per drawing)."""
+
+    def __init__(self) -> None:
+        self.loaded = None  # ((path, max_size), (image, frame)) of the last file read
+        self.front: dict = {}
+        self.simplified: dict = {}
+        self._image = None
+
+    def front_for(self, image, options, compute):
+        """Binarization to gap bridging for these options, computed once."""
+        if self._image is not image:
+            self.front.clear()
+            self.simplified.clear()
+            self._image = image
+        key = front_key(options)
+        if key not in self.front:
+            _bounded_put(self.front, key, compute())
+        return self.front[key]
+
+
+def front_key(options) -> tuple:
+    return (options.threshold, options.blur, options.multi, options.max_size)
+
+
+def _bounded_put(store: dict, key, value) -> None:
+    while len(store) >= KEEP:
+        store.pop(next(iter(store)))
+    store[key] = value
+
+
+@dataclass(frozen=True)
+class JunctionInfo:
+    """A node the page shows. id: node id of this run (not stable across runs: edits use
+    `at`); at: (x, y) output px; degree; role: "crossing" (degree 4), "y" (a spike's
+    junction), "end" (a stroke ends on a line) or "unresolved"; for crossings: decision (one
+    of `PAIRINGS`), p_crossing and confidence of the classifier, fixed (by an edit) and
+    merged (made from two degree-3 nodes: can be split)."""
+
+    id: int
+    at: tuple[float, float]
+    degree: int
+    role: str
+    decision: str | None = None
+    p_crossing: float | None = None
+    confidence: float | None = None
+    fixed: bool = False
+    merged: bool = False
+
+
+@dataclass(frozen=True)
+class BranchInfo:
+    """A branch joining two degree-3 nodes (a merge candidate): at is its middle point
+    (x, y) output px, length in output px."""
+
+    id: int
+    at: tuple[float, float]
+    length: float
+
+
+@dataclass(frozen=True)
+class GraphView:
+    """The simplified graph of the chosen reading, in output px."""
+
+    junctions: tuple[JunctionInfo, ...]
+    branches: tuple[BranchInfo, ...]
+
+    def to_dict(self) -> dict:
+        return {"junctions": [vars(j) for j in self.junctions], "branches": [vars(b) for b in self.branches]}
+
+
+def pairing_kind(directions: np.ndarray, pairing) -> str:
+    """Which of `PAIRINGS` this pairing of a degree-4 node's slots is."""
+    options = (crossing_pairing(directions),) + touching_pairings(directions)
+    normal = tuple(sorted(tuple(sorted(p)) for p in pairing))
+    for kind, option in zip(PAIRINGS, options):
+        if tuple(option) == normal:
+            return kind
+    return PAIRINGS[0]
+
+
+def pairing_of(directions: np.ndarray, kind: str):
+    """The pairing of slots that `kind` names at a node with these branch directions."""
+    return ((crossing_pairing(directions),) + touching_pairings(directions))[PAIRINGS.index(kind)]
+
+
+class Refinement:
+    """One run's edits, in the working image's pixels, with the hooks the stages call.
+
+    matrix: 2x3 working px -> output px; options: the run's VectorizeOptions (edits
+    applied); stroke_width: working px.
+    """
+
+    def __init__(self, edits: Edits, cache: StageCache, matrix: np.ndarray, options, stroke_width: float) -> None:
+        self.edits = edits
+        self.cache = cache
+        self.matrix = matrix
+        self.options = options
+        self.scale = 1.0 / float(matrix[0, 0])  # working px per output px
+        self.tol = edits.tolerance * self.scale
+        self.hits: set[int] = set()
+        self.fixed: dict[int, str] = {}
+        self._index = {id(e): i for i, e in enumerate(edits.items)}
+
+    def to_working(self, at) -> np.ndarray:
+        return (np.asarray(at, dtype=float) - self.matrix[:, 2]) * self.scale
+
+    def to_output(self, xy) -> tuple[float, float]:
+        out = self.matrix[:, :2] @ np.asarray(xy, dtype=float) + self.matrix[:, 2]
+        return (round(float(out[0]), 3), round(float(out[1]), 3))
+
+    # -- simplification ------------------------------------------------------------
+    def simplify_key(self, ends: int) -> tuple:
+        graph_edits = tuple((e.kind, e.at) for e in self.edits.of("split", "merge"))
+        return (front_key(self.options), ends, self.options.classifier, self.edits.tolerance, graph_edits)
+
+    def lookup(self, ends: int):
+        hit = self.cache.simplified.get(self.simplify_key(ends))
+        if hit is None:
+            return None
+        *solution, hits = hit
+        self.hits |= hits
+        return tuple(solution)
+
+    def store(self, ends: int, solution: tuple) -> None:
+        mine = {self._index[id(e)] for e in self.edits.of("split", "merge")} & self.hits
+        _bounded_put(self.cache.simplified, self.simplify_key(ends), (*solution, frozenset(mine)))
+
+    def simplify_hooks(self) -> dict:
+        """Keyword hooks for `simplify`: splits refuse merges, merges collapse branches."""
+        splits = [(self._index[id(e)], self.to_working(e.at)) for e in self.edits.of("split")]
+        merges = [(self._index[id(e)], self.to_working(e.at)) for e in self.edits.of("merge")]
+        hooks = {}
+        if splits:
+            def may_merge(branch) -> bool:
+                for index, point in splits:
+                    if np.min(np.linalg.norm(branch.points - point, axis=1)) <= self.tol:
+                        self.hits.add(index)
+                        return False
+                return True
+            hooks["may_merge"] = may_merge
+        if merges:
+            def after_merging(graph) -> int:
+                done = 0
+                for index, point in merges:
+                    found = _nearest_mergeable(graph, point, self.tol)
+                    if found is not None:
+                        bid, a, b = found
+                        _merge(graph, a, b, bid)
+                        self.hits.add(index)
+                        done += 1
+                return done
+            hooks["after_merging"] = after_merging
+        return hooks
+
+    # -- traversal -------------------------------------------------------------------
+    def fix_pairings(self, junctions: dict, ranked: dict, costs: dict) -> None:
+        """Pairings the user chose become the only choice at their node (in place)."""
+        self.fixed = {}
+        nodes = list(junctions)
+        if not nodes:
+            return
+        centers = np.array([junctions[n].center for n in nodes])
+        for edit in self.edits.of("pairing"):
+            dist = np.linalg.norm(centers - self.to_working(edit.at), axis=1)
+            k = int(np.argmin(dist))
+            if dist[k] > self.tol:
+                continue
+            node = nodes[k]
+            ranked[node] = (pairing_of(junctions[node].directions, edit.pairing),)
+            costs[node] = (0.0,)
+            self.fixed[node] = edit.pairing
+            self.hits.add(self._index[id(edit)])
+
+    # -- after fitting ---------------------------------------------------------------
+    def orient(self, drawing: Drawing) -> Drawing:
+        """Apply the start and reverse edits to the finished drawing (output px)."""
+        strokes = list(drawing.strokes)
+        tol = self.edits.tolerance + drawing.stroke_width
+        for edit in self.edits.of("reverse", "start"):
+            at = np.asarray(edit.at)
+            if edit.kind == "reverse":
+                dists = [float(np.min(np.linalg.norm(s.flatten(0.5) - at, axis=1))) for s in strokes]
+                k = int(np.argmin(dists)) if dists else -1
+                if k >= 0 and dists[k] <= tol:
+                    strokes[k] = strokes[k].reversed()
+                    self.hits.add(self._index[id(edit)])
+                continue
+            ends = [(float(np.linalg.norm(s.start - at)), k, False) for k, s in enumerate(strokes) if not s.is_closed]
+            ends += [(float(np.linalg.norm(s.end - at)), k, True) for k, s in enumerate(strokes) if not s.is_closed]
+            if not ends or min(ends)[0] > tol:
+                continue
+            _, k, flip = min(ends)
+            stroke = strokes.pop(k)
+            strokes.insert(0, stroke.reversed() if flip else stroke)
+            self.hits.add(self._index[id(edit)])
+        return drawing.with_strokes(strokes)
+
+    def unmatched(self) -> list[str]:
+        """One warning per edit that found nothing to act on."""
+        return [f"edit {i + 1} ({e.kind} at {e.at[0]:.0f}, {e.at[1]:.0f}) matched nothing within "
+                f"{self.edits.tolerance:g} px and was skipped"
+                for i, e in enumerate(self.edits.items) if i not in self.hits]
+
+    # -- the page's view -------------------------------------------------------------
+    def graph_view(self, solution) -> GraphView:
+        graph, simple = solution.graph, solution.simple
+        choice = dict(zip(simple.crossings, solution.ordering.choice))
+        nodes = []
+        for node in sorted(graph.incident):
+            degree = graph.degree(node)
+            if node in simple.crossings:
+                junction, verdict = solution.junctions[node], solution.verdicts[node]
+                nodes.append(JunctionInfo(
+                    node, self.to_output(graph.positions[node]), degree, "crossing",
+                    decision=pairing_kind(junction.directions, choice[node]),
+                    p_crossing=round(float(verdict.p_crossing), 4), confidence=round(float(verdict.confidence), 4),
+                    fixed=node in self.fixed, merged=graph.spans.get(node, 0.0) > 0))
+            elif degree >= 3:
+                role = "y" if node in simple.y_feet else "end" if node in simple.t_ends and node not in simple.unresolved \
+                    else "unresolved"
+                nodes.append(JunctionInfo(node, self.to_output(graph.positions[node]), degree, role))
+        branches = []
+        for bid, branch in sorted(graph.branches.items()):
+            if branch.a != branch.b and graph.degree(branch.a) == 3 and graph.degree(branch.b) == 3:
+                middle = branch.points[len(branch.points) // 2]
+                branches.append(BranchInfo(bid, self.to_output(middle), round(branch.length / self.scale, 3)))
+        return GraphView(tuple(nodes), tuple(branches))
+
+
+def _nearest_mergeable(graph, point: np.ndarray, tol: float):
+    """(branch id, a, b) of the branch between two degree-3 nodes nearest `point`, within tol."""
+    best = None
+    for bid, branch in graph.branches.items():
+        if branch.a == branch.b or graph.degree(branch.a) != 3 or graph.degree(branch.b) != 3:
+            continue
+        d = float(np.min(np.linalg.norm(branch.points - point, axis=1)))
+        if d <= tol and (best is None or d < best[0]):
+            best = (d, bid, branch.a, branch.b)
+    return None if best is None else best[1:]
