@@ -21,10 +21,14 @@ Kinds (`PLAIN_KINDS` have no touches, `TOUCH_KINDS` have at least one):
   itself: a wrong turn there still gives one stroke, with a loop run backwards), in
   touch-same in the same direction (a wrong turn splits the line in two);
 - near-touch: the same with the centre lines 0.5-0.95 widths apart: the ink merges
-  although the line never meets itself.
+  although the line never meets itself;
+- triple (`TRIPLE_KINDS`): 1-2 points where three passes cross, their lines at least 35
+  degrees apart, and ordinary crossings elsewhere (at least one). The triple point is not
+  one of the intersections: its merge zone is a don't-care zone for intersection counting
+  (an output's three passes cross in three nearby points there), the order score judges it.
 
 Every sample is checked and regenerated until it is unambiguous for a human while staying
-hard: no three passes through one spot, no crossing shallower than 5 degrees, no spike whose base
+hard: no three passes through one spot (except a triple kind's designed points), no crossing shallower than 5 degrees, no spike whose base
 also leads straight to a free end (either branch could be the retraced one), no tight bends
 (radius of curvature >= 0.75 width), no place where two passes come within one width of
 each other (ink merges) that is not a designed crossing/touch/near-touch, and the ink-merge
@@ -34,79 +38,23 @@ zone of every such event at least 3 widths away from any other event and from th
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
-import shapely
-from scipy.sparse import coo_matrix
-from scipy.sparse.csgraph import connected_components
-from scipy.spatial import cKDTree
 
-from benchmarks.metrics import ambiguous_junctions, close_passes, polyline_intersections
+from benchmarks.drawing_rules import validate
+from benchmarks.ground_truth import CANVAS, MARGIN, Event, GroundTruth, Rejected  # noqa: F401 (re-exported)
 from vectorize.drawing import Drawing
 from vectorize.stroke import Stroke
 
-CANVAS = 1000
-MARGIN = 30  # px between the ink and the canvas edge
 PLAIN_KINDS = ("open", "closed", "loops", "shallow", "transversal", "spike")
 TOUCH_KINDS = ("touch", "touch-closed", "touch-same", "near-touch")
-ALL_KINDS = tuple(dict.fromkeys(PLAIN_KINDS + TOUCH_KINDS))
+TRIPLE_KINDS = ("triple",)
+ALL_KINDS = tuple(dict.fromkeys(PLAIN_KINDS + TOUCH_KINDS + TRIPLE_KINDS))
 MAX_ATTEMPTS = 600
 # realistic single-line drawings cross themselves: fewer crossings than this are redrawn
 MIN_CROSSINGS = {"open": 2, "closed": 2, "loops": 2, "spike": 1, "touch": 1, "touch-closed": 1, "touch-same": 1,
-                 "near-touch": 1}
-
-
-@dataclass(frozen=True)
-class Event:
-    """A ground-truth place where the line meets (or nearly meets) itself.
-
-    kind: "crossing", "touch", "near-touch", "spike-base", "spike-tip" or "end";
-    point: (2,) px; angle: crossing angle in degrees (0 for the others);
-    radius: half-extent of the ink-merge zone around the point (px); group: events of one
-    feature (a spike's base and tip) share a group.
-    """
-
-    kind: str
-    point: np.ndarray
-    angle: float = 0.0
-    radius: float = 0.0
-    group: int = -1
-
-
-@dataclass(frozen=True, eq=False)
-class GroundTruth:
-    """One benchmark drawing and its ground truth.
-
-    drawing: one stroke, px on a CANVAS x CANVAS canvas, with its stroke_width;
-    intersections: (n, 2) crossing points (touches are not intersections);
-    dont_care: shapely geometries (touch points, near-touches, retraced parts) near which
-    output intersections are not counted either way; events: all designed and found events.
-    """
-
-    name: str
-    kind: str
-    drawing: Drawing
-    closed: bool
-    intersections: np.ndarray
-    events: tuple[Event, ...] = ()
-    dont_care: tuple = ()
-    meta: dict = field(default_factory=dict)
-
-    @property
-    def stroke(self) -> Stroke:
-        return self.drawing.strokes[0]
-
-    @property
-    def width(self) -> float:
-        return self.drawing.stroke_width
-
-    def count(self, kind: str) -> int:
-        return sum(1 for e in self.events if e.kind == kind)
-
-
-class Rejected(Exception):
-    """A sample that breaks a rule; the generator draws another."""
+                 "near-touch": 1, "triple": 1}
 
 
 # -- geometry helpers ---------------------------------------------------------------------------
@@ -244,6 +192,23 @@ def _meeting(rng: np.random.Generator, box: float, kind: str, width: float, oppo
     return p1, loop, p2, event, angle
 
 
+def _triple(rng: np.random.Generator, box: float) -> tuple[list[_Waypoint], np.ndarray, float]:
+    """Waypoints of three passes through one point, their lines 35-110 degrees apart, with
+    1-2 far waypoints between the passes; returns (waypoints, point, smallest angle)."""
+    x = rng.uniform(0.3 * box, 0.7 * box, size=2)
+    g1 = rng.uniform(35.0, 75.0)
+    g2 = rng.uniform(35.0, min(75.0, 145.0 - g1))  # the third gap, 180 - g1 - g2, is >= 35 too
+    lines = np.radians(rng.uniform(0, 180) + np.array([0.0, g1, g1 + g2]))
+    seq: list[_Waypoint] = []
+    for k in rng.permutation(3):
+        u = np.array([np.cos(lines[k]), np.sin(lines[k])]) * rng.choice([-1, 1])
+        a = rng.uniform(0.1, 0.18) * box
+        if seq:
+            seq += _random_points(rng, int(rng.integers(1, 3)), box, avoid=[x], min_dist=0.3 * box)
+        seq += [_Waypoint(x - a * u, u), _Waypoint(x.copy(), u), _Waypoint(x + a * u, u)]
+    return seq, x, float(min(g1, g2, 180.0 - g1 - g2))
+
+
 def _trochoid(rng: np.random.Generator, box: float) -> list[_Waypoint]:
     loops = int(rng.integers(2, 6))
     c = 1.0
@@ -271,7 +236,7 @@ def _trochoid(rng: np.random.Generator, box: float) -> list[_Waypoint]:
 
 def _build(kind: str, rng: np.random.Generator, width: float, box: float) -> tuple[list[_Waypoint], bool, list]:
     """Waypoints, closedness and the designed events (kind, point, angle) of one sample."""
-    closed = kind in ("closed", "touch-closed") or (kind in ("shallow", "transversal", "spike")
+    closed = kind in ("closed", "touch-closed") or (kind in ("shallow", "transversal", "spike", "triple")
                                                       and rng.random() < 0.35)
     designed = []
     if kind == "loops":
@@ -289,6 +254,16 @@ def _build(kind: str, rng: np.random.Generator, width: float, box: float) -> tup
                 length = rng.uniform(max(5 * width, 30.0), max(9 * width, 0.2 * box))
                 pts[k].spike = (direction, length)
         return pts, closed, designed
+    if kind == "triple":
+        seq = [] if closed else _random_points(rng, 1, box)
+        for k in range(int(rng.integers(1, 3))):
+            if k:
+                seq += _random_points(rng, 1, box)
+            points, x, angle = _triple(rng, box)
+            seq += points
+            designed.append(("triple", x, angle))
+        seq += [] if closed else _random_points(rng, 1, box)
+        return seq, closed, designed
     meeting_kind = {"shallow": "shallow", "transversal": "transversal", "touch": "touch",
                     "touch-closed": "touch", "touch-same": "touch", "near-touch": "near-touch"}[kind]
     # touch, touch-closed, near-touch: the line comes back alongside itself (passes in
@@ -312,139 +287,6 @@ def _build(kind: str, rng: np.random.Generator, width: float, box: float) -> tup
         seq += _random_points(rng, int(rng.integers(1, 3)), box, avoid=[d[1] for d in designed],
                               min_dist=0.25 * box)
     return seq, closed, designed
-
-
-# -- validation ---------------------------------------------------------------------------------
-
-def _curvature_ok(stroke: Stroke, spike_segments: set[int], min_radius: float) -> bool:
-    c = stroke.control
-    t = np.linspace(0, 1, 33)[None, :, None]
-    u = 1 - t
-    d1 = 3 * (u * u * (c[:, None, 1] - c[:, None, 0]) + 2 * u * t * (c[:, None, 2] - c[:, None, 1])
-              + t * t * (c[:, None, 3] - c[:, None, 2]))
-    d2 = 6 * (u * (c[:, None, 2] - 2 * c[:, None, 1] + c[:, None, 0]) + t * (c[:, None, 3] - 2 * c[:, None, 2]
-                                                                               + c[:, None, 1]))
-    speed = np.linalg.norm(d1, axis=2)
-    cross = np.abs(d1[..., 0] * d2[..., 1] - d1[..., 1] * d2[..., 0])
-    mask = np.ones(len(c), dtype=bool)
-    if spike_segments:
-        mask[list(spike_segments)] = False
-    if np.any(speed[mask] < 1e-6):
-        return False
-    radius = speed[mask] ** 3 / np.maximum(cross[mask], 1e-12)
-    return bool(radius.min() >= min_radius)
-
-
-def _validate(stroke: Stroke, closed: bool, width: float, designed: list, spikes: list) -> tuple[list, np.ndarray, list]:
-    """Check the rules; return (events, crossing points, dont-care geometries) or raise Rejected."""
-    w = width
-    xmin, ymin, xmax, ymax = stroke.bounds()
-    if xmin < MARGIN + w or ymin < MARGIN + w or xmax > CANVAS - MARGIN - w or ymax > CANVAS - MARGIN - w:
-        raise Rejected("outside the canvas")
-    spike_segments = {s[2] for s in spikes} | {s[2] + 1 for s in spikes}
-    if not _curvature_ok(stroke, spike_segments, 0.75 * w):
-        raise Rejected("tight bend")
-    poly = stroke.flatten(0.05)
-    if spikes and ambiguous_junctions(poly):
-        raise Rejected("a spike next to a free end: which branch is retraced is ambiguous")
-    inter = polyline_intersections([poly], [closed])
-    if len(inter.multiple):
-        raise Rejected("three passes meet")
-    if np.any(inter.crossing_angles < 5.0):
-        raise Rejected("crossing shallower than 5 degrees")
-    designed_touch = [e for k, e, _ in designed if k == "touch"]
-    for t in inter.touches:
-        if not any(np.linalg.norm(t - d) < 0.5 for d in designed_touch):
-            raise Rejected("accidental touch")
-    for d in designed_touch:
-        if not any(np.linalg.norm(t - d) < 0.5 for t in inter.touches):
-            raise Rejected("designed touch did not come out as a touch")
-    for k, e, ang in designed:
-        if k in ("shallow", "transversal"):
-            hit = np.linalg.norm(inter.crossings - e, axis=1) < 0.5 if len(inter.crossings) else np.array([False])
-            if not hit.any():
-                raise Rejected("designed crossing missing")
-
-    events: list[Event] = []
-    for p, ang in zip(inter.crossings, inter.crossing_angles):
-        events.append(Event("crossing", p, float(ang), w / (2 * np.sin(np.radians(ang) / 2))))
-    for k, e, _ in designed:
-        if k in ("touch", "near-touch"):
-            events.append(Event(k, np.asarray(e, dtype=float)))
-
-    # contacts: two samples closer than one width that are more than 3 widths apart along the line
-    spacing = w / 4
-    s, pts, pairs = close_passes(stroke, closed, w)
-    # spikes: the retrace itself and the line passing its base are not contacts
-    spike_ranges = []
-    seg_len = np.array([Stroke(stroke.control[k:k + 1]).length for k in range(stroke.segment_count)])
-    seg_start = np.concatenate([[0], np.cumsum(seg_len)])
-    for gid, (base, tip, seg) in enumerate(spikes):
-        lo, hi = seg_start[seg] - 2 * w, seg_start[seg + 2] + 2 * w
-        spike_ranges.append((lo, hi))
-        events.append(Event("spike-base", base, radius=w, group=1000 + gid))
-        events.append(Event("spike-tip", tip, radius=0.5 * w, group=1000 + gid))
-        # nothing else may come near the spike's shaft
-        shaft = shapely.LineString([base, tip])
-        far = (s < lo - 4 * w) | (s > hi + 4 * w)
-        if closed:
-            far &= (s > hi + 4 * w - stroke.length) & (s < lo - 4 * w + stroke.length)
-        if far.any():
-            dist = shapely.distance(shaft, shapely.points(pts[far]))
-            if np.min(dist) < 2.5 * w:
-                raise Rejected("line passes near a spike")
-    if spike_ranges:
-        internal = np.zeros(len(pairs), dtype=bool)
-        for lo, hi in spike_ranges:
-            a_in = (s[pairs[:, 0]] >= lo) & (s[pairs[:, 0]] <= hi)
-            b_in = (s[pairs[:, 1]] >= lo) & (s[pairs[:, 1]] <= hi)
-            internal |= a_in & b_in
-        pairs = pairs[~internal]
-    if not closed:
-        events.append(Event("end", pts[0], radius=0.5 * w, group=2000))
-        events.append(Event("end", pts[-1], radius=0.5 * w, group=2001))
-    meeting_events = [e for e in events if e.kind in ("crossing", "touch", "near-touch")]
-    if len(pairs):
-        idx = np.unique(pairs)
-        cp = pts[idx]
-        near = cKDTree(cp).query_pairs(2.0 * spacing, output_type="ndarray")
-        g = coo_matrix((np.ones(len(near)), (near[:, 0], near[:, 1])), shape=(len(cp), len(cp)))
-        ncl, label = connected_components(g, directed=False)
-        radius = {}
-        for c in range(ncl):
-            cluster = cp[label == c]
-            inside = [m for m, e in enumerate(meeting_events)
-                      if np.min(np.linalg.norm(cluster - e.point, axis=1)) <= w]
-            if len(inside) != 1:
-                raise Rejected("ink merges where no single crossing or touch explains it")
-            m = inside[0]
-            radius[m] = max(radius.get(m, 0.0), float(np.max(np.linalg.norm(cluster - meeting_events[m].point,
-                                                                              axis=1))))
-        for m, e in enumerate(meeting_events):
-            if e.kind in ("touch", "near-touch"):
-                r = radius.get(m, 0.0)
-                if r == 0.0 and e.kind == "near-touch":
-                    raise Rejected("near-touch does not merge")
-                if r > 8 * w:
-                    raise Rejected("touch merges over too long a run")
-                idx_e = events.index(e)
-                events[idx_e] = Event(e.kind, e.point, e.angle, max(r, 0.5 * w), e.group)
-    # separation of events: merge zones at least 3 widths apart
-    for i in range(len(events)):
-        for j in range(i + 1, len(events)):
-            ei, ej = events[i], events[j]
-            if ei.group >= 0 and ei.group == ej.group:
-                continue
-            if ei.kind == "end" and ej.kind == "end":
-                continue
-            need = ei.radius + ej.radius + 3 * w
-            if np.linalg.norm(ei.point - ej.point) < need:
-                raise Rejected(f"{ei.kind} and {ej.kind} too close")
-    # the whole ink-merge zone of a touch: the output's two passes share one blob of ink there
-    dont_care = [shapely.Point(*e.point).buffer(e.radius) for e in events if e.kind in ("touch", "near-touch")]
-    dont_care += [shapely.LineString([b, t]) for b, t, _ in spikes]
-    dont_care += list(inter.retraces)
-    return events, inter.crossings, dont_care
 
 
 # -- public API ---------------------------------------------------------------------------------
@@ -481,7 +323,7 @@ def generate_drawing(kind: str, seed: int = 0, index: int = 0) -> GroundTruth:
         if closed:
             stroke = _close_exactly(stroke)
         try:
-            events, crossings, dont_care = _validate(stroke, closed, width, designed, spikes)
+            events, crossings, dont_care = validate(stroke, closed, width, designed, spikes)
             if len(crossings) < MIN_CROSSINGS.get(kind, 0):
                 raise Rejected("too few crossings")
         except Rejected as why:
@@ -503,8 +345,8 @@ def _close_exactly(stroke: Stroke) -> Stroke:
 
 def generate_set(name: str, count: int, seed: int = 0) -> list[GroundTruth]:
     """`count` drawings of set "plain" (PLAIN_KINDS in turn) or "touch" (TOUCH_KINDS in turn)."""
-    kinds = {"plain": PLAIN_KINDS, "touch": TOUCH_KINDS}.get(name)
+    kinds = {"plain": PLAIN_KINDS, "touch": TOUCH_KINDS, "triple": TRIPLE_KINDS}.get(name)
     if kinds is None:
-        raise ValueError(f"unknown generated set {name!r}; use 'plain' or 'touch'")
-    offset = 0 if name == "plain" else 10_000
+        raise ValueError(f"unknown generated set {name!r}; use 'plain', 'touch' or 'triple'")
+    offset = {"plain": 0, "touch": 10_000, "triple": 20_000}[name]
     return [generate_drawing(kinds[i % len(kinds)], seed, offset + i) for i in range(count)]

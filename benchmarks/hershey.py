@@ -28,6 +28,7 @@ import shapely
 import svgelements
 
 from benchmarks.drawings import CANVAS, Event, GroundTruth
+from benchmarks.ink_metrics import ink_graph, min_traversal_length
 from benchmarks.metrics import ambiguous_junctions, merged_without_crossing, polyline_intersections
 from vectorize.drawing import Drawing
 from vectorize.stroke import Stroke
@@ -128,8 +129,13 @@ def _sharp_turns(poly: np.ndarray, closed: bool, width: float) -> list:
     return zones
 
 
-def glyph_ground_truth(glyph: Glyph, width: float) -> GroundTruth | None:
-    """The glyph as a benchmark drawing, or None when it breaks a rule (see module doc)."""
+def glyph_ground_truth(glyph: Glyph, width: float, *, ambiguous: bool = False) -> GroundTruth | None:
+    """The glyph as a benchmark drawing, or None when it breaks a rule (see module doc).
+
+    ambiguous=True returns instead only the glyphs left out for an ambiguous junction (any
+    of several free branches could be the retraced one), scored by the fair-retrace rule:
+    meta "fair" is True and meta "min_length" is the minimum traversal length (px).
+    """
     stroke, poly, closed = glyph_stroke(glyph)
     if len(poly) < 4:
         return None
@@ -151,9 +157,11 @@ def glyph_ground_truth(glyph: Glyph, width: float) -> GroundTruth | None:
         c[-1, 3] = c[0, 0]
         stroke = Stroke(c)
         poly[-1] = poly[0]
-    if ambiguous_junctions(poly):
+    if bool(ambiguous_junctions(poly)) != ambiguous:
         return None  # which branch was drawn out and back cannot be seen: no meaningful order
     inter = polyline_intersections([poly], [closed])
+    if ambiguous:
+        return _fair_ground_truth(glyph, stroke, poly, closed, width, inter)
     if len(inter.multiple) or np.any(inter.crossing_angles < 5.0):
         return None
     events = [Event("crossing", p, float(a), width / (2 * np.sin(np.radians(a) / 2)))
@@ -185,30 +193,54 @@ def glyph_ground_truth(glyph: Glyph, width: float) -> GroundTruth | None:
                        meta={"font": glyph.font, "glyph": label, "width": width})
 
 
+def _fair_ground_truth(glyph: Glyph, stroke: Stroke, poly: np.ndarray, closed: bool, width: float,
+                       inter) -> GroundTruth | None:
+    """An ambiguous glyph: its crossings must be reproduced, its order is judged by the
+    fair-retrace rule against the minimum traversal of its ink graph."""
+    try:
+        min_length = min_traversal_length(ink_graph(poly))
+    except ValueError:
+        return None
+    events = tuple(Event("crossing", p, float(a)) for p, a in zip(inter.crossings, inter.crossing_angles))
+    dont_care = [shapely.Point(*p).buffer(2 * width) for p in inter.touches] + list(inter.retraces)
+    dont_care += _sharp_turns(poly, closed, width)
+    dont_care += merged_without_crossing(stroke, closed, width, inter.crossings)
+    label = glyph.name or glyph.unicode
+    return GroundTruth(name=f"{glyph.font}-{label}", kind="hershey-ambiguous", closed=closed,
+                       drawing=Drawing((stroke,), CANVAS, CANVAS, unit="px", stroke_width=width),
+                       intersections=inter.crossings.reshape(-1, 2), events=events, dont_care=tuple(dont_care),
+                       meta={"font": glyph.font, "glyph": label, "width": width, "fair": True,
+                             "min_length": min_length, "drawn_length": stroke.length})
+
+
 def glyph_width(glyph: Glyph, seed: int) -> float:
     """Seeded stroke width in 3-8 px (quarter pixels), fixed per glyph."""
     key = [seed] + [ord(ch) for ch in f"{glyph.font}/{glyph.name}/{glyph.unicode}"]
     return float(np.round(np.random.default_rng(key).uniform(3.0, 8.0) * 4) / 4)
 
 
-def hershey_set(count: int = 40, seed: int = 0, *, touches: bool = False) -> list[GroundTruth]:
+def hershey_set(count: int = 40, seed: int = 0, *, touches: bool = False, ambiguous: bool = False,
+                glyphs: list[Glyph] | None = None) -> list[GroundTruth]:
     """`count` glyphs across fonts, deterministic for a seed.
 
     Up to 70 % are glyphs with a crossing or a retrace (as many as pass the rules), the rest
     simple ones; fonts are visited in turn so every font contributes; no simple glyph twice. touches=True returns the glyphs that touch
-    themselves instead (kind "hershey-touch"; they are not in the default set).
+    themselves instead (kind "hershey-touch"; they are not in the default set); ambiguous=True
+    the glyphs left out for an ambiguous junction (kind "hershey-ambiguous", fair-retrace rule).
+    glyphs: the glyphs to pick from (default: all single-stroke Hershey glyphs).
     """
-    glyphs = load_glyphs()
+    glyphs = load_glyphs() if glyphs is None else glyphs
     rng = np.random.default_rng(seed)
     order = rng.permutation(len(glyphs))
     by_font: dict[str, dict[str, list[GroundTruth]]] = {}
     for k in order:
         g = glyphs[k]
-        gt = glyph_ground_truth(g, glyph_width(g, seed))
+        gt = glyph_ground_truth(g, glyph_width(g, seed), ambiguous=ambiguous)
         if gt is None:
             continue
-        bucket = "touch" if gt.kind == "hershey-touch" else ("hard" if gt.kind != "hershey-simple" else "simple")
-        by_font.setdefault(g.font, {"touch": [], "hard": [], "simple": []})[bucket].append(gt)
+        bucket = {"hershey-touch": "touch", "hershey-simple": "simple", "hershey-ambiguous": "ambiguous"}.get(
+            gt.kind, "hard")
+        by_font.setdefault(g.font, {"touch": [], "hard": [], "simple": [], "ambiguous": []})[bucket].append(gt)
     fonts = sorted(by_font)
 
     def pick(bucket: str, n: int, taken: set[str], unique: bool = True) -> list[GroundTruth]:
@@ -233,6 +265,8 @@ def hershey_set(count: int = 40, seed: int = 0, *, touches: bool = False) -> lis
     taken: set[str] = set()
     if touches:
         return pick("touch", count, taken)
+    if ambiguous:
+        return pick("ambiguous", count, taken, unique=False)
     # hard glyphs are few (about 24 pass the rules): the same letter from two fonts is allowed
     chosen = pick("hard", int(round(0.7 * count)), taken, unique=False)
     chosen += pick("simple", count - len(chosen), taken)

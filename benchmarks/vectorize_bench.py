@@ -9,8 +9,11 @@
     python benchmarks/vectorize_bench.py --set plain --condition scan  # scan-like input (conditions.py)
 
 Sets: "plain" (generated, no touches), "touch" (generated, with tangential touches and
-near-touches), "hershey" (single-stroke font glyphs). Classifier "auto" runs the CNN on
-plain and hershey and both classifiers on touch. See docs/benchmark.md for the columns.
+near-touches), "hershey" (single-stroke font glyphs), "hershey-retrace" (the glyphs whose
+retraced branch cannot be told from the ink, fair-retrace rule), "relief" (Relief
+SingleLine glyphs), "triple" (three passes through a point), "handwriting" (jittered
+cursive words). Classifier "auto" runs the CNN everywhere and the geometric rule on touch
+too. See docs/benchmark.md for the columns.
 
 Each drawing is vectorized in a fresh process forked from this one (the vectorizer's
 modules and models are loaded here first by a warm-up call, as in a long-running process):
@@ -44,13 +47,32 @@ if str(ROOT) not in sys.path:
 import numpy as np  # noqa: E402
 
 from benchmarks.conditions import CONDITIONS, condition_image  # noqa: E402
+from benchmarks.bench_tables import PSNR_CAP, print_tables  # noqa: E402
 from benchmarks.drawings import generate_set  # noqa: E402
 from benchmarks.hershey import hershey_set  # noqa: E402
-from benchmarks.metrics import ORDER_THRESHOLD, evaluate  # noqa: E402
+from benchmarks.ink_metrics import ink_pieces, ink_scores  # noqa: E402
+from benchmarks.metrics import ORDER_THRESHOLD, evaluate, order_tolerance  # noqa: E402
+from benchmarks.relief import relief_set  # noqa: E402
 from benchmarks.render import render, to_uint8  # noqa: E402
 
-DEFAULT_COUNTS = {"plain": 42, "touch": 40, "hershey": 40}
-PSNR_CAP = 60.0  # dB; an identical render has infinite PSNR, averaged as this
+DEFAULT_COUNTS = {"plain": 42, "touch": 40, "hershey": 40, "hershey-retrace": 40, "relief": 40, "triple": 40,
+                  "handwriting": 40}
+SETS = tuple(DEFAULT_COUNTS)
+
+
+def build_set(name: str, count: int, seed: int) -> list:
+    """The ground truths of one benchmark set."""
+    if name == "hershey":
+        return hershey_set(count, seed)
+    if name == "hershey-retrace":
+        return hershey_set(count, seed, ambiguous=True)
+    if name == "relief":
+        return relief_set(count, seed)
+    if name == "handwriting":
+        from benchmarks.handwriting import handwriting_set
+
+        return handwriting_set(count, seed)
+    return generate_set(name, count, seed)
 TASKS: list = []  # (set name, GroundTruth), inherited by the forked workers
 PLOT_DIR: list = []  # [Path] when --plot is given
 CONDITION: list = ["clean"]  # how the rendered page is degraded (benchmarks/conditions.py)
@@ -120,6 +142,7 @@ def _run_one(index: int, classifier: str, oracle: bool, conn) -> None:
     try:
         gray = render(gt.drawing)
         image, back = condition_image(gt.drawing, gray, CONDITION[0], np.random.default_rng(index))
+        row["one_piece"] = ink_pieces(image, gt.width / back) == 1
         if oracle:
             output, seconds, peak, method, report = gt.drawing, 0.0, float("nan"), "none", None
         else:
@@ -146,14 +169,24 @@ def _run_one(index: int, classifier: str, oracle: bool, conn) -> None:
             overlay(gt, output, gray, PLOT_DIR[0] / f"{set_name}-{classifier}-{gt.name}.png")
         row.update(seconds=seconds, peak_mb=peak, memory_method=method, strokes=scores.stroke_count,
                    ssim=scores.ssim, psnr=scores.psnr, length_ratio=scores.length_ratio,
-                   out_intersections=scores.out_intersections, matched=scores.matched,
-                   order=scores.order, correct=scores.correct,
+                   gt_intersections=scores.gt_intersections, out_intersections=scores.out_intersections, matched=scores.matched,
+                   order=scores.order, order_correct=scores.correct, **_ink_row(gt, output, image, scores),
                    warnings=" | ".join(report.warnings) if report is not None else "")
     except BaseException as exc:  # noqa: BLE001 - a failing drawing is a result, not a crash
         row["error"] = f"{type(exc).__name__}: {exc}".replace("\n", " ")[:300]
         row["traceback"] = traceback.format_exc()[-2000:]
     conn.send(row)
     conn.close()
+
+
+def _ink_row(gt, output, image: np.ndarray, scores) -> dict:
+    """Excursion figures and the verdict: the order score's, or for a drawing whose order cannot
+    be read from the ink (meta "fair") the fair-retrace rule's (docs/benchmark.md)."""
+    ink = ink_scores(gt, output, image, order_tolerance(gt.width))
+    fair = bool(gt.meta.get("fair"))
+    correct = scores.correct or (fair and ink.fair_ok and scores.undetected == 0)
+    return {"excursion": ink.excursion, "excursion_w": ink.excursion_widths, "within": ink.within, "uncovered": ink.uncovered, "fair": fair,
+            "correct": bool(correct)}
 
 
 def run_tasks(jobs: list[tuple[int, str]], oracle: bool, parallel: int, timeout: float, progress) -> list[dict]:
@@ -196,130 +229,6 @@ def run_tasks(jobs: list[tuple[int, str]], oracle: bool, parallel: int, timeout:
             del running[slot]
             progress(row)
     return rows  # type: ignore[return-value]
-
-
-# -- tables -----------------------------------------------------------------------------------
-
-def _summary(rows: list[dict]) -> dict:
-    ok = [r for r in rows if not r.get("error")]
-    n = len(rows)
-
-    def mean(key, cap=None):
-        vals = [min(r[key], cap) if cap is not None else r[key] for r in ok]
-        return float(np.mean(vals)) if vals else float("nan")
-
-    gt_x = sum(r["gt_intersections"] for r in ok)
-    out_x = sum(r["out_intersections"] for r in ok)
-    matched = sum(r["matched"] for r in ok)
-    secs = [r["seconds"] for r in ok]
-    peaks = [r["peak_mb"] for r in ok if not math.isnan(r["peak_mb"])]
-    return {
-        "n": n,
-        "fail": n - len(ok),
-        "correct": 100.0 * sum(1 for r in ok if r["correct"]) / n if n else float("nan"),
-        "strokes": mean("strokes"),
-        "order": mean("order"),
-        "ssim": mean("ssim"),
-        "psnr": mean("psnr", PSNR_CAP),
-        "length": 100.0 * mean("length_ratio"),
-        "undetected": 100.0 * (gt_x - matched) / gt_x if gt_x else float("nan"),
-        "hallucinated": 100.0 * (out_x - matched) / out_x if out_x else 0.0,
-        "median_s": float(np.median(secs)) if secs else float("nan"),
-        "p90_s": float(np.percentile(secs, 90)) if secs else float("nan"),
-        "peak_mb": max(peaks) if peaks else float("nan"),
-    }
-
-
-COLUMNS = [  # key, header, width, format ("" = text, left-aligned)
-    ("set", "set", 8, ""), ("classifier", "classifier", 10, ""), ("n", "n", 4, "{:d}"), ("fail", "fail", 4, "{:d}"),
-    ("correct", "correct %", 9, "{:.1f}"), ("strokes", "strokes", 7, "{:.2f}"), ("order", "order", 6, "{:.3f}"),
-    ("ssim", "SSIM", 6, "{:.4f}"), ("psnr", "PSNR", 6, "{:.2f}"), ("length", "len %", 6, "{:.2f}"),
-    ("undetected", "undet %", 7, "{:.1f}"), ("hallucinated", "hall %", 6, "{:.1f}"),
-    ("median_s", "med s", 6, "{:.2f}"), ("p90_s", "p90 s", 6, "{:.2f}"), ("peak_mb", "peak MB", 7, "{:.0f}"),
-]
-
-
-def _fmt_row(values: dict) -> str:
-    cells = []
-    for key, _head, width, fmt in COLUMNS:
-        v = values[key]
-        if not fmt:
-            cells.append(str(v).ljust(width))
-        elif isinstance(v, float) and math.isnan(v):
-            cells.append("-".rjust(width))
-        else:
-            cells.append(fmt.format(v).rjust(width))
-    return "  ".join(cells)
-
-
-def _fmt_header() -> str:
-    return "  ".join(head.ljust(width) if not fmt else head.rjust(width) for _k, head, width, fmt in COLUMNS)
-
-
-# the issue's acceptance numbers: (label, key, comparison, target)
-ACCEPTANCE = [
-    ("one stroke in correct order %", "correct", ">=", 90.0), ("mean stroke count", "strokes", "<=", 1.15),
-    ("SSIM", "ssim", ">=", 0.985), ("PSNR dB", "psnr", ">=", 28.0), ("length ratio %", "length", "<=", 1.5),
-    ("undetected %", "undetected", "<=", 10.0), ("hallucinated %", "hallucinated", "<=", 10.0),
-    ("median s", "median_s", "<=", 1.5), ("peak MB", "peak_mb", "<=", 600.0),
-]
-
-
-def _print_acceptance(rows: list[dict]) -> None:
-    """The measured numbers next to the issue's targets (only for the rows that were run)."""
-    main = [r for r in rows if r["set"] in ("plain", "hershey") and r["classifier"] == "cnn"]
-    lines = []
-    if {r["set"] for r in main} == {"plain", "hershey"}:
-        s = _summary(main)
-        for label, key, op, target in ACCEPTANCE:
-            v = s[key]
-            ok = (v >= target) if op == ">=" else (v <= target)
-            lines.append(f"  plain+hershey, cnn: {label:<30} {v:9.3f}  target {op} {target:g}  "
-                         f"{'met' if ok and not math.isnan(v) else 'NOT MET'}")
-    touch = {c: _summary([r for r in rows if r["set"] == "touch" and r["classifier"] == c])
-             for c in ("cnn", "geometric") if any(r["set"] == "touch" and r["classifier"] == c for r in rows)}
-    if "cnn" in touch:
-        v = touch["cnn"]["correct"]
-        lines.append(f"  touch, cnn: one stroke in correct order %     {v:9.1f}  target >= 85  "
-                     f"{'met' if v >= 85 else 'NOT MET'}")
-    if len(touch) == 2:
-        gap = touch["cnn"]["correct"] - touch["geometric"]["correct"]
-        lines.append(f"  touch: cnn minus geometric (points)           {gap:9.1f}  target: clearly > 0  "
-                     f"{'met' if gap >= 10 else 'NOT MET (less than 10 points)'}")
-    if lines:
-        print()
-        print("acceptance (issue targets; time and memory as measured here):")
-        print("\n".join(lines))
-
-
-def print_tables(rows: list[dict]) -> None:
-    groups: dict = {}
-    for r in rows:
-        groups.setdefault((r["set"], r["classifier"]), []).append(r)
-    print(_fmt_header())
-    for (set_name, classifier), rs in groups.items():
-        print(_fmt_row({"set": set_name, "classifier": classifier, **_summary(rs)}))
-    if len({r["set"] for r in rows} & {"plain", "hershey"}) == 2:
-        main = [r for r in rows if r["set"] in ("plain", "hershey") and r["classifier"] == "cnn"]
-        if main:
-            print(_fmt_row({"set": "plain+h", "classifier": "cnn", **_summary(main)}))
-    _print_acceptance(rows)
-    print()
-    print("by drawing kind:")
-    print(f"{'set':<8}  {'classifier':<10}  {'kind':<17}  {'n':>3}  {'fail':>4}  {'correct %':>9}  "
-          f"{'strokes':>7}  {'order':>6}  {'undet %':>7}  {'hall %':>6}  {'med s':>6}")
-    kinds: dict = {}
-    for r in rows:
-        kinds.setdefault((r["set"], r["classifier"], r["kind"]), []).append(r)
-    for (set_name, classifier, kind), rs in sorted(kinds.items()):
-        s = _summary(rs)
-        cells = [f"{set_name:<8}", f"{classifier:<10}", f"{kind:<17}", f"{s['n']:>3}", f"{s['fail']:>4}"]
-        for key, width, fmt in (("correct", 9, "{:.1f}"), ("strokes", 7, "{:.2f}"), ("order", 6, "{:.3f}"),
-                                ("undetected", 7, "{:.1f}"), ("hallucinated", 6, "{:.1f}"),
-                                ("median_s", 6, "{:.2f}")):
-            v = s[key]
-            cells.append(("-" if isinstance(v, float) and math.isnan(v) else fmt.format(v)).rjust(width))
-        print("  ".join(cells))
 
 
 # -- whole process ----------------------------------------------------------------------------
@@ -428,7 +337,7 @@ def _git_commit() -> str:
 
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[1], formatter_class=argparse.RawTextHelpFormatter)
-    ap.add_argument("--set", default="all", choices=["plain", "touch", "hershey", "all"])
+    ap.add_argument("--set", default="all", choices=[*SETS, "all"])
     ap.add_argument("--classifier", default="auto", choices=["auto", "cnn", "geometric", "both"],
                     help="auto: cnn on plain/hershey, both on touch")
     ap.add_argument("--count", type=int, default=None, help="drawings per set (default: plain 42, touch 40, "
@@ -454,10 +363,10 @@ def main(argv: list[str] | None = None) -> int:
     if args.plot:
         args.plot.mkdir(parents=True, exist_ok=True)
         PLOT_DIR.append(args.plot)
-    sets = ["plain", "touch", "hershey"] if args.set == "all" else [args.set]
+    sets = list(SETS) if args.set == "all" else [args.set]
     for name in sets:
         count = args.count if args.count is not None else DEFAULT_COUNTS[name]
-        gts = hershey_set(count, args.seed) if name == "hershey" else generate_set(name, count, args.seed)
+        gts = build_set(name, count, args.seed)
         TASKS.extend((name, gt) for gt in gts)
     t_gen = time.perf_counter() - t_start
 
@@ -526,7 +435,8 @@ def main(argv: list[str] | None = None) -> int:
     if args.csv:
         keys = ["set", "classifier", "name", "kind", "width", "closed", "strokes", "order", "correct", "ssim",
                 "psnr", "length_ratio", "gt_intersections", "out_intersections", "matched", "seconds",
-                "peak_mb", "error", "warnings"]
+                "peak_mb", "order_correct", "fair", "one_piece", "excursion", "excursion_w", "within", "uncovered",
+                "error", "warnings"]
         args.csv.parent.mkdir(parents=True, exist_ok=True)
         with open(args.csv, "w", newline="") as fh:
             writer = csv.DictWriter(fh, fieldnames=keys, extrasaction="ignore")

@@ -16,6 +16,7 @@ from benchmarks import drawings as D  # noqa: E402
 from benchmarks.hershey import Glyph, glyph_ground_truth, glyph_stroke, load_glyphs  # noqa: E402
 from benchmarks.metrics import (  # noqa: E402
     ORDER_THRESHOLD,
+    ambiguous_junctions,
     evaluate,
     match_points,
     order_score,
@@ -244,3 +245,133 @@ def test_one_command_runs_and_prints_the_table(tmp_path, capsys):
     assert "100.0" in row
     assert len(csv_path.read_text().splitlines()) == 3
     vectorize_bench.TASKS.clear()
+
+
+# -- ink metrics: excursion, ink pieces, minimum traversal, fair retrace ---------------------------
+
+def test_excursion_is_zero_inside_the_ink_and_the_real_distance_of_a_balloon(loops_gt):
+    from benchmarks.ink_metrics import excursion, excursion_bound
+
+    stroke = loops_gt.stroke
+    s = np.linspace(0, stroke.length, int(stroke.length))
+    pts = stroke.points_at_lengths(s)
+    normal = np.gradient(pts, axis=0)[:, ::-1] * [1, -1]
+    normal /= np.linalg.norm(normal, axis=1, keepdims=True)
+    inside = Stroke.from_polyline(pts + 0.3 * normal)  # a fit 0.3 px off the centre line
+    exc = excursion(loops_gt.drawing, loops_gt.drawing.with_strokes([inside]))
+    assert exc == pytest.approx(0.3, abs=0.05)
+    assert exc <= excursion_bound(loops_gt.width)
+    # the middle of a straight retraced stem fitted as a loop 40 px wide: 20 px off each side
+    stem = Drawing((Stroke.from_polyline(np.array([[100, 500], [100, 100], [100, 500.0]])),), 1000, 1000, "px", 4.0)
+    t = np.linspace(0, np.pi, 200)
+    loop = np.c_[100 + 20 * np.sin(2 * t), 500 - 400 * (1 - np.cos(t)) / 2]
+    assert excursion(stem, stem.with_strokes([Stroke.from_polyline(loop)])) == pytest.approx(20.0, abs=0.1)
+
+
+def test_ink_pieces_counts_connected_ink_and_ignores_dust(loops_gt):
+    from benchmarks.ink_metrics import ink_pieces
+
+    image = render(loops_gt.drawing)
+    assert ink_pieces(image, loops_gt.width) == 1
+    two = loops_gt.drawing.with_strokes([Stroke.from_polyline(np.array([[50, 50], [300, 50.0]])),
+                                         Stroke.from_polyline(np.array([[50, 900], [300, 900.0]]))])
+    dusty = render(two)
+    dusty[500:502, 500:502] = 0.0  # a 4 px speck
+    assert ink_pieces(dusty, loops_gt.width) == 2
+
+
+def test_minimum_traversal_is_route_inspection():
+    from benchmarks.ink_metrics import ink_graph, min_traversal_length
+
+    # a T drawn bar left -> right, back to the middle, down the stem: the 5 px half-bar is retraced
+    tee = np.array([[0, 0], [10, 0], [5, 0], [5, 10.0]])
+    graph = ink_graph(tee)
+    assert sorted(graph.degrees.tolist()) == [1, 1, 1, 3]
+    assert min_traversal_length(graph) == pytest.approx(25.0)
+    # an H (50 px of ink, six odd nodes): two half-stems must be drawn twice, as here
+    h = np.array([[0, 0], [0, 20], [0, 10], [10, 10], [10, 20], [10, 0.0]])
+    assert min_traversal_length(ink_graph(h)) == pytest.approx(70.0)
+    square = np.array([[0, 0], [10, 0], [10, 10], [0, 10], [0, 0.0]])
+    assert min_traversal_length(ink_graph(square)) == pytest.approx(40.0)
+
+
+def _fork():
+    """A Y whose two arms are equal free stubs: either could be the retraced one."""
+    from benchmarks.hershey import Glyph, glyph_ground_truth
+
+    glyph = Glyph("test", "fork", "y", "M 0 0 L 0 10 L -5 15 L 0 10 L 5 15")  # stem, left arm out and back, right arm
+    gt = glyph_ground_truth(glyph, 6.0, ambiguous=True)
+    assert gt is not None and gt.meta["fair"]
+    return gt
+
+
+def test_fair_retrace_rule_accepts_an_equal_stub_and_rejects_an_extra_retrace():
+    from benchmarks.ink_metrics import ink_scores
+
+    gt = _fork()
+    poly = gt.stroke.flatten(0.05)
+    base, left, right = poly[np.argmin(np.abs(poly[:, 1] - poly[:, 1].min()))], None, None
+    ends = poly[[0, -1]]
+    stem_end = ends[0]
+    tips = sorted({tuple(np.round(p, 6)) for p in poly}, key=lambda p: p[1])[:2]  # the arm tips (top, y small)
+    left, right = np.array(tips[0]), np.array(tips[1])
+    junction = poly[1]
+    del base
+    tol = order_tolerance(gt.width)
+    image = render(gt.drawing)
+    # the same ink, the OTHER arm retraced: the order score rejects it, the fair rule accepts it
+    other = Stroke.from_polyline(np.array([stem_end, junction, right, junction, left]))
+    other_out = gt.drawing.with_strokes([other])
+    assert order_score(gt.stroke, [other], tol) < ORDER_THRESHOLD
+    assert other.length == pytest.approx(gt.stroke.length)
+    assert ink_scores(gt, other_out, image, tol).fair_ok
+    # both arms retraced (one more than needed): rejected
+    extra = Stroke.from_polyline(np.array([stem_end, junction, right, junction, left, junction]))
+    assert not ink_scores(gt, gt.drawing.with_strokes([extra]), image, tol).fair_ok
+    # leaving out an arm is shorter but does not cover the ink: rejected
+    short = Stroke.from_polyline(np.array([stem_end, junction, right]))
+    assert not ink_scores(gt, gt.drawing.with_strokes([short]), image, tol).fair_ok
+    # two strokes: rejected
+    two = (Stroke.from_polyline(np.array([stem_end, junction, right])), Stroke.from_polyline(np.array([junction, left])))
+    assert not ink_scores(gt, gt.drawing.with_strokes(two), image, tol).fair_ok
+
+
+# -- the new sets ---------------------------------------------------------------------------------
+
+def test_triple_drawings_have_three_passes_through_a_point():
+    gt = D.generate_drawing("triple", 0, 20_000)
+    triples = [e for e in gt.events if e.kind == "triple"]
+    assert 1 <= len(triples) <= 2 and all(e.angle >= 30 for e in triples)
+    inter = polyline_intersections([gt.stroke.flatten(0.05)], [gt.closed])
+    assert all(np.min(np.linalg.norm(inter.multiple - e.point, axis=1)) < 0.5 for e in triples)
+    assert len(gt.intersections) >= 1  # ordinary crossings elsewhere
+    assert evaluate(gt, gt.drawing).correct
+
+
+def test_handwriting_words_are_jittered_cursive_with_readable_or_flagged_order():
+    from benchmarks import handwriting as H
+
+    for word in H.WORDS:  # readable words have a crossing between each free end and each retrace
+        poly = H._runs_stroke(H.word_runs(word))[1]
+        assert bool(ambiguous_junctions(poly)) == (word in H.AMBIGUOUS), word
+    a, b = H.handwriting_drawing(0, 3), H.handwriting_drawing(0, 3)
+    np.testing.assert_array_equal(a.stroke.control, b.stroke.control)
+    assert a.meta["word"] == "little" and a.meta["fair"] and a.meta["retraces"] == 4
+    assert 3.0 <= a.width <= 8.0
+    clean = H.handwriting_drawing(0, 1)  # "ethic": order readable, a real retrace
+    assert not clean.meta["fair"] and clean.meta["retraces"] >= 1
+    # jitter: the traced line wanders off the pen path, but by well under a width
+    assert clean.drawing.length > 1.005 * clean.meta["clean_length"]
+    assert evaluate(clean, clean.drawing).correct
+    assert len(set(H.WORDS[:40])) == 40  # the default set: 40 different words
+
+
+def test_relief_glyphs_load_with_their_licence():
+    from benchmarks.relief import RELIEF_DIR, relief_glyphs, relief_set
+
+    assert (RELIEF_DIR / "OFL.txt").exists() and (RELIEF_DIR / "README.md").exists()
+    names = [g.name for g in relief_glyphs()]
+    assert len(names) == len({n.split(".")[0] for n in names}) > 40
+    gts = relief_set(6)
+    assert len(gts) == 6 and all(g.kind.startswith("relief-") for g in gts)
+    assert all(evaluate(g, g.drawing).correct for g in gts[:2])

@@ -44,10 +44,11 @@ def _register() -> None:
     from fabrication.cli.ports_cmd import ports
     from fabrication.cli.preview_cmd import preview
     from fabrication.cli.stream_cmd import emulator, stream
+    from fabrication.cli.studio_cmd import studio
     from fabrication.cli.train_cmd import train_classifier, validate_classifier
     from fabrication.cli.vectorize_cmd import vectorize
 
-    for command in (vectorize, embroider, laser, stream, preview, ports, emulator, train_classifier,
+    for command in (vectorize, embroider, laser, stream, preview, studio, ports, emulator, train_classifier,
                     validate_classifier):
         main.add_command(command)
 

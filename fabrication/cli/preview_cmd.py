@@ -27,17 +27,22 @@ DRAWING_SUFFIXES = (".svg", ".json")
 @click.command()
 @click.argument("source", type=click.Path(path_type=str))
 @click.option("-o", "--output", required=True, type=click.Path(path_type=str),
-              help="Preview image to write (.png or .svg).")
+              help="Preview to write: an image (.png, .svg) or a player page (.html).")
 @click.option("--width", "width_px", type=int, default=1000, show_default=True,
               help="Image width in px (embroidery and drawings).")
 @click.option("--hoop", default=None, help="Embroidery: draw this hoop, e.g. 100x100 or 5x7.")
 @click.option("--spm", type=float, default=None, help="Embroidery: stitches per minute for the time [600].")
 def preview(source: str, output: str, width_px: int, hoop: str | None, spm: float | None) -> None:
-    """Draw SOURCE (.pes/.dst/.jef/.exp/.vp3/... , .gcode/.nc, or an .svg/.json drawing) as OUTPUT."""
+    """Draw SOURCE (.pes/.dst/.jef/.exp/.vp3/... , .gcode/.nc, or an .svg/.json drawing) as OUTPUT.
+
+    An .html OUTPUT is a self-contained player (no server, no network) that plays the
+    stitches, laser moves or pen in order, with time, scrubber, speed and zoom."""
     from fabrication.embroidery.canvas import check_preview_path
     from fabrication.embroidery.read import readable_extensions
 
     suffix = os.path.splitext(source)[1].lower()
+    if output.lower().endswith((".html", ".htm")):
+        return _player_page(source, output, hoop, spm)
     accepted = readable_extensions() + GCODE_SUFFIXES + DRAWING_SUFFIXES
     if suffix not in accepted:
         raise InputError(f"cannot preview {source!r}; use an embroidery file "
@@ -94,3 +99,29 @@ def preview(source: str, output: str, width_px: int, hoop: str | None, spm: floa
         console.print(line, soft_wrap=True)
     done(f"wrote {output}: {stats.stitches} stitches, {stats.trims} trims, "
          f"{stats.width:.1f} x {stats.height:.1f} mm")
+
+
+def _player_page(source: str, output: str, hoop: str | None, spm: float | None) -> None:
+    """`preview SOURCE -o PAGE.html`: the standalone player page."""
+    from fabrication.player import player_data_for_file, write_player_html
+    from machines.hoops import load_embroidery_profile
+
+    profile = load_embroidery_profile()
+    if spm is not None and not spm > 0:
+        raise InputError(f"--spm {spm:g} must be greater than zero")
+    frame = None
+    if hoop is not None:
+        field = profile.hoop(hoop)
+        frame = (-field.width / 2, -field.height / 2, field.width / 2, field.height / 2)
+    data = player_data_for_file(source, stitches_per_minute=spm or profile.stitches_per_minute,
+                                trim_seconds=profile.trim_seconds, hoop=frame)
+    for message in data.warnings:
+        warn(message)
+    write_player_html(data, output, source=source)
+    from fabrication.laser.job_time import format_duration
+
+    span = (format_duration(data.total) if data.time_unit == "s"
+            else f"{data.total:.1f} {data.time_unit} drawn")
+    plural = "es" if data.number_label.endswith("ch") else "s"
+    done(f"wrote {output}: player of {len(data):,} moves, {data.number_total:,} "
+         f"{data.number_label}{plural if data.number_total != 1 else ''}, {span}")

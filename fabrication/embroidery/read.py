@@ -19,11 +19,14 @@ _CUTS = (pyembroidery.TRIM, pyembroidery.COLOR_CHANGE, pyembroidery.NEEDLE_SET, 
 @dataclass(frozen=True, eq=False)
 class EmbroideryFile:
     """A file read back: `plan` (rows as STITCH/JUMP/TRIM, params = progress 0..1),
-    `threads` (RGB per colour block) and `color_changes`."""
+    `threads` (RGB per colour block), `color_changes` and `blocks` (N,) int: the colour
+    block of each row of `plan` (0, 1, ...; a colour change row opens the next block; may
+    exceed len(threads) - 1 when a file, like DST, has more blocks than threads)."""
 
     plan: StitchPlan
     threads: tuple[tuple[int, int, int], ...]
     color_changes: int
+    blocks: np.ndarray
 
 
 def readable_extensions() -> tuple[str, ...]:
@@ -56,7 +59,9 @@ def read_embroidery(path: str | os.PathLike) -> EmbroideryFile:
     keep = kinds != 255
     if not (kinds == STITCH).any():
         raise InputError(f"{path!r} holds no stitches pyembroidery can read")
-    changes = int(np.isin(command, (pyembroidery.COLOR_CHANGE, pyembroidery.NEEDLE_SET)).sum())
+    is_change = np.isin(command, (pyembroidery.COLOR_CHANGE, pyembroidery.NEEDLE_SET))
+    changes = int(is_change.sum())
+    blocks = np.cumsum(is_change)[keep]
     points, kinds = rows[keep, :2] / 10.0, kinds[keep]
     params = np.linspace(0.0, 1.0, len(points)) if len(points) > 1 else np.zeros(len(points))
     params[kinds != STITCH] = np.nan
@@ -64,4 +69,4 @@ def read_embroidery(path: str | os.PathLike) -> EmbroideryFile:
                     for t in pattern.threadlist) or ((0, 0, 0),)
     plan = StitchPlan(points=points, kinds=kinds, roles=np.full(len(points), BODY, dtype=np.uint8),
                       params=params, strokes=np.where(kinds == STITCH, 0, -1), color=threads[0])
-    return EmbroideryFile(plan=plan, threads=threads, color_changes=changes)
+    return EmbroideryFile(plan=plan, threads=threads, color_changes=changes, blocks=blocks)

@@ -1,0 +1,190 @@
+"""Metrics of how faithfully an output follows the ink, beside the paper's Table 1 metrics.
+
+- excursion: the largest distance (px) from any point of the output curves to the
+  ground-truth centre line; a fit that stays in the ink keeps it within half the stroke
+  width + 1 px (`EXCURSION_SLACK`);
+- ink pieces: connected pieces of the ink the vectorizer was given (so "one piece of ink,
+  one stroke" can be checked);
+- minimum traversal length: the shortest pen path that draws every part of the ground
+  truth's ink graph at least once (route inspection / Chinese postman on the graph the
+  centre line forms once noded and merged), the bar for the fair-retrace rule;
+- the fair-retrace rule: where the drawing order at a junction cannot be read from the ink,
+  an output that is one stroke, stays in the ink, covers it and is no longer than the
+  minimum traversal (within `FAIR_LENGTH_SLACK`) counts as correct.
+
+docs/benchmark.md says exactly how each is measured.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from functools import lru_cache
+
+import numpy as np
+import shapely
+from scipy import ndimage
+from scipy.sparse import coo_matrix
+from scipy.sparse.csgraph import dijkstra
+from scipy.spatial import cKDTree
+
+from vectorize.drawing import Drawing
+
+EXCURSION_SLACK = 1.0  # px added to half the width: the acceptance bound of the excursion
+CENTRE_SPACING = 0.25  # px between ground-truth centre-line samples (distance error < 0.01 px)
+OUTPUT_SPACING = 0.5  # px between output samples
+FAIR_LENGTH_SLACK = (0.01, 2.0)  # (share of the minimum length, stroke widths) an output may exceed it by
+MAX_ODD_NODES = 20  # the exact pairing below is exponential in the odd nodes
+
+
+def _samples(drawing: Drawing, spacing: float) -> np.ndarray:
+    return np.concatenate([s.sample_evenly(spacing) for s in drawing.strokes])
+
+
+def excursion(gt: Drawing, output: Drawing) -> float:
+    """Largest distance (px) from the output's curves to the ground-truth centre line.
+
+    The output is sampled every 0.5 px, the ground truth every 0.25 px; nan for an empty output.
+    """
+    if not output.strokes:
+        return float("nan")
+    d, _ = cKDTree(_samples(gt, CENTRE_SPACING)).query(_samples(output, OUTPUT_SPACING))
+    return float(d.max())
+
+
+def uncovered(gt: Drawing, output: Drawing) -> float:
+    """Largest distance (px) from the ground-truth centre line to the output (inf if empty)."""
+    if not output.strokes:
+        return float("inf")
+    d, _ = cKDTree(_samples(output, CENTRE_SPACING)).query(_samples(gt, OUTPUT_SPACING))
+    return float(d.max())
+
+
+def excursion_bound(width: float) -> float:
+    """Largest excursion (px) that still counts as inside the ink: half the width + 1 px."""
+    return 0.5 * float(width) + EXCURSION_SLACK
+
+
+def ink_pieces(image: np.ndarray, width: float) -> int:
+    """Connected pieces (8-connected) of the pixels darker than mid-gray in `image`
+    ((H, W) uint8 or float in [0, 1], light paper), ignoring dust smaller than
+    max(30, 4 w^2) px."""
+    gray = np.asarray(image, dtype=float)
+    if gray.max() > 1.0:
+        gray = gray / 255.0
+    labels, count = ndimage.label(gray < 0.5, structure=np.ones((3, 3), dtype=bool))
+    if count == 0:
+        return 0
+    areas = np.bincount(labels.ravel())[1:]
+    return int(np.count_nonzero(areas >= max(30.0, 4.0 * float(width) ** 2)))
+
+
+# -- route inspection on the ink graph ------------------------------------------------------------
+
+@dataclass(frozen=True)
+class InkGraph:
+    """The graph a centre line forms once noded and merged (retraced parts become one edge).
+
+    nodes: (N, 2) px; edges: (E, 2) node indices; lengths: (E,) px.
+    """
+
+    nodes: np.ndarray
+    edges: np.ndarray
+    lengths: np.ndarray
+
+    @property
+    def degrees(self) -> np.ndarray:
+        return np.bincount(self.edges.ravel(), minlength=len(self.nodes))
+
+
+def ink_graph(polyline: np.ndarray) -> InkGraph:
+    """Node and merge a centre line ((N, 2) px, closed when its ends coincide) with shapely."""
+    merged = shapely.line_merge(shapely.union_all(shapely.LineString(np.asarray(polyline, dtype=float))))
+    parts = [p for p in shapely.get_parts(merged) if p.length > 0]
+    ends = np.array([[p.coords[0], p.coords[-1]] for p in parts], dtype=float).reshape(-1, 2)
+    nodes, inverse = np.unique(np.round(ends, 4), axis=0, return_inverse=True)
+    return InkGraph(nodes, inverse.reshape(-1, 2), np.array([p.length for p in parts], dtype=float))
+
+
+def _pairing_cost(dist: np.ndarray, free: int) -> float:
+    """Minimum total distance pairing all nodes, `free` of them allowed to stay unpaired
+    (exact, by dynamic programming over subsets)."""
+    k = len(dist)
+
+    @lru_cache(maxsize=None)
+    def best(mask: int, left: int) -> float:
+        if mask == 0:
+            return 0.0
+        i = (mask & -mask).bit_length() - 1
+        rest = mask & ~(1 << i)
+        cost = best(rest, left - 1) if left > 0 else np.inf
+        j_bits = rest
+        while j_bits:
+            j = (j_bits & -j_bits).bit_length() - 1
+            j_bits &= j_bits - 1
+            cost = min(cost, dist[i, j] + best(rest & ~(1 << j), left))
+        return cost
+
+    return float(best((1 << k) - 1, free))
+
+
+def min_traversal_length(graph: InkGraph) -> float:
+    """Length (px) of the shortest pen path (one stroke, open or closed) that draws every edge
+    of `graph` at least once: all edges plus the cheapest set of shortest paths pairing the
+    odd-degree nodes, two of which may be the path's ends (route inspection)."""
+    total = float(graph.lengths.sum())
+    odd = np.flatnonzero(graph.degrees % 2 == 1)
+    if len(odd) <= 2:
+        return total
+    if len(odd) > MAX_ODD_NODES:
+        raise ValueError(f"{len(odd)} odd junctions: too many for the exact pairing")
+    n = len(graph.nodes)
+    a, b = graph.edges[:, 0], graph.edges[:, 1]
+    keep = a != b
+    # scipy sums duplicate entries of a COO matrix: keep the shortest of parallel edges first
+    order = np.argsort(-graph.lengths[keep])
+    rows = np.r_[a[keep][order], b[keep][order]]
+    cols = np.r_[b[keep][order], a[keep][order]]
+    w = np.r_[graph.lengths[keep][order], graph.lengths[keep][order]]
+    dense = np.full((n, n), np.inf)
+    dense[rows, cols] = w  # later (shorter) entries win
+    matrix = coo_matrix(np.where(np.isfinite(dense), dense, 0.0))
+    dist = dijkstra(matrix, directed=False, indices=odd)[:, odd]
+    return total + _pairing_cost(dist, 2)
+
+
+# -- per-drawing ink scores ----------------------------------------------------------------------
+
+@dataclass(frozen=True)
+class InkScores:
+    """excursion: px (nan without output); excursion_widths: the same over the stroke width;
+    within: excursion <= half width + 1 px; uncovered: px of ground truth farthest from the
+    output; one_piece: the input ink is one connected piece; fair_ok: the fair-retrace rule
+    holds (one stroke, in the ink, covering it, no longer than the minimum traversal)."""
+
+    excursion: float
+    excursion_widths: float
+    within: bool
+    uncovered: float
+    one_piece: bool
+    fair_ok: bool
+
+
+def fair_length_limit(min_length: float, width: float) -> float:
+    """Longest output (px) that retraces no more than the minimum: 1 % + 2 widths of slack for
+    fitting (rounded corners, cusps a little short or long)."""
+    share, widths = FAIR_LENGTH_SLACK
+    return min_length * (1.0 + share) + widths * float(width)
+
+
+def ink_scores(gt, output: Drawing, image: np.ndarray, cover_tolerance: float) -> InkScores:
+    """Ink scores of `output` against a `GroundTruth` `gt`, given the image the vectorizer got
+    (for the ink pieces) and the distance within which the ground truth counts as covered."""
+    width = gt.drawing.stroke_width
+    exc = excursion(gt.drawing, output)
+    within = bool(exc <= excursion_bound(width))
+    unc = uncovered(gt.drawing, output)
+    one_piece = ink_pieces(image, width) == 1
+    min_length = gt.meta.get("min_length")
+    fair = bool(len(output.strokes) == 1 and within and unc <= cover_tolerance and min_length is not None
+                and output.length <= fair_length_limit(min_length, width))
+    return InkScores(exc, exc / width if np.isfinite(exc) else float("nan"), within, unc, one_piece, fair)

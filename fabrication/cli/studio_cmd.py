@@ -1,0 +1,51 @@
+"""`onestroke studio DRAWING`: refine the vectorization, preview and export on a local page."""
+
+from __future__ import annotations
+
+import time
+
+import click
+
+from fabrication.cli.common import console, done
+from onestroke.errors import InputError
+
+
+@click.command()
+@click.argument("source", type=click.Path(path_type=str))
+@click.option("--port", type=int, default=0, show_default=True, help="Port on 127.0.0.1 (0: any free port).")
+@click.option("--no-browser", is_flag=True, help="Print the page's address instead of opening a browser.")
+@click.option("--edits", "edits_path", default=None, type=click.Path(dir_okay=False, path_type=str),
+              help="The edits file the page loads and saves [default: DRAWING.edits.json beside the drawing].")
+@click.option("--profile", "profile_path", default=None, type=click.Path(dir_okay=False, path_type=str),
+              help="Laser profile TOML for the laser panel; default: built-in 400x400 mm.")
+@click.option("--classifier", type=click.Choice(["cnn", "geometric"]), default="cnn", show_default=True,
+              help="How crossings are told from touchings.")
+def studio(source: str, port: int, no_browser: bool, edits_path: str | None, profile_path: str | None,
+           classifier: str) -> None:
+    """Open SOURCE in the studio: fix crossings, splits, merges, start and threshold; see the
+    stitches and the laser toolpath; export and send. Ctrl-C stops it."""
+    from fabrication.studio.server import StudioServer
+    from fabrication.studio.session import StudioSession
+
+    if not 0 <= port <= 65535:
+        raise InputError(f"--port {port} must be between 0 and 65535")
+    session = StudioSession(source, edits_path=edits_path, profile=profile_path, classifier=classifier)
+    if profile_path is not None:
+        from machines.laser_profile import load_laser_profile
+
+        load_laser_profile(profile_path)  # a bad profile is refused now, not on the page
+    session.saved_edits()  # a malformed edits file is refused now too
+    with console.status(f"vectorizing {session.drawing_path.name}"):
+        session.vectorize(session.saved_edits())
+    server = StudioServer(session, port=port).start()
+    done(f"studio for {session.drawing_path.name} at {server.url}")
+    console.print(f"edits are saved to {session.edits_path}; Ctrl-C stops the studio")
+    if not no_browser:
+        import webbrowser
+
+        webbrowser.open(server.url)
+    try:
+        while server.thread.is_alive():
+            time.sleep(0.5)
+    finally:
+        server.stop()

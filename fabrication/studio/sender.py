@@ -1,0 +1,79 @@
+""""Send to laser": stream a G-code program over a port in a background thread, with the
+state, progress, pause/resume and abort the page polls and drives. The protocol is
+`machines.streamer.GrblStreamer`'s; nothing of GRBL is done here."""
+
+from __future__ import annotations
+
+import threading
+import time
+
+from machines.gcode_program import program_from_text
+from machines.ports import open_port
+from machines.streamer import GrblStreamer, StreamProgress
+from onestroke.errors import OnestrokeError
+
+
+class LaserSender:
+    """One job to one port. `status()` is a plain dict for the page."""
+
+    def __init__(self, text: str, *, port: str, baud: int = 115200, name: str = "job") -> None:
+        self.program = program_from_text(text, source=name)
+        self.port, self.baud = port, baud
+        self.state = "connecting"
+        self.message = ""
+        self.progress: StreamProgress | None = None
+        self.started = time.monotonic()
+        self._streamer: GrblStreamer | None = None
+        self._thread = threading.Thread(target=self._run, name="studio-send", daemon=True)
+
+    def start(self) -> "LaserSender":
+        self._thread.start()
+        return self
+
+    def _run(self) -> None:
+        try:
+            handle = open_port(self.port, baud=self.baud)
+            with GrblStreamer(handle, name=self.port) as streamer:
+                self._streamer = streamer
+                info = streamer.connect()
+                if info.alarm:
+                    raise OnestrokeError(f"{self.port} is locked in ALARM: home it ($H) or unlock it ($X) first")
+                self.state = "streaming"
+                result = streamer.stream(self.program, on_progress=self._on_progress)
+                self.state, self.message = "done", f"{result.lines} lines in {result.elapsed:.1f} s"
+        except OnestrokeError as error:
+            aborted = self.state == "aborting"
+            self.state, self.message = ("aborted" if aborted else "failed"), str(error)
+        finally:
+            self._streamer = None
+
+    def _on_progress(self, progress: StreamProgress) -> None:
+        self.progress = progress
+
+    def pause(self) -> None:
+        if self._streamer is not None and self.state == "streaming":
+            self._streamer.pause()
+            self.state = "paused"
+
+    def resume(self) -> None:
+        if self._streamer is not None and self.state == "paused":
+            self._streamer.resume()
+            self.state = "streaming"
+
+    def abort(self) -> None:
+        if self._streamer is not None and self.state in ("streaming", "paused", "connecting"):
+            self.state = "aborting"
+            self._streamer.abort()
+
+    @property
+    def running(self) -> bool:
+        return self._thread.is_alive()
+
+    def wait(self, timeout: float) -> None:
+        self._thread.join(timeout)
+
+    def status(self) -> dict:
+        p = self.progress
+        return {"state": self.state, "message": self.message, "port": self.port,
+                "acked": p.acked if p else 0, "total": p.total if p else len(self.program),
+                "elapsed": round(p.elapsed, 2) if p else 0.0, "machine": p.state if p else None}

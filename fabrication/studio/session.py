@@ -1,0 +1,173 @@
+"""One studio session: a drawing, its edits file and the library calls the page makes.
+
+Everything the page shows or downloads comes from the same library functions the CLI
+commands call (`vectorize_file` with edits, `embroidery_settings` + `embroider` +
+`embroidery_bytes`, `laser_settings` + `laser_program`, `drawing_to_svg`/`_json`), so a
+download is the same bytes as `onestroke embroider|laser|vectorize DRAWING --edits FILE`
+with the same options.
+"""
+
+from __future__ import annotations
+
+import os
+import threading
+from pathlib import Path
+
+import numpy as np
+
+from onestroke.atomic import atomic_write_text
+from onestroke.errors import InputError
+from vectorize import VectorizeOptions, vectorize_file
+from vectorize.edits import Edits, edits_from_dict, read_edits
+from vectorize.refine import StageCache
+
+EMBROIDERY_FORMATS = ("pes", "dst", "jef", "exp", "vp3")
+# Page fields -> embroidery_settings / laser_settings keywords (the CLI's option names).
+EMBROIDERY_FIELDS = ("style", "size", "hoop", "fit", "stitch_length", "tolerance", "stitch_width", "spacing",
+                     "pull_comp", "repeats", "arrow_size", "min_stitch", "max_stitch", "trim_distance",
+                     "lock_form", "color", "pes_version", "spm", "rotate")
+LASER_FIELDS = ("size", "rotate", "origin", "feed", "power", "passes", "tolerance", "arcs", "keep_order",
+                "air_assist", "return_home")
+# Points per px of curve sent to the page: enough for a smooth line, few enough to be quick.
+CURVE_SPACING = 2.0
+
+
+def _clean(values: dict, allowed: tuple[str, ...]) -> dict:
+    """The page's option values, empty ones dropped (the CLI's defaults then apply)."""
+    if not isinstance(values, dict):
+        raise InputError("options must be a JSON object")
+    unknown = sorted(set(values) - set(allowed))
+    if unknown:
+        raise InputError(f"unknown option(s): {', '.join(unknown)}")
+    return {k: v for k, v in values.items() if v is not None and v != ""}
+
+
+class StudioSession:
+    """drawing: the input file; edits_path: where the page saves its edits; profile: an
+    optional laser profile TOML; classifier: the vectorizer's crossing classifier."""
+
+    def __init__(self, drawing: str | os.PathLike, *, edits_path: str | os.PathLike | None = None,
+                 profile: str | os.PathLike | None = None, classifier: str = "cnn") -> None:
+        self.drawing_path = Path(drawing)
+        if not self.drawing_path.is_file():
+            raise InputError(f"input file {str(drawing)!r} does not exist")
+        self.edits_path = Path(edits_path) if edits_path else self.drawing_path.with_suffix(".edits.json")
+        self.profile = str(profile) if profile else None
+        self.options = VectorizeOptions(classifier=classifier)
+        self.cache = StageCache()
+        self.lock = threading.Lock()  # one vectorization at a time: the cache is not shared-safe
+        self.sender = None
+
+    # -- edits -----------------------------------------------------------------------
+    def saved_edits(self) -> Edits:
+        """The edits file if it exists, else no edits."""
+        return read_edits(self.edits_path) if self.edits_path.is_file() else Edits()
+
+    def save_edits(self, data: dict) -> Edits:
+        edits = edits_from_dict(data)
+        atomic_write_text(self.edits_path, edits.to_json())
+        return edits
+
+    # -- vectorization ---------------------------------------------------------------
+    def vectorize(self, edits: Edits):
+        with self.lock:
+            return vectorize_file(self.drawing_path, self.options, edits=edits, cache=self.cache)
+
+    def state(self, edits: Edits) -> dict:
+        """What the page draws: curve samples in drawing order, junctions, branches, report."""
+        result = self.vectorize(edits)
+        drawing, report = result.drawing, result.report
+        strokes = []
+        for stroke in drawing.strokes:
+            count = max(2, int(np.ceil(stroke.length / CURVE_SPACING)) + 1)
+            points = stroke.points_at_lengths(np.linspace(0.0, stroke.length, count))
+            strokes.append({"points": np.round(points, 2).tolist(), "closed": bool(stroke.is_closed),
+                            "length": round(float(stroke.length), 2)})
+        settings = edits.applied_to(self.options)
+        return {
+            "name": self.drawing_path.name, "width": drawing.width, "height": drawing.height,
+            "stroke_width": round(float(drawing.stroke_width), 3), "strokes": strokes,
+            "graph": result.graph.to_dict() if result.graph is not None else {"junctions": [], "branches": []},
+            "report": {"strokes": report.strokes, "intersections": report.intersections,
+                       "warnings": list(report.warnings),
+                       "seconds": round(float(report.total_seconds), 3)},
+            "settings": {"threshold": settings.threshold, "blur": settings.blur, "multi": settings.multi},
+            "edits": edits.to_dict(),
+        }
+
+    # -- make it ---------------------------------------------------------------------
+    def embroidery(self, edits: Edits, values: dict, extension: str = "pes"):
+        """(settings, result) of `onestroke embroider` for these option values."""
+        from fabrication.cli.job_options import embroidery_settings
+        from fabrication.embroidery.pipeline import embroider
+
+        if extension not in EMBROIDERY_FORMATS:
+            raise InputError(f"unknown embroidery format {extension!r}; use one of {', '.join(EMBROIDERY_FORMATS)}")
+        values = _clean(values, EMBROIDERY_FIELDS)
+        if extension != "pes":
+            values.pop("pes_version", None)
+        settings = embroidery_settings(output=f"design.{extension}", **values)
+        drawing = self.vectorize(edits).drawing
+        return settings, embroider(drawing, settings.job)
+
+    def embroidery_preview(self, edits: Edits, values: dict) -> dict:
+        """Needle points with their kinds (mm), hoop, stats lines and warnings."""
+        from fabrication.embroidery.plan import STITCH, TRIM
+
+        settings, result = self.embroidery(edits, values)
+        plan, stats = result.plan, result.stats
+        return {"points": np.round(plan.points, 2).tolist(), "kinds": plan.kinds.astype(int).tolist(),
+                "stitch": int(STITCH), "trim": int(TRIM), "color": "#%02x%02x%02x" % tuple(plan.color),
+                "hoop": {"name": result.hoop.name, "width": result.hoop.width, "height": result.hoop.height},
+                "stats": stats.lines(), "stitches": stats.stitches, "seconds": stats.seconds,
+                "warnings": list(settings.warnings) + list(result.warnings)}
+
+    def laser(self, edits: Edits, values: dict):
+        """(settings, program) of `onestroke laser` for these option values."""
+        from fabrication.cli.job_options import laser_settings
+        from fabrication.laser.program import laser_program
+
+        values = _clean(values, LASER_FIELDS)
+        if "passes" in values:
+            values["passes"] = int(values["passes"])
+        settings = laser_settings(profile_path=self.profile, **values)
+        drawing = self.vectorize(edits).drawing
+        program = laser_program(drawing, settings.profile, settings.toolpath, settings.gcode,
+                                name=self.drawing_path.name)
+        return settings, program
+
+    def laser_preview(self, edits: Edits, values: dict) -> dict:
+        """Burn paths (mm, +y up), the bed, and the planner's time estimate."""
+        from fabrication.laser.job_time import format_duration
+
+        settings, program = self.laser(edits, values)
+        toolpath, time = program.toolpath, program.time
+        return {"paths": [np.round(p.points, 3).tolist() for p in toolpath.paths], "bed": list(toolpath.bed),
+                "bounds": list(toolpath.bounds), "seconds": time.total_seconds,
+                "time": format_duration(time.total_seconds), "naive": format_duration(time.naive_seconds),
+                "burn_length": round(float(time.burn_length), 1), "travel_length": round(float(time.travel_length), 1),
+                "lines": len(program.lines), "warnings": list(settings.warnings)}
+
+    def export(self, kind: str, edits: Edits, values: dict) -> tuple[str, str, bytes]:
+        """(file name, media type, content) of one download."""
+        from fabrication.embroidery.export import embroidery_bytes
+        from machines.hoops import load_embroidery_profile
+        from vectorize.svg_write import drawing_to_json, drawing_to_svg
+
+        stem = self.drawing_path.stem
+        if kind in ("svg", "json"):
+            drawing = self.vectorize(edits).drawing
+            if kind == "svg":
+                return f"{stem}.svg", "image/svg+xml", drawing_to_svg(drawing).encode()
+            return f"{stem}.json", "application/json", drawing_to_json(drawing).encode()
+        if kind == "edits":
+            return f"{stem}.edits.json", "application/json", edits.to_json().encode()
+        if kind in EMBROIDERY_FORMATS:
+            settings, result = self.embroidery(edits, values, kind)
+            fmt = load_embroidery_profile().format_for(f"design.{kind}")
+            data = embroidery_bytes(result.plan, fmt, pes_version=settings.pes_version)
+            return f"{stem}.{kind}", "application/octet-stream", data
+        if kind == "gcode":
+            _, program = self.laser(edits, values)
+            return f"{stem}.gcode", "text/plain", program.text.encode()
+        raise InputError(f"unknown export {kind!r}")

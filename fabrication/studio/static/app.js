@@ -1,0 +1,557 @@
+// onestroke studio: the page. Plain JS, no build step; every computation is the server's
+// (the library's), the page only draws, keeps the edits history and sends edits back.
+"use strict";
+
+const TOKEN = new URLSearchParams(location.search).get("token") || "";
+const PAIRINGS = ["crossing", "touching", "third"];
+const COLORS = { crossing: "#1565c0", touching: "#ef6c00", third: "#8e24aa", other: "#757575", start: "#2e7d32" };
+const $ = (id) => document.getElementById(id);
+
+const studio = {
+  state: null,            // last answer of /api/state
+  history: [],            // edits states (plain objects), for undo/redo
+  at: -1,                 // index of the current state in history
+  view: { scale: 1, x: 0, y: 0 },
+  pen: 1,                 // play position, fraction of the total length
+  playing: false,
+  tool: "pairing",
+  image: new Image(),
+  requests: 0,            // answers to ignore when a newer request was sent
+};
+window.studio = studio;
+
+// ---------------------------------------------------------------- server calls
+async function call(path, body, raw = false) {
+  const init = { headers: { "X-Studio-Token": TOKEN } };
+  if (body !== undefined) {
+    init.method = "POST";
+    init.headers["Content-Type"] = "application/json";
+    init.body = JSON.stringify(body);
+  }
+  const response = await fetch(path, init);
+  if (!response.ok) {
+    let message = response.statusText;
+    try { message = (await response.json()).error || message; } catch (e) { /* not JSON */ }
+    throw new Error(message);
+  }
+  return raw ? response : response.json();
+}
+
+let busyCount = 0;
+function busy(on) {
+  busyCount += on ? 1 : -1;
+  $("busy").hidden = busyCount <= 0;
+  document.body.classList.toggle("busy", busyCount > 0);
+}
+
+function report(error) {
+  $("warnings").innerHTML = "";
+  const li = document.createElement("li");
+  li.textContent = "error: " + error.message;
+  $("warnings").appendChild(li);
+}
+
+// ---------------------------------------------------------------- edits and history
+function currentEdits() { return studio.history[studio.at]; }
+
+function blankEdits() {
+  return { format: "onestroke-edits", version: 1, threshold: null, blur: null, multi: null, tolerance: 8, edits: [] };
+}
+
+async function apply(edits, push = true) {
+  if (push) {
+    studio.history = studio.history.slice(0, studio.at + 1);
+    studio.history.push(edits);
+    studio.at = studio.history.length - 1;
+  }
+  updateButtons();
+  const ticket = ++studio.requests;
+  busy(true);
+  try {
+    const state = await call("api/state", { edits });
+    if (ticket === studio.requests) show(state);
+  } catch (error) {
+    report(error);
+  } finally {
+    busy(false);
+  }
+}
+
+function withEdit(edit, replaceNear) {
+  const edits = JSON.parse(JSON.stringify(currentEdits()));
+  if (replaceNear) {
+    // One pairing per junction: a new choice replaces the old one instead of piling up.
+    edits.edits = edits.edits.filter((e) => !(e.kind === edit.kind && dist(e.at, edit.at) <= edits.tolerance));
+  }
+  edits.edits.push(edit);
+  return edits;
+}
+
+function undo() { if (studio.at > 0) { studio.at -= 1; apply(currentEdits(), false); } }
+function redo() { if (studio.at < studio.history.length - 1) { studio.at += 1; apply(currentEdits(), false); } }
+
+function updateButtons() {
+  $("undo").disabled = studio.at <= 0;
+  $("redo").disabled = studio.at >= studio.history.length - 1;
+}
+
+// ---------------------------------------------------------------- geometry helpers
+function dist(a, b) { return Math.hypot(a[0] - b[0], a[1] - b[1]); }
+function toScreen(x, y) { const v = studio.view; return [x * v.scale + v.x, y * v.scale + v.y]; }
+function toImage(sx, sy) { const v = studio.view; return [(sx - v.x) / v.scale, (sy - v.y) / v.scale]; }
+studio.toScreen = (x, y) => {
+  const r = $("canvas").getBoundingClientRect();
+  const [sx, sy] = toScreen(x, y);
+  return [r.left + sx, r.top + sy];
+};
+
+function fit() {
+  const s = studio.state, c = $("canvas");
+  if (!s) return;
+  const w = c.clientWidth, h = c.clientHeight;
+  const scale = 0.94 * Math.min(w / s.width, h / s.height);
+  studio.view = { scale, x: (w - s.width * scale) / 2, y: (h - s.height * scale) / 2 };
+}
+
+// Points of all strokes in drawing order with cumulative length, for colour and the pen.
+function timeline() {
+  const s = studio.state;
+  const pts = [], cum = [];
+  let total = 0;
+  for (const stroke of s.strokes) {
+    stroke.points.forEach((p, i) => {
+      if (pts.length && i > 0) total += dist(pts[pts.length - 1], p);
+      pts.push(p); cum.push(total);
+      p.first = i === 0;
+    });
+  }
+  return { pts, cum, total };
+}
+
+function hue(f) { return `hsl(${Math.round(240 - 240 * f)}, 85%, 45%)`; }
+
+// ---------------------------------------------------------------- drawing view
+function draw() {
+  const c = $("canvas"), s = studio.state;
+  const dpr = window.devicePixelRatio || 1;
+  if (c.width !== Math.round(c.clientWidth * dpr) || c.height !== Math.round(c.clientHeight * dpr)) {
+    c.width = Math.round(c.clientWidth * dpr); c.height = Math.round(c.clientHeight * dpr);
+  }
+  const g = c.getContext("2d");
+  g.setTransform(dpr, 0, 0, dpr, 0, 0);
+  g.clearRect(0, 0, c.clientWidth, c.clientHeight);
+  if (!s) return;
+  const v = studio.view;
+  g.save();
+  g.translate(v.x, v.y); g.scale(v.scale, v.scale);
+  if (studio.image.complete && studio.image.naturalWidth) {
+    g.globalAlpha = 0.3;
+    g.drawImage(studio.image, 0, 0, s.width, s.height);
+    g.globalAlpha = 1;
+  }
+  g.restore();
+  const t = studio.line;
+  const penAt = studio.pen * t.total;
+  const width = Math.max(2, Math.min(6, s.stroke_width * v.scale * 0.45));
+  g.lineCap = "round"; g.lineWidth = width;
+  for (let i = 1; i < t.pts.length; i++) {
+    if (t.pts[i].first) continue;
+    const drawn = t.cum[i] <= penAt + 1e-9;
+    g.strokeStyle = drawn ? hue(t.total ? t.cum[i] / t.total : 0) : "rgba(0,0,0,0.12)";
+    const a = toScreen(...t.pts[i - 1]), b = toScreen(...t.pts[i]);
+    g.beginPath(); g.moveTo(a[0], a[1]); g.lineTo(b[0], b[1]); g.stroke();
+  }
+  arrows(g, t);
+  // Start markers: where each stroke begins.
+  s.strokes.forEach((stroke, k) => {
+    const [x, y] = toScreen(...stroke.points[0]);
+    g.fillStyle = COLORS.start; g.beginPath(); g.arc(x, y, k === 0 ? 7 : 5, 0, 2 * Math.PI); g.fill();
+    g.fillStyle = "#fff"; g.font = "bold 9px sans-serif"; g.textAlign = "center"; g.textBaseline = "middle";
+    g.fillText(String(k + 1), x, y + 0.5);
+  });
+  junctionMarkers(g);
+  if (studio.pen < 1 || studio.playing) penMarker(g, t, penAt);
+}
+
+function arrows(g, t) {
+  const step = 90 / studio.view.scale;  // one arrow every ~90 screen px
+  let next = step / 2;
+  g.fillStyle = "rgba(20,20,20,0.75)";
+  for (let i = 1; i < t.pts.length; i++) {
+    if (t.pts[i].first || t.cum[i] < next) continue;
+    next = t.cum[i] + step;
+    const a = toScreen(...t.pts[i - 1]), b = toScreen(...t.pts[i]);
+    const ang = Math.atan2(b[1] - a[1], b[0] - a[0]);
+    g.save(); g.translate(b[0], b[1]); g.rotate(ang);
+    g.beginPath(); g.moveTo(6, 0); g.lineTo(-4, -4.5); g.lineTo(-4, 4.5); g.closePath(); g.fill();
+    g.restore();
+  }
+}
+
+function junctionMarkers(g) {
+  const graph = studio.state.graph;
+  if (studio.tool === "merge") {
+    for (const b of graph.branches) {
+      const [x, y] = toScreen(...b.at);
+      g.fillStyle = "#00897b"; g.beginPath();
+      g.moveTo(x, y - 7); g.lineTo(x + 7, y); g.lineTo(x, y + 7); g.lineTo(x - 7, y); g.closePath(); g.fill();
+    }
+  }
+  for (const j of graph.junctions) {
+    const [x, y] = toScreen(...j.at);
+    if (j.role !== "crossing") {
+      g.strokeStyle = COLORS.other; g.lineWidth = 2;
+      g.beginPath(); g.arc(x, y, 5, 0, 2 * Math.PI); g.stroke();
+      continue;
+    }
+    const color = COLORS[j.decision] || COLORS.other;
+    g.lineWidth = 3; g.strokeStyle = color; g.fillStyle = "rgba(255,255,255,0.85)";
+    g.beginPath();
+    if (j.fixed) g.rect(x - 9, y - 9, 18, 18); else g.arc(x, y, 9, 0, 2 * Math.PI);
+    g.fill(); g.stroke();
+    // Confidence as the filled share of an inner disc.
+    g.fillStyle = color; g.beginPath(); g.moveTo(x, y);
+    g.arc(x, y, 6, -Math.PI / 2, -Math.PI / 2 + 2 * Math.PI * (j.confidence || 0)); g.closePath(); g.fill();
+    g.fillStyle = "#222"; g.font = "11px sans-serif"; g.textAlign = "left"; g.textBaseline = "middle";
+    g.fillText(`${j.decision} ${Math.round(100 * (j.confidence || 0))}%`, x + 12, y);
+  }
+}
+
+function penMarker(g, t, penAt) {
+  let i = t.cum.findIndex((c) => c >= penAt);
+  if (i < 0) i = t.pts.length - 1;
+  const [x, y] = toScreen(...t.pts[i]);
+  g.fillStyle = "#d50000"; g.strokeStyle = "#fff"; g.lineWidth = 2;
+  g.beginPath(); g.arc(x, y, 7, 0, 2 * Math.PI); g.fill(); g.stroke();
+  $("where").textContent = `${Math.round(penAt)} / ${Math.round(t.total)} px`;
+}
+
+// ---------------------------------------------------------------- showing a state
+function show(state) {
+  const first = !studio.state;
+  studio.state = state;
+  studio.line = timeline();
+  if (first) fit();
+  $("name").textContent = state.name;
+  const r = state.report;
+  $("summary").textContent = `${r.strokes} stroke${r.strokes === 1 ? "" : "s"}, ${r.intersections} crossing` +
+    `${r.intersections === 1 ? "" : "s"}, ${state.edits.edits.length} edit${state.edits.edits.length === 1 ? "" : "s"}` +
+    ` · ${r.seconds.toFixed(2)} s`;
+  $("summary").dataset.order = JSON.stringify(state.strokes.map((s) => s.points[0]));
+  const list = $("junctions"); list.innerHTML = "";
+  for (const j of state.graph.junctions.filter((j) => j.role === "crossing")) {
+    const li = document.createElement("li");
+    li.textContent = `(${j.at[0].toFixed(0)}, ${j.at[1].toFixed(0)}) ${j.decision}` +
+      ` · CNN p(cross) ${(j.p_crossing * 100).toFixed(0)}%` + (j.fixed ? " · fixed by you" : "");
+    li.style.color = COLORS[j.decision];
+    list.appendChild(li);
+  }
+  const warnings = $("warnings"); warnings.innerHTML = "";
+  for (const w of r.warnings) { const li = document.createElement("li"); li.textContent = w; warnings.appendChild(li); }
+  const st = state.settings;
+  $("auto-threshold").checked = st.threshold === null;
+  if (st.threshold !== null) $("threshold").value = st.threshold;
+  $("threshold-value").textContent = st.threshold === null ? "auto" : Number(st.threshold).toFixed(2);
+  $("blur").value = st.blur; $("blur-value").textContent = st.blur;
+  $("multi").checked = st.multi;
+  draw();
+  refreshPanel();
+}
+
+// ---------------------------------------------------------------- clicks on the drawing
+function nearest(items, point, radius) {
+  let best = null, bestD = radius / studio.view.scale;
+  for (const item of items) {
+    const d = dist(item.at, point);
+    if (d <= bestD) { best = item; bestD = d; }
+  }
+  return best;
+}
+
+function onClick(event) {
+  const s = studio.state;
+  if (!s || studio.dragged) return;
+  const r = $("canvas").getBoundingClientRect();
+  const p = toImage(event.clientX - r.left, event.clientY - r.top);
+  const crossings = s.graph.junctions.filter((j) => j.role === "crossing");
+  const tool = studio.tool;
+  if (tool === "pairing" || tool === "split") {
+    const j = nearest(crossings, p, 16);
+    if (!j) return;
+    if (tool === "split") return apply(withEdit({ kind: "split", at: j.at }, false));
+    const next = PAIRINGS[(PAIRINGS.indexOf(j.decision) + 1) % 3];
+    return apply(withEdit({ kind: "pairing", at: j.at, pairing: next }, true));
+  }
+  if (tool === "merge") {
+    const b = nearest(s.graph.branches, p, 16);
+    if (b) apply(withEdit({ kind: "merge", at: b.at }, false));
+    return;
+  }
+  if (tool === "start") {
+    const ends = [];
+    for (const stroke of s.strokes) if (!stroke.closed) {
+      ends.push({ at: stroke.points[0] }, { at: stroke.points[stroke.points.length - 1] });
+    }
+    const e = nearest(ends, p, 24);
+    if (e) apply(withEdit({ kind: "start", at: e.at.slice(0, 2) }, false));
+    return;
+  }
+  if (tool === "reverse") {
+    const points = studio.line.pts.map((q) => ({ at: q }));
+    const q = nearest(points, p, 16);
+    if (q) apply(withEdit({ kind: "reverse", at: q.at.slice(0, 2) }, false));
+  }
+}
+
+function setupView() {
+  const c = $("canvas");
+  let drag = null;
+  c.addEventListener("mousedown", (e) => { drag = { x: e.clientX, y: e.clientY, vx: studio.view.x, vy: studio.view.y }; studio.dragged = false; });
+  window.addEventListener("mousemove", (e) => {
+    if (!drag) return;
+    const dx = e.clientX - drag.x, dy = e.clientY - drag.y;
+    if (Math.abs(dx) + Math.abs(dy) > 4) studio.dragged = true;
+    if (studio.dragged) { studio.view.x = drag.vx + dx; studio.view.y = drag.vy + dy; draw(); }
+  });
+  window.addEventListener("mouseup", () => { drag = null; });
+  c.addEventListener("click", onClick);
+  c.addEventListener("dblclick", () => { fit(); draw(); });
+  c.addEventListener("wheel", (e) => {
+    e.preventDefault();
+    const r = c.getBoundingClientRect();
+    const sx = e.clientX - r.left, sy = e.clientY - r.top;
+    const [ix, iy] = toImage(sx, sy);
+    const factor = Math.exp(-e.deltaY * 0.0015);
+    studio.view.scale = Math.min(50, Math.max(0.05, studio.view.scale * factor));
+    studio.view.x = sx - ix * studio.view.scale; studio.view.y = sy - iy * studio.view.scale;
+    draw();
+  }, { passive: false });
+  window.addEventListener("resize", () => { fit(); draw(); });
+}
+
+// ---------------------------------------------------------------- play
+let lastFrame = 0;
+function frame(now) {
+  if (!studio.playing) return;
+  const dt = lastFrame ? (now - lastFrame) / 1000 : 0;
+  lastFrame = now;
+  const seconds = Math.min(12, Math.max(4, studio.line.total / 400));  // whole curve in 4-12 s
+  studio.pen = Math.min(1, studio.pen + dt / seconds);
+  $("scrub").value = Math.round(studio.pen * 1000);
+  draw();
+  if (studio.pen >= 1) { studio.playing = false; $("play").textContent = "▶ Play"; return; }
+  requestAnimationFrame(frame);
+}
+
+function play() {
+  if (studio.playing) { studio.playing = false; $("play").textContent = "▶ Play"; return; }
+  if (studio.pen >= 1) studio.pen = 0;
+  studio.playing = true; lastFrame = 0; $("play").textContent = "⏸ Pause";
+  requestAnimationFrame(frame);
+}
+
+// ---------------------------------------------------------------- make-it panels
+function formValues(id) {
+  const values = {};
+  for (const el of $(id).elements) {
+    if (!el.name) continue;
+    values[el.name] = el.type === "checkbox" ? el.checked : el.value;
+  }
+  return values;
+}
+function panelOptions(kind) {
+  if (kind === "embroidery") return formValues("embroidery-form");
+  if (kind === "laser") return formValues("laser-form");
+  return {};
+}
+function activeTab() { return document.querySelector("nav .tab.active").dataset.tab; }
+
+let panelTicket = 0;
+async function refreshPanel() {
+  const tab = activeTab();
+  if (tab === "refine" || !studio.state) return;
+  const ticket = ++panelTicket;
+  busy(true);
+  try {
+    const data = await call(`api/${tab}`, { edits: currentEdits(), options: panelOptions(tab) });
+    if (ticket !== panelTicket) return;
+    if (tab === "embroidery") showStitches(data); else showToolpath(data);
+  } catch (error) {
+    $(`${tab}-warnings`).innerHTML = `<li>error: ${error.message}</li>`;
+  } finally {
+    busy(false);
+  }
+}
+
+function previewCanvas(id) {
+  const c = $(id), dpr = window.devicePixelRatio || 1;
+  c.width = Math.round(c.clientWidth * dpr); c.height = Math.round(c.clientHeight * dpr);
+  const g = c.getContext("2d");
+  g.setTransform(dpr, 0, 0, dpr, 0, 0);
+  g.clearRect(0, 0, c.clientWidth, c.clientHeight);
+  return [g, c.clientWidth, c.clientHeight];
+}
+
+function showStitches(data) {
+  const [g, w, h] = previewCanvas("stitches");
+  const hw = data.hoop.width, hh = data.hoop.height;
+  const k = 0.92 * Math.min(w / hw, h / hh);
+  const X = (x) => w / 2 + x * k, Y = (y) => h / 2 + y * k;  // hoop centred on (0, 0), +y down
+  g.strokeStyle = "#bbb"; g.setLineDash([4, 4]); g.strokeRect(X(-hw / 2), Y(-hh / 2), hw * k, hh * k); g.setLineDash([]);
+  const pts = data.points, kinds = data.kinds;
+  g.lineWidth = 1.2;
+  for (let i = 1; i < pts.length; i++) {
+    if (kinds[i] === data.trim) {
+      g.strokeStyle = "#d32f2f"; const [x, y] = [X(pts[i][0]), Y(pts[i][1])];
+      g.beginPath(); g.moveTo(x - 3, y - 3); g.lineTo(x + 3, y + 3); g.moveTo(x + 3, y - 3); g.lineTo(x - 3, y + 3); g.stroke();
+      continue;
+    }
+    const jump = kinds[i] !== data.stitch || kinds[i - 1] !== data.stitch;
+    g.strokeStyle = jump ? "rgba(120,120,120,0.6)" : data.color;
+    g.setLineDash(jump ? [3, 3] : []);
+    g.beginPath(); g.moveTo(X(pts[i - 1][0]), Y(pts[i - 1][1])); g.lineTo(X(pts[i][0]), Y(pts[i][1])); g.stroke();
+  }
+  g.setLineDash([]);
+  g.fillStyle = "#333";
+  for (let i = 0; i < pts.length; i += Math.max(1, Math.floor(pts.length / 4000))) {
+    if (kinds[i] === data.stitch) g.fillRect(X(pts[i][0]) - 0.6, Y(pts[i][1]) - 0.6, 1.2, 1.2);
+  }
+  $("embroidery-stats").textContent = data.stats.join("\n");
+  $("embroidery-warnings").innerHTML = data.warnings.map((m) => `<li>${escapeHtml(m)}</li>`).join("");
+}
+
+function showToolpath(data) {
+  const [g, w, h] = previewCanvas("toolpath");
+  const [x0, y0, x1, y1] = data.bounds;
+  const m = 0.08 * Math.max(x1 - x0, y1 - y0, 1);
+  const k = Math.min(w / (x1 - x0 + 2 * m), h / (y1 - y0 + 2 * m));
+  const X = (x) => (x - x0 + m) * k, Y = (y) => h - (y - y0 + m) * k;  // machine +y up
+  let last = [0, 0];
+  const n = data.paths.length;
+  data.paths.forEach((path, i) => {
+    g.strokeStyle = "rgba(120,120,120,0.7)"; g.setLineDash([3, 3]); g.lineWidth = 1;
+    g.beginPath(); g.moveTo(X(last[0]), Y(last[1])); g.lineTo(X(path[0][0]), Y(path[0][1])); g.stroke();
+    g.setLineDash([]); g.lineWidth = 1.6; g.strokeStyle = hue(n > 1 ? i / (n - 1) : 0);
+    g.beginPath(); g.moveTo(X(path[0][0]), Y(path[0][1]));
+    for (const p of path) g.lineTo(X(p[0]), Y(p[1]));
+    g.stroke();
+    last = path[path.length - 1];
+  });
+  $("laser-time").textContent = `estimated ${data.time} (GRBL planner model; length/feed says ${data.naive}) · ` +
+    `burn ${data.burn_length} mm, travel ${data.travel_length} mm · ${data.lines} lines`;
+  $("laser-warnings").innerHTML = data.warnings.map((m) => `<li>${escapeHtml(m)}</li>`).join("");
+}
+
+function escapeHtml(text) {
+  return text.replace(/[&<>"]/g, (c) => ({ "&": "&amp;", "<": "&lt;", ">": "&gt;", '"': "&quot;" }[c]));
+}
+
+async function download(kind) {
+  busy(true);
+  try {
+    const tab = ["pes", "dst", "jef", "exp", "vp3"].includes(kind) ? "embroidery" : kind === "gcode" ? "laser" : "refine";
+    const response = await call(`api/export/${kind}`, { edits: currentEdits(), options: panelOptions(tab) }, true);
+    const blob = await response.blob();
+    const name = /filename="([^"]+)"/.exec(response.headers.get("Content-Disposition") || "")?.[1] || `drawing.${kind}`;
+    const a = document.createElement("a");
+    a.href = URL.createObjectURL(blob); a.download = name;
+    document.body.appendChild(a); a.click(); a.remove();
+    setTimeout(() => URL.revokeObjectURL(a.href), 10000);
+  } catch (error) {
+    report(error);
+  } finally {
+    busy(false);
+  }
+}
+
+// ---------------------------------------------------------------- send to laser
+let sendTimer = null;
+async function sendAction(action) {
+  try {
+    const status = action === "send"
+      ? await call("api/send", { edits: currentEdits(), options: panelOptions("laser"), port: $("port").value })
+      : await call(`api/send/${action}`, {});
+    showSend(status);
+    if (!sendTimer) sendTimer = setInterval(pollSend, 300);
+  } catch (error) {
+    $("send-status").textContent = "error: " + error.message;
+  }
+}
+async function pollSend() {
+  const status = await call("api/send");
+  showSend(status);
+  if (!["connecting", "streaming", "paused", "aborting"].includes(status.state)) { clearInterval(sendTimer); sendTimer = null; }
+}
+function showSend(s) {
+  $("send-progress").max = s.total || 1; $("send-progress").value = s.acked || 0;
+  $("send-status").textContent = `${s.state}${s.total ? ` · ${s.acked}/${s.total} lines` : ""}` +
+    `${s.machine ? ` · ${s.machine}` : ""}${s.message ? ` · ${s.message}` : ""}`;
+  $("send-status").dataset.state = s.state;
+}
+
+// ---------------------------------------------------------------- wiring
+function settingsEdit(change) {
+  const edits = JSON.parse(JSON.stringify(currentEdits()));
+  Object.assign(edits, change);
+  apply(edits);
+}
+
+function setup() {
+  setupView();
+  $("undo").onclick = undo; $("redo").onclick = redo;
+  document.addEventListener("keydown", (e) => {
+    if (!(e.ctrlKey || e.metaKey) || e.target.tagName === "INPUT") return;
+    if (e.key === "z" && !e.shiftKey) { e.preventDefault(); undo(); }
+    if (e.key === "y" || (e.key === "z" && e.shiftKey)) { e.preventDefault(); redo(); }
+  });
+  for (const radio of document.querySelectorAll("input[name=tool]")) {
+    radio.onchange = () => { studio.tool = radio.value; draw(); };
+  }
+  $("reverse-all").onclick = () => {
+    const s = studio.state; if (!s || !s.strokes.length) return;
+    const pts = s.strokes[0].points;
+    apply(withEdit({ kind: "reverse", at: pts[Math.floor(pts.length / 2)].slice(0, 2) }, false));
+  };
+  $("threshold").oninput = () => { $("threshold-value").textContent = Number($("threshold").value).toFixed(2); };
+  $("threshold").onchange = () => settingsEdit({ threshold: Number($("threshold").value) });
+  $("auto-threshold").onchange = () => settingsEdit({ threshold: $("auto-threshold").checked ? null : Number($("threshold").value) });
+  $("blur").oninput = () => { $("blur-value").textContent = $("blur").value; };
+  $("blur").onchange = () => settingsEdit({ blur: Number($("blur").value) });
+  $("multi").onchange = () => settingsEdit({ multi: $("multi").checked });
+  $("play").onclick = play;
+  $("scrub").oninput = () => { studio.playing = false; $("play").textContent = "▶ Play"; studio.pen = $("scrub").value / 1000; draw(); };
+  for (const tab of document.querySelectorAll("nav .tab")) {
+    tab.onclick = () => {
+      document.querySelectorAll("nav .tab").forEach((t) => t.classList.toggle("active", t === tab));
+      document.querySelectorAll(".panel").forEach((p) => { p.hidden = p.id !== `tab-${tab.dataset.tab}`; });
+      refreshPanel();
+    };
+  }
+  for (const form of ["embroidery-form", "laser-form"]) $(form).addEventListener("change", refreshPanel);
+  for (const button of document.querySelectorAll("[data-export]")) button.onclick = () => download(button.dataset.export);
+  $("save").onclick = async () => {
+    try { const r = await call("api/edits", { edits: currentEdits() }); $("summary").textContent += ` · saved ${r.saved}`; }
+    catch (error) { report(error); }
+  };
+  $("load").onclick = async () => {
+    try { const r = await call("api/edits"); apply(r.edits); } catch (error) { report(error); }
+  };
+  $("open").onchange = async () => {
+    const file = $("open").files[0]; if (!file) return;
+    try { apply(JSON.parse(await file.text())); } catch (error) { report(error); }
+    $("open").value = "";
+  };
+  for (const action of ["send", "pause", "resume", "abort"]) $(action).onclick = () => sendAction(action);
+  studio.image.onload = draw;
+  studio.image.src = "api/image";
+  (async () => {
+    busy(true);
+    try {
+      const state = await call("api/state");
+      studio.history = [state.edits]; studio.at = 0; updateButtons();
+      show(state);
+    } catch (error) { report(error); } finally { busy(false); }
+  })();
+}
+
+setup();

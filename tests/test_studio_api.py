@@ -1,0 +1,146 @@
+"""The studio's API through Starlette's test client: the guard (token, Host, size), the
+state and its edits, and downloads that are the CLI's bytes for the same edits and options."""
+
+from __future__ import annotations
+
+import time
+
+import pytest
+from click.testing import CliRunner
+from starlette.testclient import TestClient
+
+from fabrication.cli import main
+from fabrication.studio.app import MAX_BODY, create_app
+from fabrication.studio.session import StudioSession
+from tests.conftest import alpha_loop, render_polylines
+from vectorize.edits import PAIRINGS
+
+HOST = "127.0.0.1:8765"
+TOKEN = "test-token-123"
+
+
+@pytest.fixture(scope="module")
+def drawing(tmp_path_factory):
+    from PIL import Image
+
+    path = tmp_path_factory.mktemp("studio-api") / "loop.png"
+    Image.fromarray(render_polylines([alpha_loop()])).save(path)
+    return path
+
+
+@pytest.fixture(scope="module")
+def client(drawing):
+    session = StudioSession(drawing, edits_path=drawing.with_name("saved.edits.json"))
+    app = create_app(session, token=TOKEN, hosts={HOST})
+    with TestClient(app, base_url=f"http://{HOST}") as test_client:
+        test_client.headers["X-Studio-Token"] = TOKEN
+        yield test_client
+
+
+def test_guard_token_host_and_size(drawing):
+    app = create_app(StudioSession(drawing), token=TOKEN, hosts={HOST})
+    with TestClient(app, base_url=f"http://{HOST}") as anonymous:
+        assert anonymous.get("/api/state").status_code == 403
+        assert anonymous.get("/api/state", headers={"X-Studio-Token": "wrong"}).status_code == 403
+        assert anonymous.get("/static/app.js").status_code == 403
+        page = anonymous.get(f"/?token={TOKEN}")
+        assert page.status_code == 200 and "<canvas" in page.text
+        # The page's cookie carries the token from then on (the client keeps it).
+        assert anonymous.get("/static/app.js").status_code == 200
+        assert anonymous.get(f"/?token={TOKEN}", headers={"Host": "evil.example:8765"}).status_code == 403
+        big = b"x" * (MAX_BODY + 1)
+        assert anonymous.post("/api/state", content=big).status_code == 413
+        assert anonymous.post("/api/send", json={"port": "socket://10.0.0.1:23"}).status_code == 400
+        assert anonymous.post("/api/send", json={"port": "sim://?profile=/etc/passwd"}).status_code == 400
+
+
+def test_state_pairing_edit_changes_the_order(client):
+    state = client.get("/api/state").json()
+    assert state["report"]["strokes"] == 1 and len(state["strokes"][0]["points"]) > 50
+    junction = next(j for j in state["graph"]["junctions"] if j["role"] == "crossing")
+    assert junction["decision"] in PAIRINGS and 0.5 <= junction["confidence"] <= 1
+    other = PAIRINGS[(PAIRINGS.index(junction["decision"]) + 1) % 3]
+    edits = dict(state["edits"], edits=[{"kind": "pairing", "at": junction["at"], "pairing": other}])
+    changed = client.post("/api/state", json={"edits": edits}).json()
+    fixed = next(j for j in changed["graph"]["junctions"] if j["role"] == "crossing")
+    assert fixed["fixed"] and fixed["decision"] == other
+    assert changed["strokes"][0]["points"] != state["strokes"][0]["points"]
+    bad = client.post("/api/state", json={"edits": {"format": "nope"}})
+    assert bad.status_code == 400 and "edits" in bad.json()["error"]
+
+
+def test_save_and_load_edits(client, drawing):
+    edits = {"format": "onestroke-edits", "version": 1, "threshold": 0.45, "blur": 1.0, "multi": False,
+             "tolerance": 8, "edits": [{"kind": "reverse", "at": [200, 100]}]}
+    saved = client.post("/api/edits", json={"edits": edits}).json()
+    assert saved["saved"].endswith("saved.edits.json")
+    assert client.get("/api/edits").json()["edits"]["edits"] == edits["edits"]
+    assert drawing.with_name("saved.edits.json").read_text().startswith("{")
+
+
+def test_previews(client):
+    state = client.get("/api/state").json()
+    stitches = client.post("/api/embroidery", json={"edits": state["edits"], "options": {"size": "60mm"}}).json()
+    assert stitches["stitches"] > 50 and any(line.startswith("stitches") for line in stitches["stats"])
+    laser = client.post("/api/laser", json={"edits": state["edits"], "options": {"size": "50mm"}}).json()
+    assert laser["seconds"] > 0 and len(laser["paths"]) == 1
+    refused = client.post("/api/embroidery", json={"edits": state["edits"], "options": {"size": "-3mm"}})
+    assert refused.status_code == 400 and "--size" in refused.json()["error"]
+
+
+@pytest.mark.parametrize("kind, command, options, flags", [
+    ("svg", "vectorize", {}, []),
+    ("pes", "embroider", {"style": "zigzag", "size": "70mm", "color": "#1f3a93"},
+     ["--style", "zigzag", "--size", "70mm", "--color", "#1f3a93"]),
+    ("dst", "embroider", {"style": "triple", "size": "50mm"}, ["--style", "triple", "--size", "50mm"]),
+    ("gcode", "laser", {"size": "40mm", "feed": "1200mm/min", "power": "35%", "passes": "2"},
+     ["--size", "40mm", "--feed", "1200mm/min", "--power", "35%", "--passes", "2"]),
+])
+def test_downloads_are_the_cli_bytes(client, drawing, tmp_path, kind, command, options, flags):
+    state = client.get("/api/state").json()
+    junction = next(j for j in state["graph"]["junctions"] if j["role"] == "crossing")
+    other = PAIRINGS[(PAIRINGS.index(junction["decision"]) + 1) % 3]
+    edits = dict(state["edits"], blur=0.5, edits=[{"kind": "pairing", "at": junction["at"], "pairing": other}])
+    page = client.post(f"/api/export/{kind}", json={"edits": edits, "options": options})
+    assert page.status_code == 200, page.text
+    import json
+
+    (tmp_path / "edits.json").write_text(json.dumps(edits))
+    out = tmp_path / f"cli.{kind}"
+    run = CliRunner().invoke(main, [command, str(drawing), "--edits", str(tmp_path / "edits.json"),
+                                    "-o", str(out), *flags])
+    assert run.exit_code == 0, run.output
+    assert page.content == out.read_bytes()
+
+
+def test_send_to_the_emulator(client):
+    state = client.get("/api/state").json()
+    started = client.post("/api/send", json={"edits": state["edits"], "options": {"size": "20mm"},
+                                             "port": "sim://?speed=200"})
+    assert started.status_code == 200, started.text
+    deadline = time.monotonic() + 30
+    status = started.json()
+    while status["state"] in ("connecting", "streaming", "paused") and time.monotonic() < deadline:
+        time.sleep(0.1)
+        status = client.get("/api/send").json()
+    assert status["state"] == "done", status
+    assert status["acked"] == status["total"] > 10
+
+
+def test_send_pause_resume_abort(client):
+    state = client.get("/api/state").json()
+    started = client.post("/api/send", json={"edits": state["edits"], "options": {"size": "60mm", "passes": "3"},
+                                             "port": "sim://?speed=2"})
+    assert started.status_code == 200, started.text
+    deadline = time.monotonic() + 20
+    while client.get("/api/send").json()["state"] != "streaming" and time.monotonic() < deadline:
+        time.sleep(0.05)
+    assert client.post("/api/send/pause").json()["state"] == "paused"
+    assert client.post("/api/send", json={"edits": state["edits"], "port": "sim://"}).status_code == 400  # busy
+    assert client.post("/api/send/resume").json()["state"] == "streaming"
+    client.post("/api/send/abort")
+    status = client.get("/api/send").json()
+    while status["state"] in ("streaming", "aborting") and time.monotonic() < deadline:
+        time.sleep(0.05)
+        status = client.get("/api/send").json()
+    assert status["state"] == "aborted" and status["acked"] < status["total"], status
