@@ -8,7 +8,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.interpolate import splev, splprep
 
-from vectorize.ink_guard import InkGuard, keep_in_ink
+from vectorize.ink_guard import InkGuard, curve_excess, keep_in_ink
 from vectorize.stroke import Stroke
 
 
@@ -163,13 +163,21 @@ def fit_stroke(traced: list[TracedPoint], *, closed: bool, sigma: float, stroke_
     corner[found[keep[found] & ~split[found]]] = True
     split |= corner
     split_at = np.flatnonzero(split)
-    if closed and split_at.size:
-        # Start a closed stroke at its first sharp feature: then it is a chain of open pieces.
-        shift = int(split_at[0])
+    if closed and len(xy) > 3:
+        # Where a closed line starts cannot be read from the ink; like a pen usually does,
+        # start at its top-left sharp feature (then it is a chain of open pieces), or, when
+        # it has none, at its top.
+        if np.allclose(xy[0], xy[-1]):
+            xy, keep, split, corner = xy[:-1], keep[:-1], split[:-1], corner[:-1]
+            split_at = np.flatnonzero(split)
+        if split_at.size:
+            shift = int(split_at[np.argmin(xy[split_at].sum(axis=1))])
+        else:
+            shift = int(np.lexsort((xy[:, 0], xy[:, 1]))[0])
         xy, keep, split, corner = (np.roll(a, -shift, axis=0) for a in (xy, keep, split, corner))
         xy = np.vstack([xy, xy[:1]])
-        keep, split, corner = np.append(keep, True), np.append(split, True), np.append(corner, corner[0])
-        closed = False
+        keep, split, corner = np.append(keep, keep[0]), np.append(split, split[0]), np.append(corner, corner[0])
+        closed = not split_at.size
     # Around a corner the axis is off the centre line for about a stroke width: leave it out.
     arc = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(xy, axis=0), axis=1))])
     for i in np.flatnonzero(corner):
@@ -220,5 +228,16 @@ def fit_stroke(traced: list[TracedPoint], *, closed: bool, sigma: float, stroke_
             after[0, 1] += point - after[0, 0]
         before[-1, 3] = point
         after[0, 0] = point
+    if guard is not None:
+        # Moving the ends to the joints can swing a piece out (a corner cut across the paper):
+        # refit those between their joints on all of their traced points.
+        for k, (lo, hi) in enumerate(zip(cuts[:-1], cuts[1:])):
+            if curve_excess(guard, pieces[k])[0] <= 0.0:
+                continue
+            whole = xy[lo:hi + 1].copy()
+            if len(pieces) == 1 and closed:
+                continue  # a closed piece has no joints: it was checked when fitted
+            whole[0], whole[-1] = pieces[k][0, 0], pieces[k][-1, 3]
+            pieces[k] = keep_in_ink(whole, _open_fit(whole, sigma), guard, _open_fit, sigma)
     control = np.concatenate(pieces, axis=0)
     return Stroke(control)

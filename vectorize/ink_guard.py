@@ -69,7 +69,7 @@ class InkGuard:
         return float(self.excess(stroke.flatten(0.2)).max())
 
 
-def _curve_excess(guard: InkGuard, control: np.ndarray) -> tuple[float, np.ndarray]:
+def curve_excess(guard: InkGuard, control: np.ndarray) -> tuple[float, np.ndarray]:
     """Largest excess of a piece and where it is."""
     pts = Stroke(control).flatten(0.2)
     ex = guard.excess(pts)
@@ -86,7 +86,7 @@ def keep_in_ink(points: np.ndarray, control: np.ndarray, guard: InkGuard,
     anchored at its ends. Returns control points (K', 4, 2) whose curve lies within the
     guard's margin of the ink wherever the centre line itself does.
     """
-    worst, at = _curve_excess(guard, control)
+    worst, at = curve_excess(guard, control)
     if worst <= 0.0 or len(points) < 3:
         return control
     # The centre line itself may run outside (a bridged pen gap): then only do as well.
@@ -94,7 +94,7 @@ def keep_in_ink(points: np.ndarray, control: np.ndarray, guard: InkGuard,
     if worst <= allowed + 1e-6:
         return control
     tight = fit(points, 0.25 * sigma)
-    tight_worst, at = _curve_excess(guard, tight)
+    tight_worst, at = curve_excess(guard, tight)
     if tight_worst <= allowed + 1e-6:
         return tight
     if depth < SPLIT_DEPTH and len(points) >= 8:
