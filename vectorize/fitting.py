@@ -14,11 +14,14 @@ from vectorize.stroke import Stroke
 
 @dataclass(frozen=True)
 class TracedPoint:
-    """A point of a traversed stroke with what the filter needs to know about it."""
+    """A point of a traversed stroke with what the filter needs to know about it: keep it
+    for the fit; split the fit there; a corner (split, and the joint goes where the two
+    sides' tangents meet)."""
 
     xy: np.ndarray
     keep: bool
     split: bool
+    corner: bool = False
 
 
 def _dedupe(points: np.ndarray, min_step: float) -> np.ndarray:
@@ -119,9 +122,7 @@ def sharp_corners(xy: np.ndarray, stroke_width: float, *, closed: bool) -> np.nd
     narrow = _turn(xy, arc, 0.5 * stroke_width, closed)
     candidate = (wide > np.radians(40.0)) & (narrow > 0.6 * wide)
     corners: list[int] = []
-    for i in np.argsort(-wide):
-        if not candidate[i]:
-            break
+    for i in np.flatnonzero(candidate)[np.argsort(-wide[candidate], kind="stable")]:
         if all(abs(arc[i] - arc[j]) > 2.0 * stroke_width for j in corners):
             corners.append(int(i))
     return np.array(sorted(corners), dtype=int)
@@ -161,23 +162,20 @@ def fit_stroke(traced: list[TracedPoint], *, closed: bool, sigma: float, stroke_
     corner = np.zeros(len(xy), dtype=bool)
     found = sharp_corners(xy, stroke_width, closed=closed)
     corner[found[keep[found] & ~split[found]]] = True
+    corner |= np.array([p.corner for p in traced], dtype=bool)
     split |= corner
     split_at = np.flatnonzero(split)
-    if closed and len(xy) > 3:
-        # Where a closed line starts cannot be read from the ink; like a pen usually does,
-        # start at its top-left sharp feature (then it is a chain of open pieces), or, when
-        # it has none, at its top.
+    if closed and split_at.size and len(xy) > 3:
+        # Where a closed line starts cannot be read from the ink; start at its top-left
+        # sharp feature, as a pen usually does: then it is a chain of open pieces.
         if np.allclose(xy[0], xy[-1]):
             xy, keep, split, corner = xy[:-1], keep[:-1], split[:-1], corner[:-1]
             split_at = np.flatnonzero(split)
-        if split_at.size:
-            shift = int(split_at[np.argmin(xy[split_at].sum(axis=1))])
-        else:
-            shift = int(np.lexsort((xy[:, 0], xy[:, 1]))[0])
+        shift = int(split_at[np.argmin(xy[split_at].sum(axis=1))])
         xy, keep, split, corner = (np.roll(a, -shift, axis=0) for a in (xy, keep, split, corner))
         xy = np.vstack([xy, xy[:1]])
         keep, split, corner = np.append(keep, keep[0]), np.append(split, split[0]), np.append(corner, corner[0])
-        closed = not split_at.size
+        closed = False
     # Around a corner the axis is off the centre line for about a stroke width: leave it out.
     arc = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(xy, axis=0), axis=1))])
     for i in np.flatnonzero(corner):

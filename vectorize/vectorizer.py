@@ -133,12 +133,13 @@ def _trace(graph: MedialGraph, simple: Simplified, ordering: Ordering, junctions
         xy = np.array([t.xy for t in traced])
         for base in sharp_points:
             for i in np.flatnonzero(np.all(xy == base, axis=1)):
-                traced[i] = TracedPoint(traced[i].xy, traced[i].keep, True)
+                traced[i] = TracedPoint(traced[i].xy, traced[i].keep, True, traced[i].corner)
         for center, reach, crossing in zones:
             dist = np.linalg.norm(xy - center, axis=1)
             for i in np.flatnonzero(dist < reach):
                 at_node = dist[i] < 1e-6
-                traced[i] = TracedPoint(traced[i].xy, crossing and at_node and traced[i].keep, traced[i].split)
+                traced[i] = TracedPoint(traced[i].xy, crossing and at_node and traced[i].keep, traced[i].split,
+                                        traced[i].corner)
         result.append((traced, closed))
     return result
 
