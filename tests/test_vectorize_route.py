@@ -116,3 +116,41 @@ def test_large_matchings_are_complete():
     dist = np.linalg.norm(points[:, None] - points[None], axis=2)
     pairs, ends = match_odd(dist, np.zeros(m))
     assert sorted(sum(pairs, ()) + tuple(ends)) == list(range(m)) and len(ends) == 2
+
+
+def test_three_passes_through_one_point_go_straight_through():
+    # A closed line that crosses itself three times at one point (three lines through the
+    # centre, 60 degrees apart, joined by arcs at their ends): the paper's Fig. 12 case.
+    centre = np.array([200.0, 200.0])
+    path = []
+    for k in range(3):
+        a = np.radians(60.0 * k)
+        d = np.array([np.cos(a), np.sin(a)])
+        start, end = centre - 150 * d, centre + 150 * d
+        path.extend([start, end])
+    # Arcs between the line ends: end of line k to start of line k + 1 around the outside.
+    poly = []
+    for k in range(3):
+        a0, a1 = path[2 * k + 1], path[(2 * k + 2) % 6]
+        poly.extend(_dense([path[2 * k], a0], step=2.0))
+        ang0, ang1 = (np.arctan2(*(p - centre)[::-1]) for p in (a0, a1))
+        ang1 = ang0 + ((ang1 - ang0) % (2 * np.pi))
+        t = np.linspace(ang0, ang1, 60)
+        poly.extend(centre + 150 * np.c_[np.cos(t), np.sin(t)])
+    poly = np.array(poly)
+    result = vectorize_image(render_polylines([poly], width=WIDTH), OPTIONS)
+    assert result.report.strokes == 1
+    assert result.report.high_degree_junctions == 0
+    stroke = result.drawing.strokes[0]
+    assert _excursion(result.drawing, [poly]) <= WIDTH / 2 + 1
+    # Each pass through the centre is straight: the curve's direction at its three visits
+    # of the centre are three directions 60 degrees apart, none turning there.
+    s = np.linspace(0, stroke.length, 6000)
+    pts = stroke.points_at_lengths(s)
+    near = np.linalg.norm(pts - centre, axis=1) < 3.0
+    visits = np.split(np.flatnonzero(near), np.flatnonzero(np.diff(np.flatnonzero(near)) > 1) + 1)
+    assert len(visits) == 3
+    for v in visits:
+        before = stroke.tangents_at(stroke.parameters_at_lengths(s[v[0]] - 4 * WIDTH))
+        after = stroke.tangents_at(stroke.parameters_at_lengths(s[v[-1]] + 4 * WIDTH))
+        assert float(np.dot(before, after)) > np.cos(np.radians(15))

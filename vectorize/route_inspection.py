@@ -413,7 +413,7 @@ def _route(graph: MedialGraph, chain_list: list[Chain], stroke_width: float, dir
     return Route(tuple(passes), not ends, retraced)
 
 
-def connect_pairings(graph: MedialGraph, ranked: dict, costs: dict, *,
+def connect_pairings(graph: MedialGraph, ranked: dict, costs: dict, *, fixed: dict | None = None,
                      max_tries: int = 400) -> tuple[dict, int]:
     """Pairings for the decided junctions under which the drawing stays one piece.
 
@@ -422,12 +422,14 @@ def connect_pairings(graph: MedialGraph, ranked: dict, costs: dict, *,
     search tries assignments best-first by total cost until the graph is one piece. If none
     within `max_tries` is, junctions are left undecided, least sure first, until it is:
     there the walk may turn any way. Returns node -> pairing (undecided nodes left out) and
-    the number of assignments tried.
+    the number of assignments tried. fixed: node -> slot pairs decided elsewhere (three
+    passes through a point), part of every assignment and never changed.
     """
     nodes = sorted(ranked)
+    fixed = fixed or {}
 
     def assign(ranks: tuple[int, ...]) -> dict:
-        return {n: ranked[n][r] for n, r in zip(nodes, ranks)}
+        return {**fixed, **{n: ranked[n][r] for n, r in zip(nodes, ranks)}}
 
     start = tuple(0 for _ in nodes)
     best_key, best_ranks = (pieces(graph, assign(start)), 0.0), start
@@ -454,12 +456,14 @@ def connect_pairings(graph: MedialGraph, ranked: dict, costs: dict, *,
                     heapq.heappush(heap, (cost + delta, child, j))
     pairing = assign(best_ranks)
     count = best_key[0]
+    for n in fixed:
+        del pairing[n]
     if count > 1:
         # Least sure first: the node whose second choice costs least.
         # A pairing the user fixed (its only choice) stays, even if the line then falls apart.
         for node in sorted((n for n in nodes if len(ranked[n]) > 1), key=lambda n: (costs[n][1], n)):
             trial = {n: p for n, p in pairing.items() if n != node}
-            now = pieces(graph, trial)
+            now = pieces(graph, {**fixed, **trial})
             if now < count:
                 pairing, count = trial, now
             if count <= 1:

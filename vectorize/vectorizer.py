@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import time
+from dataclasses import replace
 from typing import NamedTuple
 
 import numpy as np
@@ -16,6 +17,7 @@ from vectorize.gaps import bridge_gaps, keep_largest_piece
 from vectorize.graph import MedialGraph
 from vectorize.ink_guard import InkGuard
 from vectorize.classifiers import make_classifier
+from vectorize.clusters import merge_triple_points, straightest_pairs
 from vectorize.intersections import Junction, JunctionVerdict, ranked_pairings
 from vectorize.medial_axis import medial_axis
 from vectorize.outline import outline_rings
@@ -112,6 +114,10 @@ def _trace(graph: MedialGraph, simple: Simplified, ordering: Ordering, junctions
         reach = max(reach, graph.spans.get(node, 0.0) + 0.5 * stroke_width)
         reach = float(np.clip(reach, graph.radii[node], 12.0 * stroke_width))
         zones.append((graph.positions[node], reach, verdicts[node].is_crossing))
+    for node in simple.through:
+        # Three passes cross: their inks overlap about as far as the cluster reached.
+        reach = float(np.clip(graph.spans.get(node, 0.0) + stroke_width, graph.radii[node], 12.0 * stroke_width))
+        zones.append((graph.positions[node], reach, True))
     result = []
     for passes, closed in zip(ordering.strokes, ordering.closed):
         traced: list[TracedPoint] = []
@@ -174,7 +180,11 @@ def _order(graph: MedialGraph, ink, options: VectorizeOptions, ends: int, clock:
         graph, simple, junctions, verdicts = cached
     else:
         hooks = refine.simplify_hooks() if refine is not None else {}
-        simple = simplify(graph, stroke_width=w, multi=options.multi, ends=ends, **hooks)
+        through = merge_triple_points(graph, stroke_width=w, may_merge=hooks.get("may_merge"))
+        simple = simplify(graph, stroke_width=w, multi=options.multi, ends=ends, through=through, **hooks)
+        # Paired after simplification: merging crossings next to a triple point renumbers its slots.
+        simple = replace(simple, through={n: straightest_pairs(directions(graph, n, 2.5 * w))[0]
+                                          for n in simple.through})
         clock.lap("simplification")
         junction_list = _junctions(graph, simple.crossings, w)
         junctions = dict(zip(simple.crossings, junction_list))
@@ -221,7 +231,7 @@ def _junction_end_cost(graph: MedialGraph, node: int, dirs: np.ndarray, w: float
 def _single_route(graph: MedialGraph, simple: Simplified, ranked: dict, costs: dict,
                   w: float) -> tuple[Ordering, int]:
     """Single-line mode: one stroke over the whole (connected) graph, retracing the least."""
-    pairing, tried = connect_pairings(graph, ranked, costs)
+    pairing, tried = connect_pairings(graph, ranked, costs, fixed=simple.through)
     dirs = {n: directions(graph, n, 2.5 * w) for n in graph.incident if graph.degree(n) >= 3}
     # The tip of a sharp corner's spur is not where a pen starts; a junction is a poorer
     # place than a free end, all else equal.
@@ -229,7 +239,7 @@ def _single_route(graph: MedialGraph, simple: Simplified, ranked: dict, costs: d
               if n not in simple.retraced}
     end_cost = {n: 3.0 * w for n in v_tips}
     end_cost.update({n: _junction_end_cost(graph, n, dirs[n], w) for n in dirs})
-    routes = plan_routes(graph, pairing, stroke_width=w, directions=dirs, end_cost=end_cost)
+    routes = plan_routes(graph, {**simple.through, **pairing}, stroke_width=w, directions=dirs, end_cost=end_cost)
     choice = tuple(pairing.get(n, ranked[n][0]) for n in simple.crossings)
     return Ordering(tuple(r.passes for r in routes), tuple(r.closed for r in routes), choice), tried
 
