@@ -162,6 +162,9 @@ def print_tables(rows: list[dict]) -> None:
     print(_fmt_header())
     for (set_name, classifier), rs in groups.items():
         print(_fmt_row({"set": set_name, "classifier": classifier, **_summary(rs)}))
+    if len({r["set"] for r in rows} & {"hershey", "hershey-retrace"}) == 2:
+        both = [r for r in rows if r["set"] in ("hershey", "hershey-retrace") and r["classifier"] == "cnn"]
+        print(_fmt_row({"set": "hershey+retr", "classifier": "cnn", **_summary(both)}))
     if len({r["set"] for r in rows} & {"plain", "hershey"}) == 2:
         main = [r for r in rows if r["set"] in ("plain", "hershey") and r["classifier"] == "cnn"]
         if main:
@@ -183,3 +186,41 @@ def print_tables(rows: list[dict]) -> None:
             v = s[key]
             cells.append(("-" if isinstance(v, float) and math.isnan(v) else fmt.format(v)).rjust(width))
         print("  ".join(cells))
+
+
+def failure_kind(row: dict) -> str:
+    """Why a drawing is not correct, first reason first: error, split into several strokes,
+    leaves the ink, misses ink, extra retrace (fair drawings: longer than the minimum), or a
+    wrong order (one stroke in the ink, but a wrong turn or a different retrace)."""
+    from benchmarks.ink_metrics import fair_length_limit
+
+    if row.get("error"):
+        return "error"
+    if row["strokes"] != 1:
+        return "split"
+    if not row["within"]:
+        return "leaves the ink"
+    if row["uncovered"] > row["cover_tolerance"]:
+        return "misses ink"
+    if row["fair"] and row["out_length"] > fair_length_limit(row["min_length"], row["width"]):
+        return "extra retrace"
+    return "wrong order"
+
+
+def print_failures(rows: list[dict]) -> None:
+    """Every drawing that is not correct, grouped by `failure_kind`."""
+    groups: dict = {}
+    for r in rows:
+        if not r.get("correct"):
+            groups.setdefault(failure_kind(r), []).append(r)
+    if not groups:
+        return
+    print()
+    print("failures by kind (set/classifier/name: strokes, order, excursion px / widths):")
+    for kind, rs in sorted(groups.items(), key=lambda kv: -len(kv[1])):
+        print(f"  {kind} ({len(rs)}):")
+        for r in rs:
+            detail = r["error"] if r.get("error") else (
+                f"{r['strokes']} strokes, order {r['order']:.3f}, excursion {r['excursion']:.1f} px "
+                f"/ {r['excursion_w']:.2f} w")
+            print(f"    {r['set']}/{r['classifier']}/{r['name']}: {detail}")

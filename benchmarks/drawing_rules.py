@@ -34,6 +34,16 @@ def _curvature_ok(stroke: Stroke, spike_segments: set[int], min_radius: float) -
     return bool(radius.min() >= min_radius)
 
 
+def _match_designed(found: np.ndarray, designed: list, extra: str, missing: str) -> None:
+    """Every found point is a designed one and every designed point is found (within 0.5 px)."""
+    for p in found:
+        if not any(np.linalg.norm(p - d) < 0.5 for d in designed):
+            raise Rejected(extra)
+    for d in designed:
+        if not any(np.linalg.norm(p - d) < 0.5 for p in found):
+            raise Rejected(missing)
+
+
 def validate(stroke: Stroke, closed: bool, width: float, designed: list, spikes: list) -> tuple[list, np.ndarray, list]:
     """Check the rules; return (events, crossing points, dont-care geometries) or raise Rejected."""
     w = width
@@ -47,22 +57,12 @@ def validate(stroke: Stroke, closed: bool, width: float, designed: list, spikes:
     if spikes and ambiguous_junctions(poly):
         raise Rejected("a spike next to a free end: which branch is retraced is ambiguous")
     inter = polyline_intersections([poly], [closed])
-    triples = [e for k, e, _ in designed if k == "triple"]
-    for m in inter.multiple:
-        if not any(np.linalg.norm(m - t) < 0.5 for t in triples):
-            raise Rejected("three passes meet")
-    for t in triples:
-        if not any(np.linalg.norm(m - t) < 0.5 for m in inter.multiple):
-            raise Rejected("designed triple point missing")
+    _match_designed(inter.multiple, [e for k, e, _ in designed if k == "triple"], "three passes meet",
+                    "designed triple point missing")
     if np.any(inter.crossing_angles < 5.0):
         raise Rejected("crossing shallower than 5 degrees")
-    designed_touch = [e for k, e, _ in designed if k == "touch"]
-    for t in inter.touches:
-        if not any(np.linalg.norm(t - d) < 0.5 for d in designed_touch):
-            raise Rejected("accidental touch")
-    for d in designed_touch:
-        if not any(np.linalg.norm(t - d) < 0.5 for t in inter.touches):
-            raise Rejected("designed touch did not come out as a touch")
+    _match_designed(inter.touches, [e for k, e, _ in designed if k == "touch"], "accidental touch",
+                    "designed touch did not come out as a touch")
     for k, e, ang in designed:
         if k in ("shallow", "transversal"):
             hit = np.linalg.norm(inter.crossings - e, axis=1) < 0.5 if len(inter.crossings) else np.array([False])

@@ -129,12 +129,15 @@ def _sharp_turns(poly: np.ndarray, closed: bool, width: float) -> list:
     return zones
 
 
-def glyph_ground_truth(glyph: Glyph, width: float, *, ambiguous: bool = False) -> GroundTruth | None:
+def glyph_ground_truth(glyph: Glyph, width: float, *, ambiguous: bool = False,
+                       close_gaps: bool = False) -> GroundTruth | None:
     """The glyph as a benchmark drawing, or None when it breaks a rule (see module doc).
 
     ambiguous=True returns instead only the glyphs left out for an ambiguous junction (any
     of several free branches could be the retraced one), scored by the fair-retrace rule:
     meta "fair" is True and meta "min_length" is the minimum traversal length (px).
+    close_gaps=True treats a glyph whose two ends lie within one width of each other as closed
+    (the ink is a closed loop: where the pen started cannot be seen).
     """
     stroke, poly, closed = glyph_stroke(glyph)
     if len(poly) < 4:
@@ -152,6 +155,8 @@ def glyph_ground_truth(glyph: Glyph, width: float, *, ambiguous: bool = False) -
     poly = poly * scale + offset
     if stroke.length < 2 * room:
         return None
+    if close_gaps and not closed and np.linalg.norm(poly[0] - poly[-1]) <= width:
+        closed = True
     if closed:
         c = np.array(stroke.control)
         c[-1, 3] = c[0, 0]
@@ -220,14 +225,15 @@ def glyph_width(glyph: Glyph, seed: int) -> float:
 
 
 def hershey_set(count: int = 40, seed: int = 0, *, touches: bool = False, ambiguous: bool = False,
-                glyphs: list[Glyph] | None = None) -> list[GroundTruth]:
+                glyphs: list[Glyph] | None = None, close_gaps: bool = False) -> list[GroundTruth]:
     """`count` glyphs across fonts, deterministic for a seed.
 
     Up to 70 % are glyphs with a crossing or a retrace (as many as pass the rules), the rest
     simple ones; fonts are visited in turn so every font contributes; no simple glyph twice. touches=True returns the glyphs that touch
     themselves instead (kind "hershey-touch"; they are not in the default set); ambiguous=True
     the glyphs left out for an ambiguous junction (kind "hershey-ambiguous", fair-retrace rule).
-    glyphs: the glyphs to pick from (default: all single-stroke Hershey glyphs).
+    glyphs: the glyphs to pick from (default: all single-stroke Hershey glyphs); close_gaps: see
+    `glyph_ground_truth`.
     """
     glyphs = load_glyphs() if glyphs is None else glyphs
     rng = np.random.default_rng(seed)
@@ -235,7 +241,7 @@ def hershey_set(count: int = 40, seed: int = 0, *, touches: bool = False, ambigu
     by_font: dict[str, dict[str, list[GroundTruth]]] = {}
     for k in order:
         g = glyphs[k]
-        gt = glyph_ground_truth(g, glyph_width(g, seed), ambiguous=ambiguous)
+        gt = glyph_ground_truth(g, glyph_width(g, seed), ambiguous=ambiguous, close_gaps=close_gaps)
         if gt is None:
             continue
         bucket = {"hershey-touch": "touch", "hershey-simple": "simple", "hershey-ambiguous": "ambiguous"}.get(

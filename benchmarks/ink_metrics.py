@@ -158,14 +158,13 @@ def min_traversal_length(graph: InkGraph) -> float:
 class InkScores:
     """excursion: px (nan without output); excursion_widths: the same over the stroke width;
     within: excursion <= half width + 1 px; uncovered: px of ground truth farthest from the
-    output; one_piece: the input ink is one connected piece; fair_ok: the fair-retrace rule
-    holds (one stroke, in the ink, covering it, no longer than the minimum traversal)."""
+    output; fair_ok: the fair-retrace rule's geometric part holds (one stroke, in the ink,
+    covering it, no longer than the minimum traversal)."""
 
     excursion: float
     excursion_widths: float
     within: bool
     uncovered: float
-    one_piece: bool
     fair_ok: bool
 
 
@@ -176,15 +175,14 @@ def fair_length_limit(min_length: float, width: float) -> float:
     return min_length * (1.0 + share) + widths * float(width)
 
 
-def ink_scores(gt, output: Drawing, image: np.ndarray, cover_tolerance: float) -> InkScores:
-    """Ink scores of `output` against a `GroundTruth` `gt`, given the image the vectorizer got
-    (for the ink pieces) and the distance within which the ground truth counts as covered."""
+def ink_scores(gt, output: Drawing, cover_tolerance: float) -> InkScores:
+    """Ink scores of `output` against a `GroundTruth` `gt`, given the distance (px) within which
+    the ground truth counts as covered."""
     width = gt.drawing.stroke_width
     exc = excursion(gt.drawing, output)
     within = bool(exc <= excursion_bound(width))
     unc = uncovered(gt.drawing, output)
-    one_piece = ink_pieces(image, width) == 1
     min_length = gt.meta.get("min_length")
     fair = bool(len(output.strokes) == 1 and within and unc <= cover_tolerance and min_length is not None
                 and output.length <= fair_length_limit(min_length, width))
-    return InkScores(exc, exc / width if np.isfinite(exc) else float("nan"), within, unc, one_piece, fair)
+    return InkScores(exc, exc / width if np.isfinite(exc) else float("nan"), within, unc, fair)

@@ -20,7 +20,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from fabrication.laser import toolpath as toolpath_module  # noqa: E402
 from fabrication.laser.gcode_write import GcodeOptions, gcode_lines, write_gcode  # noqa: E402
-from fabrication.laser.job_time import estimate_gcode_time  # noqa: E402
+from machines.job_time import estimate_job_time as estimate_gcode_time  # noqa: E402
 from fabrication.laser.toolpath import ToolpathOptions, plan_toolpath  # noqa: E402
 from fabrication.placement import PlacementOptions, place  # noqa: E402
 from machines.laser_profile import load_laser_profile  # noqa: E402

@@ -1,12 +1,11 @@
 """Benchmark: the job-time estimate against independent models, and vector vs raster time.
 
 Run from the repo root: `python benchmarks/laser_time.py`. For each job it prints
-- estimate: fabrication.laser.job_time (closed-form trapezoids, vectorized look-ahead);
+- estimate: machines.job_time, planner bound alone (the batch driver of machines.planner_model)
+  and with the serial link and parser modelled (what `onestroke laser` prints);
 - simulation: tests/laser_grbl_sim.py, written separately from GRBL's documented rules
   (literal 15-slot planner buffer, GRBL's incremental arc generator, time-stepped motion
   at 0.1 ms; shares no code with the estimator);
-- machines model: machines.gcode_program.analyze_program, the emulator/streamer helper's
-  own planner model (written by another author), when it is importable;
 - length/feed: what common senders (LaserGRBL, bCNC) show.
 Then the paper's Fig. 14 comparison: vector engraving vs raster engraving of the same
 drawing on the same machine model.
@@ -25,7 +24,7 @@ sys.path.insert(0, str(ROOT))
 sys.path.insert(0, str(ROOT / "tests"))
 
 from fabrication.laser.gcode_write import GcodeOptions, gcode_lines  # noqa: E402
-from fabrication.laser.job_time import estimate_gcode_time  # noqa: E402
+from machines.job_time import estimate_job_time as estimate_gcode_time  # noqa: E402
 from fabrication.laser.raster_time import raster_time  # noqa: E402
 from fabrication.laser.toolpath import ToolpathOptions, plan_toolpath  # noqa: E402
 from fabrication.placement import PlacementOptions  # noqa: E402
@@ -34,16 +33,6 @@ from laser_grbl_sim import simulate  # noqa: E402
 from machines.laser_profile import load_laser_profile  # noqa: E402
 
 PROFILE = load_laser_profile()
-
-
-def machines_model(lines):
-    try:
-        from machines.gcode_program import analyze_program, program_from_text
-    except ImportError:
-        return None
-    settings = {110: PROFILE.max_rate_x, 111: PROFILE.max_rate_y, 120: PROFILE.acceleration_x,
-                121: PROFILE.acceleration_y, 11: PROFILE.junction_deviation, 12: PROFILE.arc_tolerance, 32: 1}
-    return analyze_program(program_from_text("\n".join(lines)), settings=settings).total_seconds
 
 
 def straight_line(feed):
@@ -75,30 +64,29 @@ def row(label, lines):
     start = time.perf_counter()
     job = estimate_gcode_time(lines, PROFILE)
     est_seconds = time.perf_counter() - start
+    planner = job.planner_seconds
     sim = simulate(lines, max_rate=(PROFILE.max_rate_x, PROFILE.max_rate_y),
                    accel=(PROFILE.acceleration_x, PROFILE.acceleration_y),
                    junction_deviation=PROFILE.junction_deviation, arc_tolerance=PROFILE.arc_tolerance,
                    steps_per_mm=(PROFILE.steps_per_mm_x, PROFILE.steps_per_mm_y),
                    planner_blocks=PROFILE.planner_blocks)
-    other = machines_model(lines)
-    other_text = f"{other:9.3f} ({other / sim - 1:+6.2%})" if other is not None else "      n/a         "
-    print(f"{label:44s} {len(lines):6d} {job.total_seconds:9.3f} {sim:9.3f} {job.total_seconds / sim - 1:+7.2%} "
-          f"{other_text} {job.naive_seconds:9.3f} ({job.naive_seconds / sim - 1:+6.1%})  [{est_seconds * 1000:.0f} ms]")
+    print(f"{label:44s} {len(lines):6d} {planner:9.3f} {sim:9.3f} {planner / sim - 1:+7.2%} "
+          f"{job.total_seconds:9.3f} {job.bound:>7s} {job.naive_seconds:9.3f} ({job.naive_seconds / sim - 1:+6.1%})"
+          f"  [{est_seconds * 1000:.0f} ms]")
 
 
-def main() -> None:
-    print(f"{'job':44s} {'lines':>6s} {'estimate':>9s} {'simulat.':>9s} {'diff':>7s} "
-          f"{'machines model':>18s} {'len/feed':>9s} (vs sim)  [estimator run time]")
+def jobs():
+    """(label, G-code lines) of every job this benchmark times (laser_estimate_vs_emulator.py too)."""
     for feed in (1500, 6000):
-        row(f"long straight line 537 mm, F{feed}", straight_line(feed))
+        yield f"long straight line 537 mm, F{feed}", straight_line(feed)
     for feed in (1500, 3000, 6000):
-        row(f"spiral of 0.05 mm segments, F{feed}", spiral(feed))
+        yield f"spiral of 0.05 mm segments, F{feed}", spiral(feed)
     drawing, how = vectorized_drawing()
     for size, feed in ((60, 1500), (60, 3000), (20, 6000)):
         for arcs in (False, True):
             tp = plan_toolpath(drawing, PROFILE, ToolpathOptions(placement=PlacementOptions(size=size), arcs=arcs))
             lines = gcode_lines(tp, PROFILE, GcodeOptions(feed=float(feed)))
-            row(f"vectorized trefoil ({how}) {size} mm, {'arcs' if arcs else 'lines'}, F{feed}", lines)
+            yield f"vectorized trefoil ({how}) {size} mm, {'arcs' if arcs else 'lines'}, F{feed}", lines
 
     from vectorize import VectorizeOptions, vectorize_file
 
@@ -109,7 +97,15 @@ def main() -> None:
             print(f"{png.name}: not vectorized ({error})")
             continue
         tp = plan_toolpath(example, PROFILE, ToolpathOptions(placement=PlacementOptions(size=60)))
-        row(f"examples/{png.name} 60 mm, F3000", gcode_lines(tp, PROFILE, GcodeOptions(feed=3000.0)))
+        yield f"examples/{png.name} 60 mm, F3000", gcode_lines(tp, PROFILE, GcodeOptions(feed=3000.0))
+
+
+def main() -> None:
+    print(f"{'job':44s} {'lines':>6s} {'planner':>9s} {'simulat.':>9s} {'diff':>7s} "
+          f"{'with link':>9s} {'bound':>7s} {'len/feed':>9s} (vs sim)  [estimator run time]")
+    for label, lines in jobs():
+        row(label, lines)
+    drawing, _ = vectorized_drawing()
 
     print()
     print("Fig. 14 comparison (same machine model):")

@@ -5,7 +5,10 @@ OFL licence and README).
 The glyphs drawn with one move-to go through the same rules and ground truth as the
 Hershey glyphs (benchmarks/hershey.py: scaled to the canvas, seeded width 3-8 px, crossings
 and touches found on the exact curve, ambiguous or crowded glyphs left out). Size variants
-of one shape (".numr", ".dnom", ".subs", ".osf", ...) count once: the first by name.
+of one shape (".numr", ".dnom", ".subs", ".osf", ...) count once: the first by name. Many
+closed shapes (O, circle, squares, triangles, 0, 8) end a unit or two short of where they
+started: a glyph whose ends lie within one width of each other counts as closed (its ink is
+a closed loop, the start cannot be seen, so an output may start anywhere on it).
 """
 
 from __future__ import annotations
@@ -34,5 +37,5 @@ def relief_glyphs(directory: Path | str = RELIEF_DIR) -> list[Glyph]:
 def relief_set(count: int = 40, seed: int = 0) -> list[GroundTruth]:
     """`count` Relief glyphs (those with crossings first, up to 70 %), deterministic for a seed;
     kinds "relief-crossing", "relief-simple", ..."""
-    chosen = hershey_set(count, seed, glyphs=relief_glyphs())
+    chosen = hershey_set(count, seed, glyphs=relief_glyphs(), close_gaps=True)
     return [replace(gt, kind=gt.kind.replace("hershey", "relief")) for gt in chosen]

@@ -47,7 +47,7 @@ if str(ROOT) not in sys.path:
 import numpy as np  # noqa: E402
 
 from benchmarks.conditions import CONDITIONS, condition_image  # noqa: E402
-from benchmarks.bench_tables import PSNR_CAP, print_tables  # noqa: E402
+from benchmarks.bench_tables import PSNR_CAP, print_failures, print_tables  # noqa: E402
 from benchmarks.drawings import generate_set  # noqa: E402
 from benchmarks.hershey import hershey_set  # noqa: E402
 from benchmarks.ink_metrics import ink_pieces, ink_scores  # noqa: E402
@@ -170,7 +170,7 @@ def _run_one(index: int, classifier: str, oracle: bool, conn) -> None:
         row.update(seconds=seconds, peak_mb=peak, memory_method=method, strokes=scores.stroke_count,
                    ssim=scores.ssim, psnr=scores.psnr, length_ratio=scores.length_ratio,
                    gt_intersections=scores.gt_intersections, out_intersections=scores.out_intersections, matched=scores.matched,
-                   order=scores.order, order_correct=scores.correct, **_ink_row(gt, output, image, scores),
+                   order=scores.order, order_correct=scores.correct, **_ink_row(gt, output, scores),
                    warnings=" | ".join(report.warnings) if report is not None else "")
     except BaseException as exc:  # noqa: BLE001 - a failing drawing is a result, not a crash
         row["error"] = f"{type(exc).__name__}: {exc}".replace("\n", " ")[:300]
@@ -179,13 +179,15 @@ def _run_one(index: int, classifier: str, oracle: bool, conn) -> None:
     conn.close()
 
 
-def _ink_row(gt, output, image: np.ndarray, scores) -> dict:
+def _ink_row(gt, output, scores) -> dict:
     """Excursion figures and the verdict: the order score's, or for a drawing whose order cannot
     be read from the ink (meta "fair") the fair-retrace rule's (docs/benchmark.md)."""
-    ink = ink_scores(gt, output, image, order_tolerance(gt.width))
+    ink = ink_scores(gt, output, order_tolerance(gt.width))
     fair = bool(gt.meta.get("fair"))
     correct = scores.correct or (fair and ink.fair_ok and scores.undetected == 0)
-    return {"excursion": ink.excursion, "excursion_w": ink.excursion_widths, "within": ink.within, "uncovered": ink.uncovered, "fair": fair,
+    return {"excursion": ink.excursion, "excursion_w": ink.excursion_widths, "within": ink.within,
+            "uncovered": ink.uncovered, "cover_tolerance": order_tolerance(gt.width), "fair": fair,
+            "out_length": output.length, "min_length": gt.meta.get("min_length", float("nan")),
             "correct": bool(correct)}
 
 
@@ -426,6 +428,7 @@ def main(argv: list[str] | None = None) -> int:
 
     rows = run_tasks(jobs, args.ground_truth_as_output, max(1, args.jobs), args.timeout, progress)
     print_tables(rows)
+    print_failures(rows)
     errors = [r for r in rows if r.get("error")]
     if errors:
         print()
@@ -436,6 +439,7 @@ def main(argv: list[str] | None = None) -> int:
         keys = ["set", "classifier", "name", "kind", "width", "closed", "strokes", "order", "correct", "ssim",
                 "psnr", "length_ratio", "gt_intersections", "out_intersections", "matched", "seconds",
                 "peak_mb", "order_correct", "fair", "one_piece", "excursion", "excursion_w", "within", "uncovered",
+                "cover_tolerance", "out_length", "min_length",
                 "error", "warnings"]
         args.csv.parent.mkdir(parents=True, exist_ok=True)
         with open(args.csv, "w", newline="") as fh:

@@ -1,11 +1,14 @@
-"""A G-code file ready to stream: cleaned lines with their file line numbers, and what
-the job does (extent, max S, laser use, planner-model time per line).
+"""A G-code program read the way GRBL 1.1h reads it: cleaned lines with their file line
+numbers, then what the job does (moves, planner blocks, extent, max S, refused lines).
+
+`analyze_program` is the one pass every consumer shares: the pre-check (`errors`), the
+sender's job check and ETA, the time estimate (`machines.job_time`) and the preview.
 """
 
 from __future__ import annotations
 
 import os
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -13,18 +16,23 @@ import numpy as np
 from machines.gcode_interpreter import GcodeError, GcodeInterpreter, GcodeState, MachineConfig
 from machines.grbl_codes import describe_error
 from machines.grbl_protocol import MAX_LINE_CHARS, clean_line
-from machines.planner_model import BlockBuilder, Kinematics, block_durations
+from machines.planner_model import Kinematics, plan_times
 from onestroke.errors import InputError
 from onestroke.textfile import read_text
+
+SETTINGS_REFUSED = ("a '$' system command inside a job (e.g. $RST=* resets every setting, $32=0 leaves the beam "
+                    "on during travel): remove it, or pass --allow-settings if it is meant")
 
 
 @dataclass(frozen=True)
 class Program:
     """Lines to send: `lines[i]` is (file line number, 1-based; cleaned text). Blank and
-    comment-only lines are left out (they would only cost an `ok` round trip)."""
+    comment-only lines are left out (they would only cost an `ok` round trip).
+    `n_lines` counts every line of the source, blank ones included."""
 
     source: str
     lines: tuple[tuple[int, str], ...]
+    n_lines: int = 0
 
     def __len__(self) -> int:
         return len(self.lines)
@@ -33,9 +41,10 @@ class Program:
 def program_from_text(text: str, *, source: str = "<text>") -> Program:
     """Clean every line; InputError naming the first line GRBL would refuse as too long."""
     lines = []
-    for number, raw in enumerate(text.splitlines(), start=1):
+    raw_lines = text.splitlines()
+    for number, raw in enumerate(raw_lines, start=1):
         clean = clean_line(raw)
-        if not clean:
+        if not clean or clean == "%":  # '%' marks a program's start/end on tape; senders drop it
             continue
         if len(clean) > MAX_LINE_CHARS:
             raise InputError(f"{source} line {number} has {len(clean)} characters after removing spaces "
@@ -44,7 +53,12 @@ def program_from_text(text: str, *, source: str = "<text>") -> Program:
             raise InputError(f"{source} line {number} {raw.strip()[:40]!r} has non-ASCII characters; "
                              "GRBL reads plain ASCII G-code")
         lines.append((number, clean))
-    return Program(source, tuple(lines))
+    return Program(source, tuple(lines), len(raw_lines))
+
+
+def program_from_lines(lines: Sequence[str], *, source: str = "<lines>") -> Program:
+    """`program_from_text` for a list of lines (without line ends)."""
+    return program_from_text("\n".join(lines), source=source)
 
 
 def load_program(path: str | os.PathLike) -> Program:
@@ -58,6 +72,51 @@ def load_program(path: str | os.PathLike) -> Program:
 
 
 @dataclass(frozen=True)
+class GcodeMoves:
+    """Every motion command of a program as written (arcs whole), machine mm, XY.
+
+    kind (M,) int8: 0 rapid G0, 1 G1, 2 G2 (clockwise), 3 G3, 38 probe. start, end,
+    centre (M, 2) (centre NaN unless an arc). feed (M,) mm/min (NaN for G0). power (M,)
+    S. laser_on (M,) the beam can fire (M3/M4, S > 0, not G0). line (M,) 0-based index
+    of the source line.
+    """
+
+    kind: np.ndarray
+    start: np.ndarray
+    end: np.ndarray
+    centre: np.ndarray
+    feed: np.ndarray
+    power: np.ndarray
+    laser_on: np.ndarray
+    line: np.ndarray
+
+    def __len__(self) -> int:
+        return len(self.kind)
+
+
+@dataclass(frozen=True)
+class Segments:
+    """The straight moves GRBL plans (arcs cut into chords), in order.
+
+    start, end (B, 3) mm; feed (B,) mm/min (NaN for rapids); rapid (B,); stop_before (B,)
+    the planner drains before it; move (B,) index into `GcodeMoves`; index (B,) index
+    into `Program.lines`; seconds (B,) planner-model seconds (batch driver).
+    """
+
+    start: np.ndarray
+    end: np.ndarray
+    feed: np.ndarray
+    rapid: np.ndarray
+    stop_before: np.ndarray
+    move: np.ndarray
+    index: np.ndarray
+    seconds: np.ndarray
+
+    def __len__(self) -> int:
+        return len(self.rapid)
+
+
+@dataclass(frozen=True)
 class ProgramStats:
     """What a program does on a given machine.
 
@@ -65,7 +124,10 @@ class ProgramStats:
     nothing moves); burn_extent the same for moves with the beam on. max_s: largest S.
     uses_laser: M3/M4 with S > 0 somewhere. line_seconds: (len(program),) planner-model
     seconds up to the end of each program line (cumulative). errors: (file line, text)
-    for lines GRBL would refuse.
+    for lines GRBL would refuse (or `$` commands when not allowed), in file order; codes
+    the matching GRBL error codes (0 for a refused `$` command). dwell: (len(program),)
+    seconds of G4 on each line. syncs: (len(program),) the line drains the planner (its
+    `ok` waits for the machine to stop).
     """
 
     extent: tuple[tuple[float, float], tuple[float, float]] | None
@@ -74,19 +136,35 @@ class ProgramStats:
     uses_laser: bool
     line_seconds: np.ndarray
     errors: tuple[tuple[int, str], ...]
+    codes: tuple[int, ...]
+    moves: GcodeMoves
+    segments: Segments
+    dwell: np.ndarray
+    syncs: np.ndarray
 
     @property
     def total_seconds(self) -> float:
         return float(self.line_seconds[-1]) if len(self.line_seconds) else 0.0
 
 
-def analyze_program(program: Program, *, settings: dict[int, float] | None = None,
+def _box(points) -> tuple[tuple[float, float], tuple[float, float]] | None:
+    if not len(points):
+        return None
+    arr = np.asarray(points, dtype=float)
+    return (tuple(arr.min(axis=0).tolist()), tuple(arr.max(axis=0).tolist()))
+
+
+def analyze_program(program: Program, *, settings: Mapping[int, float] | None = None,
                     start: Sequence[float] = (0.0, 0.0, 0.0),
-                    offsets: dict[str, Sequence[float]] | None = None,
-                    planner_blocks: int = 15) -> ProgramStats:
-    """Interpret `program` as GRBL would with `settings` ($$), from machine position `start`
-    (mm) and work offsets from `$#` ({"G54": (x, y, z), ..., "G92": ...})."""
-    settings = settings or {}
+                    offsets: Mapping[str, Sequence[float]] | None = None,
+                    planner_blocks: int = 15, allow_settings: bool = True) -> ProgramStats:
+    """Interpret `program` as GRBL 1.1h would with `settings` ($$), from machine position
+    `start` (mm) and work offsets from `$#` ({"G54": (x, y, z), ..., "G92": ...}).
+
+    allow_settings: False reports every `$` line as an error (a job should not change
+    the machine's settings); True skips them like any sender that passes them through.
+    """
+    settings = dict(settings or {})
     kin = Kinematics.from_settings(settings, planner_blocks=planner_blocks)
     config = MachineConfig(laser_mode=bool(settings.get(32, 1)), soft_limits=False,
                            arc_tolerance=settings.get(12, 0.002))
@@ -97,57 +175,78 @@ def analyze_program(program: Program, *, settings: dict[int, float] | None = Non
     if offsets and "G92" in offsets:
         state.g92 = [float(v) for v in offsets["G92"]]
     interp = GcodeInterpreter(config, state)
-    builder = BlockBuilder(kin)
-    items: list = []
-    owner: list[int] = []
-    points: list[tuple[float, float]] = []
-    burn: list[tuple[float, float]] = []
-    max_s, uses_laser, errors = 0.0, False, []
-    rest = True
-    position = list(state.position)
+    seg_start, seg_end, seg_feed, seg_rapid, seg_stop, seg_move, seg_index = [], [], [], [], [], [], []
+    mv_kind, mv_start, mv_end, mv_centre, mv_feed, mv_power, mv_on, mv_line = [], [], [], [], [], [], [], []
+    points: list = [(float(start[0]), float(start[1]))]
+    burn: list = []
+    dwell = np.zeros(len(program))
+    syncs = np.zeros(len(program), dtype=bool)
+    max_s, uses_laser = 0.0, False
+    errors, codes = [], []
+    position = tuple(float(v) for v in state.position)
+    pending_stop = True
     for index, (number, text) in enumerate(program.lines):
         if text.startswith("$"):
+            if not allow_settings:
+                errors.append((number, f"{text}: {SETTINGS_REFUSED}"))
+                codes.append(0)
             continue
         try:
             actions = interp.execute(text)
         except GcodeError as error:
-            if len(errors) < 20:
-                errors.append((number, f"{text}: {describe_error(error.code)}"))
+            errors.append((number, f"{text}: {describe_error(error.code)}"))
+            codes.append(error.code)
             continue
+        motion = interp.motion
+        move_index = len(mv_kind)
         for action in actions:
             kind = action[0]
             if kind == "move":
                 _, target, feed, rapid, mode, s = action
-                block = builder.make(position, target, feed_mm_min=feed, rapid=rapid, from_rest=rest)
-                if block is not None:
-                    items.append(block)
-                    owner.append(index)
-                    rest = False
-                    if mode != "M5" and s > 0 and not rapid:
-                        burn += [(position[0], position[1]), (target[0], target[1])]
-                        uses_laser = True
-                position = list(target)
-                points.append((target[0], target[1]))
+                seg_start.append(position)
+                seg_end.append(target)
+                seg_feed.append(np.nan if feed is None else feed)
+                seg_rapid.append(rapid)
+                seg_stop.append(pending_stop)
+                seg_move.append(move_index)
+                seg_index.append(index)
+                pending_stop = False
+                if mode != "M5" and s > 0 and not rapid:
+                    burn += [position[:2], target[:2]]
+                    uses_laser = True
+                position = target
+                points.append(target[:2])
                 max_s = max(max_s, s)
             elif kind in ("sync", "end", "pause"):
-                items.append(None)
-                owner.append(index)
-                rest = True
+                pending_stop = True
+                syncs[index] = True
             elif kind == "dwell":
-                items.append(float(action[1]))
-                owner.append(index)
-                rest = True
+                dwell[index] += float(action[1])
+                pending_stop = True
             elif kind == "spindle":
                 max_s = max(max_s, action[2])
-    seconds = block_durations(items, window=kin.planner_blocks) if items else np.zeros(0)
-    per_line = np.bincount(np.asarray(owner, dtype=int), weights=seconds, minlength=len(program)) \
-        if items else np.zeros(len(program))
-    points_all = points + [(float(start[0]), float(start[1]))] if points else []
-
-    def box(pts):
-        if not pts:
-            return None
-        arr = np.asarray(pts)
-        return (tuple(arr.min(axis=0).tolist()), tuple(arr.max(axis=0).tolist()))
-
-    return ProgramStats(box(points_all), box(burn), max_s, uses_laser, np.cumsum(per_line), tuple(errors))
+        if motion is not None:
+            st = interp.state
+            on = st.spindle != "M5" and st.s > 0 and motion.kind != 0
+            mv_kind.append(motion.kind)
+            mv_start.append(motion.start[:2])
+            mv_end.append(motion.end[:2])
+            mv_centre.append(motion.centre[:2] if motion.centre else (np.nan, np.nan))
+            mv_feed.append(np.nan if motion.kind == 0 else st.feed)
+            mv_power.append(st.s)
+            mv_on.append(on)
+            mv_line.append(number - 1)
+    moves = GcodeMoves(np.array(mv_kind, dtype=np.int8), np.array(mv_start, dtype=float).reshape(-1, 2),
+                       np.array(mv_end, dtype=float).reshape(-1, 2), np.array(mv_centre, dtype=float).reshape(-1, 2),
+                       np.array(mv_feed, dtype=float), np.array(mv_power, dtype=float),
+                       np.array(mv_on, dtype=bool), np.array(mv_line, dtype=int))
+    starts = np.array(seg_start, dtype=float).reshape(-1, 3)
+    ends = np.array(seg_end, dtype=float).reshape(-1, 3)
+    feeds, rapids = np.array(seg_feed, dtype=float), np.array(seg_rapid, dtype=bool)
+    stops = np.array(seg_stop, dtype=bool)
+    seconds = plan_times(starts, ends, feeds, rapids, stops, kin)
+    segments = Segments(starts, ends, feeds, rapids, stops, np.array(seg_move, dtype=int),
+                        np.array(seg_index, dtype=int), seconds)
+    per_line = np.bincount(segments.index, weights=seconds, minlength=len(program)) + dwell
+    return ProgramStats(_box(points) if len(points) > 1 else None, _box(burn), max_s, uses_laser,
+                        np.cumsum(per_line), tuple(errors), tuple(codes), moves, segments, dwell, syncs)

@@ -33,19 +33,31 @@ MAX_LINE_CHARS = 79
 DEFAULT_RX_BUFFER = 128
 DEFAULT_PLANNER_BLOCKS = 15
 
-_COMMENT = re.compile(r"\([^)]*\)|;.*$")
+_PLAIN = re.compile(r"^[!-'*-.0-:<-~]*$")  # printable, no '(', ')', '/', ';': nothing to strip
 
 
 def clean_line(text: str) -> str:
-    """Strip comments, whitespace and '%' from a G-code line, as GRBL would; upper-case it.
-
-    Sending the cleaned form saves RX-buffer space and wire time.
+    """What GRBL keeps of a line (protocol.c): no spaces or control characters, no block
+    delete '/', no '(...)' or ';' comments, upper case. The one line cleaner of onestroke:
+    the sender sends this form (it saves RX-buffer space and wire time) and the emulator
+    reads received lines through it.
     """
-    text = _COMMENT.sub("", text)
-    text = "".join(ch for ch in text if ch > " ")
-    if text == "%":
-        return ""
-    return text.upper()
+    if _PLAIN.match(text):
+        return text.upper()
+    out = []
+    comment = ""
+    for ch in text:
+        if comment:
+            if comment == "(" and ch == ")":
+                comment = ""
+            continue
+        if ch <= " " or ch == "/":
+            continue
+        if ch in "(;":
+            comment = ch
+        else:
+            out.append(ch)
+    return "".join(out).upper()
 
 
 _EEPROM_WRITER = re.compile(r"^(\$\d+=|\$N\d*=|\$RST=|\$I=)|G10L[2]|G10L20|G28\.1|G30\.1")

@@ -3,7 +3,9 @@
 A profile holds what the planner, the G-code writer and the time estimate need to know
 about one machine: bed size, max S (`$30`), laser mode (`$32`), per-axis max rates and
 accelerations (`$110/$111/$120/$121`), junction deviation (`$11`), arc tolerance (`$12`),
-steps per mm (`$100/$101`), the serial RX buffer and the planner's block count. The
+steps per mm (`$100/$101`), the serial RX buffer, the planner's block count, the baud
+rate and the controller's time to parse and plan one line (`parse_time`: 2 ms for an
+ATmega328 at 16 MHz, the Arduino Uno GRBL 1.1h targets). The
 format is documented in docs/laser.md; `profiles/laser-default.toml` is the default.
 """
 
@@ -47,6 +49,8 @@ class LaserProfile:
     steps_per_mm_y: float = 80.0
     rx_buffer: int = 128
     planner_blocks: int = 15
+    baud: int = 115200
+    parse_time: float = 0.002
 
     def __post_init__(self) -> None:
         for name in ("bed_width", "bed_height", "max_power", "max_rate_x", "max_rate_y",
@@ -57,6 +61,10 @@ class LaserProfile:
                 raise InputError(f"laser profile {self.name!r}: {name} {value!r} must be a positive number")
         if not (isinstance(self.rx_buffer, int) and self.rx_buffer >= 16):
             raise InputError(f"laser profile {self.name!r}: rx_buffer {self.rx_buffer!r} must be an integer >= 16")
+        if not (isinstance(self.baud, int) and self.baud > 0):
+            raise InputError(f"laser profile {self.name!r}: baud {self.baud!r} must be a positive integer")
+        if not (isinstance(self.parse_time, (int, float)) and 0 <= self.parse_time < 1):
+            raise InputError(f"laser profile {self.name!r}: parse_time {self.parse_time!r} must be seconds in [0, 1)")
         if not (isinstance(self.planner_blocks, int) and 2 <= self.planner_blocks <= 1000):
             raise InputError(f"laser profile {self.name!r}: planner_blocks {self.planner_blocks!r} "
                              "must be an integer in 2..1000")
@@ -98,6 +106,14 @@ def _integer(value, what: str) -> int:
     return value
 
 
+def _seconds(value, what: str) -> float:
+    if isinstance(value, str) and value.strip().endswith("ms"):
+        return _number(float(value.strip()[:-2]), what) / 1000.0
+    if isinstance(value, str) and value.strip().endswith("s"):
+        value = float(value.strip()[:-1])
+    return _number(value, what)
+
+
 # key in the TOML table -> (profile field, converter)
 _FIELDS = {
     "laser": {
@@ -118,6 +134,8 @@ _FIELDS = {
     "controller": {
         "rx_buffer": ("rx_buffer", _integer),
         "planner_blocks": ("planner_blocks", _integer),
+        "baud": ("baud", _integer),
+        "parse_time": ("parse_time", _seconds),
     },
 }
 

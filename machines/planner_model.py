@@ -1,6 +1,8 @@
 """GRBL's motion planner as a time model: per-axis limits, junction deviation, look-ahead.
 
-Used by the emulator (to run moves in real time) and by senders for job-time estimates.
+The one planner core of onestroke: the emulator runs it block by block (`BlockBuilder`,
+`exit_speed`, `trapezoid`: the incremental driver) and job-time estimates run it over a
+whole program at once (`plan_times`: the batch driver, the same rules vectorized).
 Rules follow GRBL 1.1 `planner.c`: each block's nominal speed and acceleration are limited
 per axis ($110-$112 in mm/min, $120-$122 in mm/s^2); the corner speed comes from junction
 deviation ($11): v^2 = a * delta * sin(theta/2) / (1 - sin(theta/2)); entry speeds come
@@ -11,7 +13,7 @@ block runs a trapezoid (accelerate, cruise, decelerate). Units: mm, mm/s, mm/s^2
 from __future__ import annotations
 
 import math
-from collections.abc import Iterable, Sequence
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -25,14 +27,16 @@ class Kinematics:
     """Machine limits for the planner model.
 
     max_rate: (3,) mm/min for X, Y, Z ($110-$112); acceleration: (3,) mm/s^2 ($120-$122);
-    junction_deviation in mm ($11); arc_tolerance in mm ($12); planner_blocks is the
-    look-ahead depth (15 on an Uno).
+    junction_deviation in mm ($11); arc_tolerance in mm ($12); steps_per_mm: (3,)
+    ($100-$102; GRBL plans between whole steps); planner_blocks is the look-ahead depth
+    (15 on an Uno).
     """
 
     max_rate: tuple[float, float, float] = (6000.0, 6000.0, 500.0)
     acceleration: tuple[float, float, float] = (500.0, 500.0, 10.0)
     junction_deviation: float = 0.01
     arc_tolerance: float = 0.002
+    steps_per_mm: tuple[float, float, float] = (80.0, 80.0, 250.0)
     planner_blocks: int = 15
 
     @classmethod
@@ -41,7 +45,8 @@ class Kinematics:
         base = cls()
         rate = tuple(settings.get(110 + i, base.max_rate[i]) for i in range(3))
         acc = tuple(settings.get(120 + i, base.acceleration[i]) for i in range(3))
-        return cls(max_rate=rate, acceleration=acc,
+        steps = tuple(settings.get(100 + i, base.steps_per_mm[i]) for i in range(3))
+        return cls(max_rate=rate, acceleration=acc, steps_per_mm=steps,
                    junction_deviation=settings.get(11, base.junction_deviation),
                    arc_tolerance=settings.get(12, base.arc_tolerance), planner_blocks=planner_blocks)
 
@@ -84,6 +89,7 @@ class BlockBuilder:
     def __init__(self, kinematics: Kinematics):
         self.kin = kinematics
         self.max_rate_s = tuple(r / 60.0 for r in kinematics.max_rate)
+        self.steps = np.asarray(kinematics.steps_per_mm, dtype=float)
         self.previous_unit: np.ndarray | None = None
 
     def make(self, start: Sequence[float], target: Sequence[float], *, feed_mm_min: float | None,
@@ -92,9 +98,12 @@ class BlockBuilder:
 
         feed_mm_min is ignored for rapid moves; from_rest is True when the planner is empty.
         """
-        delta = np.asarray(target, dtype=float) - np.asarray(start, dtype=float)
+        # GRBL plans between whole step positions (lround), which makes tiny segments uneven
+        steps = self.steps
+        delta = (lround(np.asarray(target, dtype=float) * steps)
+                 - lround(np.asarray(start, dtype=float) * steps)) / steps
         length = float(math.sqrt(float(delta @ delta)))
-        if length < 1e-9:
+        if length == 0.0:
             return None
         unit = delta / length
         acceleration = limit_by_axis(self.kin.acceleration, unit)
@@ -195,34 +204,91 @@ def exit_speed(window: Sequence[Block], *, feed_override: float = 1.0, rapid_ove
     return math.sqrt(entry_sqr)
 
 
-Barrier = None  # an item of a block sequence meaning "planner drains here" (sync)
+def lround(values: np.ndarray) -> np.ndarray:
+    """C's lround: nearest integer, halves away from zero (numpy's rint rounds to even)."""
+    return np.sign(values) * np.floor(np.abs(values) + 0.5)
 
 
-def block_durations(items: Iterable[Block | float | None], *, window: int = 15) -> np.ndarray:
-    """Seconds each item takes when the planner is never starved ("planner-limited" time).
+def _axis_limit(limits: np.ndarray, unit: np.ndarray) -> np.ndarray:
+    """`limit_by_axis` for many unit vectors (B, D) at once -> (B,)."""
+    with np.errstate(divide="ignore"):
+        ratio = np.where(np.abs(unit) > 0, limits[None, :] / np.abs(unit), np.inf)
+    return ratio.min(axis=1)
 
-    items: Blocks, None for a forced stop (planner sync), or a float for a dwell in seconds.
-    Each block's exit speed is planned over itself and the next `window - 1` blocks (the
-    planner holds `window` blocks including the executing one). Returns shape (len(items),).
+
+def plan_times(start: np.ndarray, end: np.ndarray, feed: np.ndarray, rapid: np.ndarray,
+               stop_before: np.ndarray, kin: Kinematics) -> np.ndarray:
+    """Batch driver: seconds of each straight move when the planner is never starved.
+
+    start, end (B, D) mm with D <= 3 axes (X, Y[, Z]); feed (B,) mm/min (NaN: undefined);
+    rapid (B,) G0; stop_before (B,) the planner drains before the move (forced stop).
+    Same rules as the incremental driver (`BlockBuilder`, `exit_speed`, `trapezoid`):
+    each block may leave at most at the speed from which the next planner_blocks - 1
+    blocks can still brake to rest; it enters at the speed the previous one left with.
+    Returns (B,) seconds (0 for moves of zero steps).
     """
-    items = list(items)
-    out = np.zeros(len(items))
-    v = 0.0
-    for i, item in enumerate(items):
-        if item is None:
-            v = 0.0
-            continue
-        if not isinstance(item, Block):
-            out[i] = float(item)
-            v = 0.0
-            continue
-        look: list[Block] = [item]
-        j = i + 1
-        while j < len(items) and len(look) < window and isinstance(items[j], Block):
-            look.append(items[j])
-            j += 1
-        v_entry = min(v, math.sqrt(item.junction_sqr) if item.junction_sqr < SOME_LARGE_VALUE else v)
-        profile = trapezoid(v_entry, exit_speed(look), item.nominal(), item.acceleration, item.length)
-        out[i] = profile.duration
-        v = profile.v_exit
+    start, end = np.asarray(start, dtype=float), np.asarray(end, dtype=float)
+    dims = start.shape[1] if start.ndim == 2 else 2
+    out = np.zeros(len(start))
+    if not len(start):
+        return out
+    steps = np.asarray(kin.steps_per_mm[:dims], dtype=float)
+    s1 = lround(end * steps)
+    s0 = np.vstack([lround(start[:1] * steps), s1[:-1]])  # each block starts where the last ended
+    delta = (s1 - s0) / steps
+    length_all = np.sqrt((delta * delta).sum(axis=1))
+    keep = length_all > 0
+    if not keep.any():
+        return out
+    # a stop before a dropped block still happens before the next kept one
+    stop_cum = np.cumsum(stop_before)
+    idx = np.flatnonzero(keep)
+    prev_kept_stop = np.concatenate([[0], stop_cum[idx[:-1]]])
+    stop = (stop_cum[idx] - prev_kept_stop) > 0
+    stop[0] = True  # the planner starts empty
+    length = length_all[keep]
+    unit = delta[keep] / length[:, None]
+    accels = np.asarray(kin.acceleration[:dims], dtype=float)
+    rapid_rate = _axis_limit(np.asarray(kin.max_rate[:dims], dtype=float) / 60.0, unit)
+    accel = _axis_limit(accels, unit)
+    f = np.nan_to_num(np.asarray(feed, dtype=float)[keep], nan=0.0) / 60.0
+    nominal = np.where(np.asarray(rapid)[keep], rapid_rate,
+                       np.minimum(np.maximum(f, MINIMUM_FEED_RATE), rapid_rate))
+    # junction speeds (planner.c plan_buffer_line)
+    prev_unit = np.vstack([unit[:1], unit[:-1]])
+    cos_theta = -(prev_unit * unit).sum(axis=1)
+    junction = unit - prev_unit
+    jnorm = np.sqrt((junction * junction).sum(axis=1))
+    with np.errstate(invalid="ignore", divide="ignore"):
+        jaccel = _axis_limit(accels, np.nan_to_num(junction / jnorm[:, None]))
+        sin_half = np.sqrt(np.clip(0.5 * (1.0 - cos_theta), 0.0, 1.0))
+        vj2 = jaccel * kin.junction_deviation * sin_half / (1.0 - sin_half)
+    vj2 = np.where(cos_theta > 0.999999, 0.0, np.where(cos_theta < -0.999999, SOME_LARGE_VALUE, vj2))
+    prev_nominal = np.concatenate([[0.0], nominal[:-1]])
+    max_entry = np.minimum(vj2, np.minimum(nominal, prev_nominal) ** 2)
+    max_entry[stop] = 0.0
+    b = len(length)
+    reach = 2.0 * accel * length  # v^2 gained or lost over a block
+    window = kin.planner_blocks
+    pad_entry = np.concatenate([max_entry, np.zeros(window)])
+    pad_reach = np.concatenate([reach, np.zeros(window)])
+    j = np.arange(b)
+    # backward pass of every look-ahead window at once: block j+window-1 exits at 0
+    limit = np.zeros(b)
+    for d in range(window - 1, 0, -1):
+        k = j + d
+        limit = np.minimum(pad_entry[k], limit + pad_reach[k])
+    # forward pass e_j = min(limit_j, e_{j-1} + reach_j), e_{-1} = 0, in closed form
+    cum = np.cumsum(reach)
+    exit_sq = np.maximum(cum + np.minimum(0.0, np.minimum.accumulate(limit - cum)), 0.0)
+    exit_sq = np.minimum(exit_sq, limit)
+    entry_sq = np.concatenate([[0.0], exit_sq[:-1]])
+    entry_sq[stop] = 0.0
+    # trapezoid (or triangle) per block
+    peak_sq = np.minimum(nominal ** 2, (reach + entry_sq + exit_sq) / 2.0)
+    peak_sq = np.maximum(peak_sq, np.maximum(entry_sq, exit_sq))
+    v0, v1, vp = np.sqrt(entry_sq), np.sqrt(exit_sq), np.sqrt(peak_sq)
+    ramp = (peak_sq - entry_sq) / (2 * accel) + (peak_sq - exit_sq) / (2 * accel)
+    cruise = np.maximum(length - ramp, 0.0)
+    out[keep] = (vp - v0) / accel + (vp - v1) / accel + cruise / vp
     return out

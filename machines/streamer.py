@@ -37,12 +37,15 @@ DRAIN_LINE = "G4P0"
 
 
 class StreamError(MachineError):
-    """Streaming stopped. `last_acked_line` is the last file line GRBL acknowledged (0: none)."""
+    """Streaming stopped. `last_acked_line` is the last file line GRBL acknowledged (0: none);
+    `halt` how the machine was stopped (None when no halt was attempted)."""
 
-    def __init__(self, message: str, *, last_acked_line: int = 0, failed_line: int | None = None):
+    def __init__(self, message: str, *, last_acked_line: int = 0, failed_line: int | None = None,
+                 halt: HaltReport | None = None):
         super().__init__(message)
         self.last_acked_line = last_acked_line
         self.failed_line = failed_line
+        self.halt = halt
 
 
 class StreamInterrupted(StreamError):
@@ -52,13 +55,34 @@ class StreamInterrupted(StreamError):
 
 
 @dataclass(frozen=True, kw_only=True)
+class HaltReport:
+    """How a halt went: feed holds sent (1, or 2 when the first got no Hold), seconds from
+    the stop signal to the soft reset, and whether the controller confirmed the reset
+    with its welcome (then the beam is off: a reset stops the spindle/laser)."""
+
+    holds_sent: int
+    reset_after: float
+    confirmed: bool
+
+    def describe(self) -> str:
+        again = "feed hold sent twice (no Hold within 0.5 s), " if self.holds_sent > 1 else ""
+        if self.confirmed:
+            return f"{again}machine reset {self.reset_after:.2f} s after the stop, beam off"
+        return (f"{again}reset sent {self.reset_after:.2f} s after the stop but not confirmed - check the machine and "
+                "switch the laser off by hand")
+
+
+@dataclass(frozen=True, kw_only=True)
 class StreamOptions:
     """Timing of the sender, in seconds.
 
     connect_timeout: wait for the welcome after a soft reset. status_hz: `?` rate (GRBL
     asks for 5 Hz at most). watchdog: an Idle machine that leaves a line unanswered this
-    long trips the stall / lost-ok watchdogs. hold_timeout: wait for Hold:0 when halting.
-    send_response: send every line one at a time (slower; for comparison or odd firmware).
+    long trips the stall / lost-ok watchdogs. hold_timeout: how long a hold nobody asked
+    for may last mid-job before the sender gives up. send_response: send every line one
+    at a time (slower; for comparison or odd firmware). hold_resend: when halting, send
+    the feed hold again if no Hold was reported this long after the stop signal;
+    reset_after: soft-reset this long after the stop signal at the latest (beam off).
     """
 
     connect_timeout: float = 5.0
@@ -66,6 +90,8 @@ class StreamOptions:
     watchdog: float = 2.0
     hold_timeout: float = 10.0
     send_response: bool = False
+    hold_resend: float = 0.5
+    reset_after: float = 0.9
 
 
 @dataclass(frozen=True)
@@ -131,6 +157,7 @@ class GrblStreamer:
         self._alarm_locked = False
         self._last_query = 0.0
         self._abort = threading.Event()
+        self._abort_time = 0.0
         self._paused = False  # a hold the user asked for (pause) is not a stall
         self.rx_buffer = DEFAULT_RX_BUFFER
         self.planner_blocks = DEFAULT_PLANNER_BLOCKS
@@ -260,30 +287,27 @@ class GrblStreamer:
 
     # ------------------------------------------------------------------ connect
 
-    def connect(self) -> MachineInfo:
-        """Soft-reset, wait for the welcome, then read `$I`, `$$`, `$#` and the position."""
+    def connect(self, *, reset: bool = True) -> MachineInfo:
+        """Soft-reset, wait for the welcome, then read `$I`, `$$`, `$#` and the position.
+
+        reset: False attaches without resetting (a reset would kill a job another program
+        started): it asks for a status first and refuses a controller that is busy
+        (Run, Hold, Jog, Home, Door) - streaming into a running job would mix two jobs.
+        """
         try:
             self.port.reset_input_buffer()
         except (serial.SerialException, OSError):
             pass
         self._drain_replies()
-        self._write(SOFT_RESET)
-        welcome = self._wait_welcome(self.options.connect_timeout)
-        if welcome is None:
-            raise MachineError(
-                f"no answer from {self.name} within {self.options.connect_timeout:g} s: not a GRBL board, "
-                "wrong baud rate (--baud), or still booting; check the cable and 'onestroke ports'; "
-                "nothing was sent, no line was acknowledged")
-        # A board that reboots when the port opens may greet twice (its boot, then our
-        # reset); a reset arriving after the next command would swallow it, so wait it out.
-        while (again := self._wait_welcome(0.3)) is not None:
-            welcome = again
-        if welcome.version.startswith("0."):
-            raise MachineError(f"{self.name} runs GRBL {welcome.version}; onestroke speaks GRBL 1.1 (status "
-                               "reports and real-time commands differ): update the firmware to 1.1")
+        if reset:
+            version = self._reset_and_greet()
+        else:
+            version = self._attach()
         for reply in self._optional("$I"):  # without [OPT:...] the GRBL 1.1 sizes hold
             if isinstance(reply, Message) and reply.kind == "OPT":
                 self.planner_blocks, self.rx_buffer = parse_options(reply.text)
+            elif isinstance(reply, Message) and reply.kind == "VER" and version is None:
+                version = reply.text.split(":")[0].rsplit(".", 1)[0]
         settings = {r.number: r.value for r in self._collect("$$") if isinstance(r, Setting)}
         offsets = {}
         for reply in self._optional("$#"):
@@ -300,8 +324,40 @@ class GrblStreamer:
             wco = offsets.get("G54", (0.0, 0.0, 0.0))
             position = tuple(w + o for w, o in zip(status.wpos, wco))
         alarm = self._alarm_locked or (status is not None and status.state == "Alarm")
-        return MachineInfo(welcome.version, self.rx_buffer, self.planner_blocks, settings, offsets,
+        return MachineInfo(version or "1.1", self.rx_buffer, self.planner_blocks, settings, offsets,
                            tuple(position), alarm)
+
+    def _reset_and_greet(self) -> str:
+        """Soft reset and the welcome that answers it; returns the firmware version."""
+        self._write(SOFT_RESET)
+        welcome = self._wait_welcome(self.options.connect_timeout)
+        if welcome is None:
+            raise MachineError(
+                f"no answer from {self.name} within {self.options.connect_timeout:g} s: not a GRBL board, "
+                "wrong baud rate (--baud), or still booting; check the cable and 'onestroke ports'; "
+                "nothing was sent, no line was acknowledged")
+        # A board that reboots when the port opens may greet twice (its boot, then our
+        # reset); a reset arriving after the next command would swallow it, so wait it out.
+        while (again := self._wait_welcome(0.3)) is not None:
+            welcome = again
+        if welcome.version.startswith("0."):
+            raise MachineError(f"{self.name} runs GRBL {welcome.version}; onestroke speaks GRBL 1.1 (status "
+                               "reports and real-time commands differ): update the firmware to 1.1")
+        return welcome.version
+
+    def _attach(self) -> str | None:
+        """Attach without a reset: status first; refuse a controller that is busy."""
+        status = self.wait_status(lambda s: True, self.options.connect_timeout)
+        if status is None:
+            raise MachineError(
+                f"no status from {self.name} within {self.options.connect_timeout:g} s (attaching without a "
+                "reset): not a GRBL 1.1 board, wrong baud rate (--baud), or still booting; nothing was sent")
+        if status.state in ("Run", "Hold", "Jog", "Home", "Door"):
+            raise MachineError(
+                f"{self.name} is busy ({status.full_state}): another program's job is running; onestroke does not "
+                "stream into a running job - wait for it to end (or stop it there), then run again")
+        self._drain_replies()
+        return None
 
     def _optional(self, line: str) -> list[Reply]:
         """Replies to an informational command, or none if this firmware refuses it."""
@@ -369,6 +425,7 @@ class GrblStreamer:
 
     def abort(self) -> None:
         """Ask the running `stream` to stop safely (from another thread); it raises StreamInterrupted."""
+        self._abort_time = time.monotonic()
         self._abort.set()
 
     def feed_override(self, step: int) -> None:
@@ -381,21 +438,36 @@ class GrblStreamer:
         self._write({10: SPINDLE_OV_PLUS_10, -10: SPINDLE_OV_MINUS_10, 1: SPINDLE_OV_PLUS_1,
                      -1: SPINDLE_OV_MINUS_1, 0: SPINDLE_OV_RESET}[step])
 
-    def halt(self) -> bool:
-        """Stop safely now: `!`, wait for Hold:0 (or Idle), then soft reset and wait for the welcome.
+    def halt(self, since: float | None = None) -> HaltReport:
+        """Stop safely now: `!`; `!` again if no Hold is reported within `hold_resend`
+        seconds of `since` (the stop signal; default now); soft reset once the hold is
+        complete and in any case `reset_after` seconds after `since`; wait for the welcome.
 
-        A reset after a completed hold raises no alarm and turns the beam off. Returns True
-        if the machine confirmed the reset.
+        A reset after a completed hold raises no alarm; any reset turns the beam off.
         """
+        since = time.monotonic() if since is None else since
+        holds = 0
+
+        def left(limit: float) -> float:
+            return max(0.0, since + limit - time.monotonic())
+
         try:
             self._write(FEED_HOLD)
-            self.wait_status(lambda s: s.full_state in ("Hold:0", "Idle", "Alarm", "Check", "Sleep"),
-                             self.options.hold_timeout)
+            holds = 1
+            stopped = ("Hold:0", "Idle", "Alarm", "Check", "Sleep")
+            seen = self.wait_status(lambda s: s.state in ("Hold", *stopped), left(self.options.hold_resend))
+            if seen is None:
+                self._write(FEED_HOLD)  # the first one was lost (noise) or came too early
+                holds = 2
+            if seen is None or seen.full_state not in stopped:
+                self.wait_status(lambda s: s.full_state in stopped, left(self.options.reset_after))
             self._drain_replies()
             self._write(SOFT_RESET)
-            return self._wait_welcome(self.options.connect_timeout) is not None
+            reset_after = time.monotonic() - since
+            confirmed = self._wait_welcome(self.options.connect_timeout) is not None
         except MachineError:
-            return False
+            return HaltReport(holds_sent=holds, reset_after=time.monotonic() - since, confirmed=False)
+        return HaltReport(holds_sent=holds, reset_after=reset_after, confirmed=confirmed)
 
     # ------------------------------------------------------------------ streaming
 
@@ -442,19 +514,19 @@ class GrblStreamer:
         mode = "send-response" if self.options.send_response else "character-counting"
 
         def stop(message: str, *, failed: int | None = None, halt: bool = True,
-                 cls: type[StreamError] = StreamError) -> StreamError:
+                 cls: type[StreamError] = StreamError, since: float | None = None) -> StreamError:
+            since = time.monotonic() if since is None else since
+            report = self.halt(since) if halt else None
             self._polling = False
-            safe = self.halt() if halt else False
-            suffix = "machine halted and reset, beam off" if safe else (
-                "could not confirm the halt - check the machine" if halt else "")
+            suffix = report.describe() if report is not None else ""
             where = f"last acknowledged line {last_line}" if last_line else "no line was acknowledged"
             text = "; ".join(part for part in (message, suffix, where) if part)
-            return cls(text, last_acked_line=last_line, failed_line=failed)
+            return cls(text, last_acked_line=last_line, failed_line=failed, halt=report)
 
         try:
             while acked < len(lines):
                 if self._abort.is_set():
-                    raise stop("stopped on request", cls=StreamInterrupted)
+                    raise stop("stopped on request", cls=StreamInterrupted, since=self._abort_time)
                 # Send every line that fits in GRBL's RX buffer.
                 while sent < len(lines):
                     number, text = lines[sent]
@@ -521,7 +593,7 @@ class GrblStreamer:
             if self._alarm_locked:
                 raise stop("the machine went into ALARM at the end of the job")
         except KeyboardInterrupt:
-            raise stop("stopped by Ctrl-C", cls=StreamInterrupted) from None
+            raise stop("stopped by Ctrl-C", cls=StreamInterrupted, since=time.monotonic()) from None
         except MachineError as error:
             if isinstance(error, StreamError):
                 raise

@@ -18,6 +18,12 @@ def check_writable(path: str | os.PathLike) -> Path:
     folder = path.parent if str(path.parent) else Path(".")
     if path.is_dir():
         raise InputError(f"output {str(path)!r} is a directory; give a file name")
+    # The nearest existing ancestor tells a missing folder from a file used as a folder.
+    ancestor = folder
+    while not ancestor.exists() and ancestor != ancestor.parent:
+        ancestor = ancestor.parent
+    if ancestor.exists() and not ancestor.is_dir():
+        raise InputError(f"cannot write {str(path)!r}: {str(ancestor)!r} is a file, not a folder")
     if not folder.is_dir():
         raise InputError(f"cannot write {str(path)!r}: folder {str(folder)!r} does not exist")
     if not os.access(folder, os.W_OK):

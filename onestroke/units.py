@@ -5,6 +5,7 @@ All lengths come back in millimetres, speeds in mm/min, fractions in [0, 1].
 
 from __future__ import annotations
 
+import math
 import re
 
 from onestroke.errors import InputError
@@ -19,7 +20,7 @@ _PERCENT = re.compile(rf"^\s*{_NUMBER}\s*(%?)\s*$")
 def parse_length(text: str | float, *, default_unit: str = "mm", what: str = "length") -> float:
     """Return a length in mm from "90mm", "3.5in", "9cm", "12px" (96 px/in) or a bare number."""
     if isinstance(text, (int, float)):
-        return float(text) * MM_PER_UNIT[default_unit]
+        return _finite(float(text) * MM_PER_UNIT[default_unit], text, what)
     match = _LENGTH.match(str(text))
     if not match:
         raise InputError(f"{what} {text!r} is not a length; use e.g. '90mm', '3.5in', '9cm'")
@@ -28,7 +29,14 @@ def parse_length(text: str | float, *, default_unit: str = "mm", what: str = "le
         raise InputError(
             f"{what} {text!r} has unknown unit {unit!r}; use one of {', '.join(MM_PER_UNIT)}"
         )
-    return value * MM_PER_UNIT[unit]
+    return _finite(value * MM_PER_UNIT[unit], text, what)
+
+
+def _finite(value: float, text, what: str) -> float:
+    # "1e999" parses to inf: refuse it here so no caller meets an infinite length or speed.
+    if not math.isfinite(value):
+        raise InputError(f"{what} {text!r} is not a finite number")
+    return value
 
 
 def parse_positive_length(text: str | float, *, what: str = "length") -> float:
@@ -42,7 +50,7 @@ def parse_positive_length(text: str | float, *, what: str = "length") -> float:
 def parse_speed(text: str | float, *, what: str = "feed") -> float:
     """Return a speed in mm/min from "1500mm/min", "25mm/s", "60in/min" or a bare number (mm/min)."""
     if isinstance(text, (int, float)):
-        return float(text)
+        return _finite(float(text), text, what)
     match = _SPEED.match(str(text))
     if not match:
         raise InputError(f"{what} {text!r} is not a speed; use e.g. '1500mm/min' or '25mm/s'")
@@ -50,7 +58,7 @@ def parse_speed(text: str | float, *, what: str = "feed") -> float:
     unit, per = (match.group(2) or "mm").lower(), match.group(3) or "min"
     if unit not in MM_PER_UNIT:
         raise InputError(f"{what} {text!r} has unknown unit {unit!r}; use mm/min, mm/s, in/min")
-    return value * MM_PER_UNIT[unit] * (60.0 if per == "s" else 1.0)
+    return _finite(value * MM_PER_UNIT[unit] * (60.0 if per == "s" else 1.0), text, what)
 
 
 def parse_fraction(text: str | float, *, what: str = "power") -> float:

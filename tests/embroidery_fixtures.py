@@ -73,3 +73,54 @@ def lock_figure_ok(points: np.ndarray) -> bool:
     steps = np.linalg.norm(np.diff(points, axis=0), axis=1)
     return bool(np.allclose(points[0], points[4]) and np.allclose(points[1], points[3])
                 and steps.min() > 0)
+
+
+# -- what an embroiderer checks: piled-up holes -------------------------------------------
+PENETRATION_GAP = 0.2  # mm: a needle this close to a recent hole on its side re-pierces it
+PENETRATION_WINDOW = 4  # "the previous few" needle points
+
+
+def needle_sides(plan: StitchPlan, *, centre: float = 0.15) -> np.ndarray:
+    """Side of the curve of each row: +1 left, -1 right, 0 on the curve (within `centre`
+    mm), from the sewn stroke at the row's parameter (rows without a stroke: 0)."""
+    sides = np.zeros(len(plan.points), dtype=int)
+    sewn = plan.sewn
+    for k in np.unique(plan.strokes[plan.strokes >= 0]):
+        rows = np.flatnonzero(plan.strokes == k)
+        t = np.clip(plan.params[rows] - k, 0.0, 1.0)
+        stroke = sewn.strokes[int(k)]
+        offset = plan.points[rows] - stroke.points_at(t)
+        tangent = stroke.tangents_at(t)
+        cross = tangent[:, 0] * offset[:, 1] - tangent[:, 1] * offset[:, 0]
+        far = np.linalg.norm(offset, axis=1) > centre
+        sides[rows] = np.where(far, np.sign(cross), 0).astype(int)
+    return sides
+
+
+def repeated_penetrations(plan: StitchPlan, *, gap: float = PENETRATION_GAP,
+                          window: int = PENETRATION_WINDOW) -> int:
+    """Needle points outside tacks and locks that land within `gap` mm of one of the
+    previous `window` needle points on the same side of the curve (same run of thread)."""
+    sides = needle_sides(plan)
+    count = 0
+    for run in needle_runs(plan):
+        pts, side, role = plan.points[run], sides[run], plan.roles[run]
+        for lag in range(1, window + 1):
+            if len(run) <= lag:
+                break
+            close = np.linalg.norm(pts[lag:] - pts[:-lag], axis=1) < gap - 1e-9
+            same = side[lag:] == side[:-lag]
+            free = (role[lag:] != TACK) & (role[lag:] != LOCK)
+            count += int((close & same & free).sum())
+    return count
+
+
+def worst_density(plan: StitchPlan, radius: float = 0.5) -> int:
+    """Most needle points within `radius` mm of a needle point, both outside tacks and
+    locks (measured independently of `embroidery_stats`)."""
+    from scipy.spatial import cKDTree
+
+    needle = plan.kinds == STITCH
+    pts, roles = plan.points[needle], plan.roles[needle]
+    sewn = pts[(roles != TACK) & (roles != LOCK)]
+    return int(cKDTree(sewn).query_ball_point(sewn, radius, return_length=True).max())

@@ -91,3 +91,18 @@ def trefoil_png(path, size: int = 500, width: int = 7):
     ImageDraw.Draw(image).line([tuple(p) for p in pts.tolist()], fill=0, width=width, joint="curve")
     image.save(path)
     return path
+
+
+def grbl_refusals(lines) -> list:
+    """(file line, reason) of every line GRBL 1.1h would refuse, `$` commands included."""
+    from machines.gcode_program import analyze_program, program_from_lines
+
+    return list(analyze_program(program_from_lines(lines), allow_settings=False).errors)
+
+
+def parse_gcode(lines):
+    """Every motion command of `lines` as GRBL reads them (`machines.gcode_program.GcodeMoves`)."""
+    from machines.job_time import read_moves
+    from machines.laser_profile import load_laser_profile
+
+    return read_moves(lines, load_laser_profile())[0]

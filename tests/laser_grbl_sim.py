@@ -1,7 +1,7 @@
 """An independent simulation of GRBL 1.1's planner and stepper, for checking the estimate.
 
 Written from GRBL's documented rules (doc/markdown/settings.md, planner.c comments) by a
-different method than fabrication/laser/job_time.py and sharing no code with it: its own
+different method than machines/ (planner_model.py, job_time.py) and sharing no code with it: its own
 G-code reader, GRBL's incremental arc generator (rotation with a correction every 12
 segments), a literal 15-slot planner buffer re-planned block by block with GRBL's reverse
 and forward passes, and a time-stepped execution of each block (speed raised or lowered

@@ -309,31 +309,24 @@ def test_fair_retrace_rule_accepts_an_equal_stub_and_rejects_an_extra_retrace():
     from benchmarks.ink_metrics import ink_scores
 
     gt = _fork()
-    poly = gt.stroke.flatten(0.05)
-    base, left, right = poly[np.argmin(np.abs(poly[:, 1] - poly[:, 1].min()))], None, None
-    ends = poly[[0, -1]]
-    stem_end = ends[0]
-    tips = sorted({tuple(np.round(p, 6)) for p in poly}, key=lambda p: p[1])[:2]  # the arm tips (top, y small)
-    left, right = np.array(tips[0]), np.array(tips[1])
-    junction = poly[1]
-    del base
+    # the glyph's vertices in px: stem end, junction, left tip, junction again, right tip
+    stem_end, junction, left, _, right = np.vstack([gt.stroke.control[:, 0], gt.stroke.control[-1:, 3]])
     tol = order_tolerance(gt.width)
-    image = render(gt.drawing)
     # the same ink, the OTHER arm retraced: the order score rejects it, the fair rule accepts it
     other = Stroke.from_polyline(np.array([stem_end, junction, right, junction, left]))
     other_out = gt.drawing.with_strokes([other])
     assert order_score(gt.stroke, [other], tol) < ORDER_THRESHOLD
     assert other.length == pytest.approx(gt.stroke.length)
-    assert ink_scores(gt, other_out, image, tol).fair_ok
+    assert ink_scores(gt, other_out, tol).fair_ok
     # both arms retraced (one more than needed): rejected
     extra = Stroke.from_polyline(np.array([stem_end, junction, right, junction, left, junction]))
-    assert not ink_scores(gt, gt.drawing.with_strokes([extra]), image, tol).fair_ok
+    assert not ink_scores(gt, gt.drawing.with_strokes([extra]), tol).fair_ok
     # leaving out an arm is shorter but does not cover the ink: rejected
     short = Stroke.from_polyline(np.array([stem_end, junction, right]))
-    assert not ink_scores(gt, gt.drawing.with_strokes([short]), image, tol).fair_ok
+    assert not ink_scores(gt, gt.drawing.with_strokes([short]), tol).fair_ok
     # two strokes: rejected
     two = (Stroke.from_polyline(np.array([stem_end, junction, right])), Stroke.from_polyline(np.array([junction, left])))
-    assert not ink_scores(gt, gt.drawing.with_strokes(two), image, tol).fair_ok
+    assert not ink_scores(gt, gt.drawing.with_strokes(two), tol).fair_ok
 
 
 # -- the new sets ---------------------------------------------------------------------------------
@@ -375,3 +368,24 @@ def test_relief_glyphs_load_with_their_licence():
     gts = relief_set(6)
     assert len(gts) == 6 and all(g.kind.startswith("relief-") for g in gts)
     assert all(evaluate(g, g.drawing).correct for g in gts[:2])
+
+
+def test_new_sets_run_through_the_command_and_their_ground_truth_is_perfect(capsys):
+    from benchmarks import vectorize_bench
+    from benchmarks.bench_tables import failure_kind
+
+    for set_name in ("hershey-retrace", "triple"):
+        vectorize_bench.TASKS.clear()
+        assert vectorize_bench.main(["--ground-truth-as-output", "--set", set_name, "--count", "2",
+                                     "--classifier", "cnn"]) == 0
+        row = next(line for line in capsys.readouterr().out.splitlines() if line.startswith(set_name + " "))
+        cells = row.split()
+        assert cells[4] == "100.0"  # correct %
+        assert cells[-7] == "100.0" and cells[-2] == "100.0" and cells[-1] == "0"  # one stroke, in the ink
+    vectorize_bench.TASKS.clear()
+    base = {"error": "", "strokes": 1, "within": True, "uncovered": 1.0, "cover_tolerance": 5.0, "fair": True,
+            "out_length": 1000.0, "min_length": 900.0, "width": 5.0}
+    assert failure_kind(base) == "extra retrace"  # 1000 > 1.01 * 900 + 2 * 5
+    assert failure_kind({**base, "out_length": 915.0}) == "wrong order"
+    assert failure_kind({**base, "strokes": 2}) == "split"
+    assert failure_kind({**base, "within": False}) == "leaves the ink"

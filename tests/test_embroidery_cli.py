@@ -195,7 +195,7 @@ def test_png_end_to_end(classifier, tmp_path, monkeypatch):
     assert (plan.kinds == STITCH).sum() > 300
     assert len([k for k in plan.kinds if k != STITCH]) <= 2  # one curve: no trims in between
     with Image.open(tmp_path / "loop_preview.png") as image:
-        assert image.size == (1000, 1000)
+        assert image.size[0] == 1000  # realistic: framed to the design, not the hoop
 
 
 def test_bundled_example_png_end_to_end(tmp_path, monkeypatch):
@@ -217,4 +217,4 @@ def test_bundled_example_png_end_to_end(tmp_path, monkeypatch):
     assert (plan.kinds[first:] == STITCH).all()  # one curve: sewn without a single jump or trim
     assert (plan.kinds == STITCH).sum() > 300
     with Image.open(tmp_path / "amp.png") as image:
-        assert image.size == (1000, 1000)
+        assert image.size[0] == 1000

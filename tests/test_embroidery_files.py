@@ -17,7 +17,7 @@ import pytest
 
 from embroidery_fixtures import (FORMATS, STYLE_NAMES, design, lock_figure_ok, needle_runs,
                                  sewn_stitches, stroke_rows)
-from fabrication.embroidery.export import embroidery_bytes, plan_units, write_embroidery
+from fabrication.embroidery.export import embroidery_bytes, plan_units, write_embroidery, writer_settings
 from fabrication.embroidery.hooping import check_plan_in_hoop
 from fabrication.embroidery.needles import LOCK, TACK
 from fabrication.embroidery.plan import JUMP, STITCH, TRIM, PlanOptions, plan_embroidery, style_options
@@ -126,13 +126,15 @@ def test_our_normalization_matches_pyembroidery_encoder_bytes(ext):
     thread.set_color(*plan.color)
     thread.description = "onestroke #{:02x}{:02x}{:02x}".format(*plan.color)
     raw.add_thread(thread)
+    raw.metadata("name", plan.name)
     commands = (pyembroidery.STITCH, pyembroidery.JUMP, pyembroidery.TRIM)
     units = plan_units(plan)
     for (x, y), kind in zip(units.tolist(), plan.kinds.tolist()):
         raw.add_stitch_absolute(commands[kind], x, y)
     raw.add_stitch_absolute(pyembroidery.END, *units[-1].tolist())
     buffer = io.BytesIO()
-    getattr(pyembroidery, f"write_{ext}")(raw, buffer, dict(fmt.settings))
+    # The same settings as ours: the profile's, plus the plan's fixed JEF date.
+    getattr(pyembroidery, f"write_{ext}")(raw, buffer, writer_settings(plan, fmt))
     assert embroidery_bytes(plan, fmt) == buffer.getvalue()
 
 

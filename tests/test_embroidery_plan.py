@@ -144,19 +144,22 @@ def test_stats_count_time_thread_and_size():
     assert any(line.startswith("stitches") for line in stats.lines())
 
 
-def test_density_warning_at_six_needle_points_within_half_a_millimetre():
-    def plan_of(points):
+def test_density_warning_above_six_needle_points_within_half_a_millimetre():
+    def plan_of(points, roles=None):
         n = len(points)
         return StitchPlan(points=np.asarray(points, float), kinds=np.zeros(n, np.uint8),
-                          roles=np.full(n, BODY, np.uint8), params=np.linspace(0, 1, n),
-                          strokes=np.zeros(n, int))
-    five = [[0, 0], [0.3, 0], [0, 0.3], [0.3, 0.3], [0.2, 0.1], [5, 5]]
-    six = five[:5] + [[0.1, 0.4], [5, 5]]
-    assert embroidery_stats(plan_of(five)).max_density == 5
-    assert not embroidery_stats(plan_of(five)).too_dense
-    stats = embroidery_stats(plan_of(six))
-    assert stats.too_dense and stats.max_density == 6 and stats.dense_points == 6
+                          roles=np.full(n, BODY, np.uint8) if roles is None else np.asarray(roles, np.uint8),
+                          params=np.linspace(0, 1, n), strokes=np.zeros(n, int))
+    six = [[0, 0], [0.3, 0], [0, 0.3], [0.3, 0.3], [0.2, 0.1], [0.1, 0.4], [5, 5]]
+    seven = six[:6] + [[0.15, 0.15], [5, 5]]
+    assert embroidery_stats(plan_of(six)).max_density == 6
+    assert not embroidery_stats(plan_of(six)).too_dense
+    stats = embroidery_stats(plan_of(seven))
+    assert stats.too_dense and stats.max_density == 7 and stats.dense_points == 7
     assert "too dense" in stats.warnings[0]
+    # Tacks and locks are dense on purpose: they are left out of the count.
+    locked = embroidery_stats(plan_of(seven, [TACK, TACK, LOCK, LOCK, BODY, BODY, BODY, BODY]))
+    assert not locked.too_dense and locked.max_density == 3
     # A zigzag at 0.1 mm spacing is too dense; the default 0.4 mm on a straight line is not.
     line = Drawing((_line([0, 0], [20, 0]),), 20, 1, "mm")
     assert embroidery_stats(plan_embroidery(line, PlanOptions(style=ZigzagOptions(spacing=0.1)))).too_dense
@@ -174,14 +177,15 @@ def test_thread_colours():
 
 
 def _dots(n):
-    return tuple(_line([i * 5.0, 0.0], [i * 5.0 + 0.5, 0.0]) for i in range(n))
+    return tuple(_line([i * 5.0, 0.0], [i * 5.0 + 1.5, 0.0]) for i in range(n))
 
 
 EDGE_CASES = {
     "no strokes": (Drawing((), 10, 10, "mm"), InputError),
     "one point": (Drawing((Stroke(np.zeros((1, 4, 2))),), 1, 1, "mm"), InputError),
     "shorter than a stitch": (Drawing((_line([0, 0], [0.2, 0]),), 1, 1, "mm"), InputError),
-    "just over the minimum": (Drawing((_line([0, 0], [0.35, 0]),), 1, 1, "mm"), None),
+    "a lone speck": (Drawing((_line([0, 0], [0.35, 0]),), 1, 1, "mm"), InputError),
+    "just over the minimum stroke": (Drawing((_line([0, 0], [1.05, 0]),), 1, 1, "mm"), None),
     "closed loop": (Drawing((spiral(0, 0, 10, 10, 1.0),), 20, 20, "mm"), None),
     "300 short strokes": (Drawing(_dots(300), 1500, 1, "mm"), None),
     "pixels, not placed": (Drawing((_line([0, 0], [10, 0]),), 10, 1, "px"), InputError),
@@ -214,10 +218,10 @@ def test_embroider_pipeline_places_fits_stitches_and_measures():
     assert max(xmax - xmin, ymax - ymin) == pytest.approx(90.0, abs=1e-6)
     assert result.fit_scale == 1.0 and result.stats.stitches == int((result.plan.kinds == STITCH).sum())
     job = EmbroideryJob(placement=PlacementOptions(size=150.0), hoop=hoop_named("4x4"), fit=True,
-                        plan=PlanOptions(style=ZigzagOptions(width=8.0)), stitches_per_minute=800)
+                        plan=PlanOptions(style=ZigzagOptions(width=11.0)), stitches_per_minute=800)
     fitted = embroider(px, job)
     assert fitted.fit_scale < 0.7 and any("scaled down" in w for w in fitted.warnings)
-    assert any("lie loose" in w for w in fitted.warnings)
+    assert any("lie loose" in w and "--stitch-width" in w for w in fitted.warnings)
     check_plan_in_hoop(fitted.plan, hoop_named("4x4"))
     assert fitted.stats.stitches_per_minute == 800
     with pytest.raises(InputError, match="hoop 100x100"):

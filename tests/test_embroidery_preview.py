@@ -27,6 +27,9 @@ def plan():
     return plan_embroidery(design(), PlanOptions(style=style_options("running"), color=(200, 30, 40)))
 
 
+DIAGNOSTIC = PreviewOptions(style="diagnostic")
+
+
 def _pixel(image, canvas, point_mm):
     x, y = canvas.px(np.asarray(point_mm, float))
     return np.asarray(image)[int(round(y)), int(round(x))].astype(int)
@@ -34,7 +37,7 @@ def _pixel(image, canvas, point_mm):
 
 def test_png_preview_size_and_content(plan, tmp_path):
     path = tmp_path / "p.png"
-    render_stitch_preview(plan, path, hoop=HOOP, stats=embroidery_stats(plan))
+    render_stitch_preview(plan, path, hoop=HOOP, stats=embroidery_stats(plan), options=DIAGNOSTIC)
     with Image.open(path) as image:
         image.load()
         assert image.format == "PNG" and image.size == (1000, 1000)  # 108 x 108 mm shown
@@ -44,14 +47,14 @@ def test_png_preview_size_and_content(plan, tmp_path):
     assert (np.abs(pixels - background).sum(axis=1) > 30).mean() > 0.01
     assert len(colours) > 100
     wide = tmp_path / "wide.png"
-    render_stitch_preview(plan, wide, options=PreviewOptions(width=640, margin=2.0))
+    render_stitch_preview(plan, wide, options=PreviewOptions(width=640, margin=2.0, style="diagnostic"))
     xmin, ymin, xmax, ymax = plan.bounds()
     with Image.open(wide) as image:
         assert image.size == (640, round(640 * (ymax - ymin + 4) / (xmax - xmin + 4)))
 
 
 def test_png_preview_shows_order_jumps_trims_and_hoop(plan, tmp_path):
-    canvas = stitch_canvas(plan, hoop=HOOP, stats=None)
+    canvas = stitch_canvas(plan, hoop=HOOP, stats=None, options=DIAGNOSTIC)
     image = canvas.to_image()
     a, b = plan.stitches()
     first, last = (a[10] + b[10]) / 2, (a[-10] + b[-10]) / 2
@@ -77,7 +80,7 @@ def test_png_preview_shows_order_jumps_trims_and_hoop(plan, tmp_path):
 def test_svg_preview_is_valid_xml(plan, tmp_path):
     path = tmp_path / "p.svg"
     render_stitch_preview(plan, path, hoop=HOOP, stats=embroidery_stats(plan),
-                          options=PreviewOptions(width=800))
+                          options=PreviewOptions(width=800, style="diagnostic"))
     root = ET.parse(path).getroot()
     assert root.tag.endswith("svg") and root.get("width") == "800" and root.get("height") == "800"
     ns = "{http://www.w3.org/2000/svg}"

@@ -5,9 +5,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from fabrication.laser.gcode_read import parse_gcode, validate_gcode
+from laser_fixtures import grbl_refusals, parse_gcode
 from fabrication.laser.gcode_write import GcodeOptions, gcode_lines
-from fabrication.laser.job_time import estimate_gcode_time
+from machines.job_time import estimate_job_time as estimate_gcode_time
 from fabrication.laser.toolpath import ToolpathOptions, plan_toolpath
 from fabrication.placement import PlacementOptions
 from machines.laser_profile import load_laser_profile
@@ -49,7 +49,7 @@ def test_zero_length_stroke_among_others_is_dropped():
 def test_tiny_and_bed_sized_designs(size):
     tp = _plan(_drawing([[0, 0], [100, 40], [30, 90]]), placement=PlacementOptions(size=size))
     lines = gcode_lines(tp, PROFILE, GcodeOptions())
-    assert validate_gcode(lines) == []
+    assert grbl_refusals(lines) == []
     moves = parse_gcode(lines)
     burn = np.vstack([moves.start[moves.laser_on], moves.end[moves.laser_on]])
     assert np.ptp(burn, axis=0).max() == pytest.approx(size, abs=0.002)
@@ -61,7 +61,7 @@ def test_three_hundred_strokes():
     tp = _plan(_drawing(*polylines))
     assert len(tp.paths) == 300 and tp.travel_after < tp.travel_greedy <= tp.travel_before
     lines = gcode_lines(tp, PROFILE, GcodeOptions(passes=2))
-    assert validate_gcode(lines) == []
+    assert grbl_refusals(lines) == []
     assert estimate_gcode_time(lines, PROFILE).total_seconds > 0
 
 

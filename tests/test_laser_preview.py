@@ -8,9 +8,10 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from fabrication.laser.gcode_read import parse_gcode
+from laser_fixtures import parse_gcode
 from fabrication.laser.gcode_write import GcodeOptions, gcode_lines, write_gcode
-from fabrication.laser.job_time import estimate_gcode_time, format_duration
+from machines.job_time import estimate_job_time as estimate_gcode_time
+from machines.job_time import format_duration
 from fabrication.laser.preview import order_colours, render_gcode_preview
 from fabrication.laser.raster_time import raster_time
 from fabrication.laser.toolpath import ToolpathOptions, plan_toolpath

@@ -6,7 +6,8 @@ import numpy as np
 import pytest
 
 from fabrication.laser.gcode_write import GcodeOptions, gcode_lines
-from fabrication.laser.job_time import estimate_gcode_time, format_duration
+from machines.job_time import estimate_job_time as estimate_gcode_time
+from machines.job_time import format_duration
 from fabrication.laser.toolpath import ToolpathOptions, plan_toolpath
 from fabrication.placement import PlacementOptions
 from laser_fixtures import spiral_points, trefoil_png
@@ -99,8 +100,11 @@ def test_forced_stops_are_modelled():
     a, b = estimate_gcode_time(smooth, PROFILE), estimate_gcode_time(stopped, PROFILE)
     assert b.total_seconds > a.total_seconds + 0.05
     assert b.total_seconds == pytest.approx(_sim(stopped), rel=0.02)
-    dwell = estimate_gcode_time(smooth[:-1] + ["G4P1.5", "M5"], PROFILE)
-    assert dwell.total_seconds == pytest.approx(a.total_seconds + 1.5, abs=1e-9)
+    dwell = estimate_gcode_time(smooth[:-1] + ["G4P1.5", "M5"], PROFILE, link=False)
+    assert dwell.total_seconds == pytest.approx(a.planner_seconds + 1.5, abs=1e-9)
+    # through the link, the dwell line is parsed once the planner has drained: one parse more
+    linked = estimate_gcode_time(smooth[:-1] + ["G4P1.5", "M5"], PROFILE)
+    assert linked.total_seconds == pytest.approx(a.total_seconds + 1.5 + PROFILE.parse_time, abs=1e-3)
 
 
 @pytest.mark.parametrize("between,same_without_stop,stops", [
@@ -134,8 +138,11 @@ def test_per_line_seconds_are_cumulative():
     assert len(job.line_seconds) == len(lines)
     assert np.all(np.diff(job.line_seconds) >= 0)
     assert job.line_seconds[-1] == pytest.approx(job.total_seconds)
-    assert job.line_seconds[3] == pytest.approx(job.travel_seconds)  # the G0 comes first
-    assert job.line_seconds[2] == 0.0
+    # the G0 comes first; through the link it starts once 4 lines have been sent and parsed
+    assert job.line_seconds[3] == pytest.approx(job.travel_seconds, abs=4 * PROFILE.parse_time + 0.002)
+    planner_only = estimate_gcode_time(lines, PROFILE, link=False)
+    assert planner_only.line_seconds[3] == pytest.approx(planner_only.travel_seconds)
+    assert planner_only.line_seconds[2] == 0.0
 
 
 def test_slower_machine_takes_longer():

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 import shapely
 
-from fabrication.laser.gcode_read import parse_gcode
+from laser_fixtures import parse_gcode
 from fabrication.laser.gcode_write import GcodeOptions, gcode_lines
 from fabrication.laser.toolpath import ToolpathOptions, plan_toolpath
 from fabrication.placement import PlacementOptions

@@ -15,8 +15,8 @@ from fabrication.cli import main
 from fabrication.embroidery.plan import PlanOptions, plan_embroidery, style_options
 from fabrication.embroidery.read import read_embroidery
 from fabrication.embroidery.stats import embroidery_stats
-from fabrication.laser.gcode_read import parse_gcode, read_gcode_file
-from fabrication.laser.job_time import estimate_gcode_time
+from machines.job_time import estimate_job_time as estimate_gcode_time
+from machines.job_time import read_moves
 from fabrication.player import player_html, stitch_player_data, write_player_html
 from fabrication.player.data import COLOR, DOWN, DRAW, TRAVEL, TRIM
 from machines.laser_profile import load_laser_profile
@@ -87,6 +87,19 @@ def test_stitch_plan_from_the_pipeline(tmp_path):
     assert int((data.kinds == DRAW).sum()) == len(plan.stitches()[0])  # sewn stitches are lines
 
 
+def test_two_colour_plan_from_the_pipeline():
+    """A plan with its own colour blocks (COLOR rows): colours, changes and time as the stats say."""
+    plan = plan_embroidery(design(), PlanOptions(style=style_options("running"), colors=(RED, BLUE)))
+    stats = embroidery_stats(plan, stitches_per_minute=700, trim_seconds=12)
+    data = stitch_player_data(plan, stitches_per_minute=700, trim_seconds=12)
+    assert data.palette == ("#%02x%02x%02x" % RED, "#%02x%02x%02x" % BLUE)
+    np.testing.assert_array_equal(data.colors, plan.blocks)
+    assert int((data.kinds == COLOR).sum()) == plan.color_changes == stats.color_changes == 1
+    assert int((data.kinds == TRIM).sum()) == stats.trims
+    assert data.times[-1] == data.total == stats.seconds
+    assert data.number_total == stats.stitches
+
+
 def test_gcode_page_matches_the_estimate(tmp_path):
     out = tmp_path / "rose.html"
     result = _preview(ROSE, "-o", out)
@@ -95,13 +108,13 @@ def test_gcode_page_matches_the_estimate(tmp_path):
     assert_self_contained(html)
     data = page_data(html)
     profile = load_laser_profile()
-    lines = read_gcode_file(ROSE)
+    lines = open(ROSE, encoding="utf-8").read().splitlines()
     job = estimate_gcode_time(lines, profile)
-    moves = parse_gcode(lines, laser_mode=profile.laser_mode)
+    moves = read_moves(lines, profile)[0]
     assert data["total"] == job.total_seconds
     assert data["t"][-1] == pytest.approx(job.total_seconds, rel=1e-12)
     assert np.all(np.diff(data["t"]) >= 0) and data["yUp"]
-    assert data["numberTotal"] == moves.n_lines == len(lines)
+    assert data["numberTotal"] == len(job.line_seconds) == len(lines)
     # each move ends at its line's planner time, on its end point
     end_rows = np.r_[np.flatnonzero(np.diff(data["num"].astype(int)) != 0), len(data["num"]) - 1]
     last_move = {int(line): k for k, line in enumerate(moves.line)}
@@ -135,7 +148,7 @@ def test_refuses_to_overwrite_its_input_and_bad_inputs(tmp_path):
     assert result.exit_code == 2 and "cannot play" in result.output
     pes = tmp_path / "two.pes"
     write_pattern(pes)
-    with pytest.raises(InputError, match="is the input file"):
+    with pytest.raises(InputError, match="is the same file as the input"):
         from fabrication.player import player_data_for_file
 
         write_player_html(player_data_for_file(pes), pes.with_suffix(".html"), source=pes.with_suffix(".html"))

@@ -83,7 +83,8 @@ def test_previews(client):
     stitches = client.post("/api/embroidery", json={"edits": state["edits"], "options": {"size": "60mm"}}).json()
     assert stitches["stitches"] > 50 and any(line.startswith("stitches") for line in stitches["stats"])
     laser = client.post("/api/laser", json={"edits": state["edits"], "options": {"size": "50mm"}}).json()
-    assert laser["seconds"] > 0 and len(laser["paths"]) == 1
+    assert laser["profile"] and laser["seconds"] > 0 and laser["player"]["source"] == "gcode" and laser["player"]["n"] > 10
+    assert stitches["player"]["source"] == "embroidery" and stitches["player"]["numberTotal"] > 50
     refused = client.post("/api/embroidery", json={"edits": state["edits"], "options": {"size": "-3mm"}})
     assert refused.status_code == 400 and "--size" in refused.json()["error"]
 
@@ -93,6 +94,10 @@ def test_previews(client):
     ("pes", "embroider", {"style": "zigzag", "size": "70mm", "color": "#1f3a93"},
      ["--style", "zigzag", "--size", "70mm", "--color", "#1f3a93"]),
     ("dst", "embroider", {"style": "triple", "size": "50mm"}, ["--style", "triple", "--size", "50mm"]),
+    ("jef", "embroider", {"style": "arrows", "hoop": "130x180", "size": "120mm"},
+     ["--style", "arrows", "--hoop", "130x180", "--size", "120mm"]),
+    ("exp", "embroider", {"stitch_length": "3mm"}, ["--stitch-length", "3mm"]),
+    ("vp3", "embroider", {"color": "#c01020"}, ["--color", "#c01020"]),
     ("gcode", "laser", {"size": "40mm", "feed": "1200mm/min", "power": "35%", "passes": "2"},
      ["--size", "40mm", "--feed", "1200mm/min", "--power", "35%", "--passes", "2"]),
 ])
@@ -144,3 +149,17 @@ def test_send_pause_resume_abort(client):
         time.sleep(0.05)
         status = client.get("/api/send").json()
     assert status["state"] == "aborted" and status["acked"] < status["total"], status
+
+
+def test_an_svg_drawing_opens_and_exports(drawing, tmp_path):
+    from vectorize import vectorize_file
+    from vectorize.svg_write import write_drawing
+
+    svg = tmp_path / "loop.svg"
+    write_drawing(vectorize_file(drawing).drawing, svg)
+    app = create_app(StudioSession(svg), token=TOKEN, hosts={HOST})
+    with TestClient(app, base_url=f"http://{HOST}", headers={"X-Studio-Token": TOKEN}) as svg_client:
+        state = svg_client.get("/api/state").json()
+        assert state["report"]["strokes"] == 1 and state["graph"]["junctions"] == []
+        assert svg_client.get("/api/image").headers["content-type"].startswith("image/svg+xml")
+        assert svg_client.post("/api/export/svg", json={}).content.startswith(b"<?xml")

@@ -30,6 +30,7 @@ class StageCache:
         self.loaded = None  # ((path, max_size), (image, frame)) of the last file read
         self.front: dict = {}
         self.simplified: dict = {}
+        self.solved: dict = {}
         self._image = None
 
     def front_for(self, image, options, compute):
@@ -37,6 +38,7 @@ class StageCache:
         if self._image is not image:
             self.front.clear()
             self.simplified.clear()
+            self.solved.clear()
             self._image = image
         key = front_key(options)
         if key not in self.front:
@@ -178,7 +180,26 @@ class Refinement:
             hooks["after_merging"] = after_merging
         return hooks
 
-    # -- traversal -------------------------------------------------------------------
+    # -- traversal and fitting -------------------------------------------------------
+    def _solved_key(self) -> tuple:
+        pairings = tuple((e.at, e.pairing) for e in self.edits.of("pairing"))
+        return (self.simplify_key(-1), pairings)
+
+    def solved(self):
+        """(best solution, fitted working strokes) of an earlier run with the same edits up to
+        traversal, or None."""
+        hit = self.cache.solved.get(self._solved_key())
+        if hit is None:
+            return None
+        best, strokes, hits, fixed = hit
+        self.hits |= hits
+        self.fixed = dict(fixed)
+        return best, strokes
+
+    def keep_solved(self, best, strokes) -> None:
+        early = {self._index[id(e)] for e in self.edits.of("split", "merge", "pairing")} & self.hits
+        _bounded_put(self.cache.solved, self._solved_key(), (best, tuple(strokes), frozenset(early), dict(self.fixed)))
+
     def fix_pairings(self, junctions: dict, ranked: dict, costs: dict) -> None:
         """Pairings the user chose become the only choice at their node (in place)."""
         self.fixed = {}

@@ -29,9 +29,12 @@ class Stroke:
     Segment k runs from control[k, 0] to control[k, 3]; consecutive segments share end
     points. The global parameter t in [0, 1] maps uniformly onto the K segments. Units are
     those of the `Drawing` that holds the stroke (px before placement, mm after).
+    `color`: RGB 0-255 the stroke is drawn in (an SVG stroke colour), None when unknown;
+    it travels with the curve through reversal and transforms.
     """
 
     control: np.ndarray
+    color: tuple[int, int, int] | None = None
 
     def __post_init__(self) -> None:
         control = np.array(self.control, dtype=float)
@@ -41,6 +44,11 @@ class Stroke:
             raise InputError("stroke control points must be finite numbers")
         control.setflags(write=False)
         object.__setattr__(self, "control", control)
+        if self.color is not None:
+            color = tuple(int(c) for c in self.color)
+            if len(color) != 3 or not all(0 <= c <= 255 for c in color):
+                raise InputError(f"stroke colour {self.color!r} must be three values 0-255")
+            object.__setattr__(self, "color", color)
 
     # -- construction ------------------------------------------------------------------
     @classmethod
@@ -191,11 +199,11 @@ class Stroke:
     # -- transformations ---------------------------------------------------------------
     def reversed(self) -> "Stroke":
         """The same curve traversed from end to start."""
-        return Stroke(self.control[::-1, ::-1])
+        return Stroke(self.control[::-1, ::-1], self.color)
 
     def transformed(self, matrix: np.ndarray) -> "Stroke":
         """Apply a 2x3 affine matrix [[a, b, tx], [c, d, ty]] to every control point."""
         (a, b, tx), (c, d, ty) = np.asarray(matrix, dtype=float)
         x, y = self.control[..., 0], self.control[..., 1]
         # Written out: a batched (K*4, 2) @ (2, 2) matmul is several times slower.
-        return Stroke(np.stack([a * x + b * y + tx, c * x + d * y + ty], axis=-1))
+        return Stroke(np.stack([a * x + b * y + tx, c * x + d * y + ty], axis=-1), self.color)

@@ -89,6 +89,14 @@ def _has_paint(value) -> bool:
         and getattr(value, "opacity", 1.0) != 0
 
 
+def _rgb(paint) -> tuple[int, int, int] | None:
+    """RGB 0-255 of an svgelements paint (the stroke colour), None when it has none."""
+    try:
+        return int(paint.red), int(paint.green), int(paint.blue)
+    except (AttributeError, TypeError, ValueError):
+        return None
+
+
 def read_svg(path: str | os.PathLike) -> SvgContent:
     """Parse an SVG file into strokes and outline rings (px at 96 dpi, transforms applied)."""
     if not os.path.isfile(path):
@@ -108,10 +116,11 @@ def read_svg(path: str | os.PathLike) -> SvgContent:
         path_obj = se.Path(element)
         stroked = _has_paint(element.stroke)
         filled = _has_paint(element.fill)
+        color = _rgb(element.stroke) if stroked else None
         for control in _subpaths(path_obj):
             if stroked or not filled:
                 # Unpainted shapes are treated as strokes: a line drawing has no other use.
-                strokes.append(Stroke(control))
+                strokes.append(Stroke(control, color))
                 width = element.stroke_width
                 widths.append(float(width) if width else 1.0)
             else:

@@ -40,7 +40,9 @@ def drawing_to_svg(drawing: Drawing, *, color: str = "#000000") -> str:
         'stroke-linecap="round" stroke-linejoin="round">',
     ]
     for index, stroke in enumerate(drawing.strokes):
-        lines.append(f'<path id="stroke-{index + 1}" d="{path_data(stroke)}"/>')
+        # A stroke's own colour overrides the group's; uncoloured strokes inherit it.
+        paint = "" if stroke.color is None else ' stroke="#{:02x}{:02x}{:02x}"'.format(*stroke.color)
+        lines.append(f'<path id="stroke-{index + 1}"{paint} d="{path_data(stroke)}"/>')
     lines += ["</g>", "</svg>", ""]
     return "\n".join(lines)
 
@@ -56,6 +58,9 @@ def drawing_to_json(drawing: Drawing) -> str:
         "stroke_width": round(float(drawing.stroke_width), 6),
         "strokes": [np.round(s.control, 4).tolist() for s in drawing.strokes],
     }
+    if any(s.color is not None for s in drawing.strokes):
+        # One entry per stroke: [r, g, b] or null (written only when a stroke has a colour).
+        payload["colors"] = [None if s.color is None else list(s.color) for s in drawing.strokes]
     return json.dumps(payload, separators=(",", ":")) + "\n"
 
 
@@ -67,8 +72,12 @@ def drawing_from_json(text: str) -> Drawing:
         payload = json.loads(text)
         if payload.get("format") != "onestroke-drawing":
             raise ValueError("not an onestroke drawing")
+        colors = payload.get("colors") or [None] * len(payload["strokes"])
+        if len(colors) != len(payload["strokes"]):
+            raise ValueError(f"{len(colors)} colours for {len(payload['strokes'])} strokes")
         return Drawing(
-            strokes=tuple(Stroke(np.array(c, dtype=float)) for c in payload["strokes"]),
+            strokes=tuple(Stroke(np.array(c, dtype=float), None if rgb is None else tuple(rgb))
+                          for c, rgb in zip(payload["strokes"], colors)),
             width=float(payload["width"]),
             height=float(payload["height"]),
             unit=payload.get("unit", "px"),

@@ -310,8 +310,10 @@ def run_pipeline(image: np.ndarray, options: VectorizeOptions, *,
     # A single line has two free ends, or none when it closes: free ends beyond those are
     # spikes drawn out and back. Try the open reading first, the closed one if it fails.
     readings = (2,) if options.multi else (2, 0)
-    best = None
-    for ends in readings:
+    # A session's earlier answer for the same edits up to traversal (undo, start, reverse).
+    solved = refine.solved() if refine is not None else None
+    best = solved[0] if solved is not None else None
+    for ends in readings if solved is None else ():
         attempt = _order(graph.copy() if len(readings) > 1 or refining else graph, ink, options, ends, clock, refine)
         if best is None or len(attempt.ordering.strokes) < len(best.ordering.strokes):
             best = attempt
@@ -322,12 +324,14 @@ def run_pipeline(image: np.ndarray, options: VectorizeOptions, *,
     # Smoothing allowance: the medial axis wobbles by ~0.07 px per px of stroke width (pixel
     # grid, anti-aliasing); fitting tighter follows that wobble, looser cuts corners.
     sigma = float(np.clip(0.065 * w, 0.15, 0.8))
-    guard = InkGuard(graph, ink.gray, ink.threshold)
-    strokes = []
-    for traced, closed in _trace(graph, simple, ordering, junctions, verdicts, w):
+    guard = InkGuard(graph, ink.gray, ink.threshold) if solved is None else None
+    strokes = list(solved[1]) if solved is not None else []
+    for traced, closed in _trace(graph, simple, ordering, junctions, verdicts, w) if solved is None else ():
         if len(traced) < 2:
             continue
         strokes.append(_orient(fit_stroke(traced, closed=closed, sigma=sigma, stroke_width=w, guard=guard), closed))
+    if refine is not None and solved is None:
+        refine.keep_solved(best, strokes)
     strokes = [s for s in strokes if s.length > 0.5 * w or len(strokes) == 1]
     strokes.sort(key=lambda s: (round(float(s.start.sum()) / (4 * w)), float(s.start[0])))
     clock.lap("fitting")

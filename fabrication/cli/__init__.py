@@ -1,56 +1,133 @@
 """The `onestroke` command line: a thin click layer over the library.
 
 Each command lives in its own module (`vectorize_cmd.py`, `embroider_cmd.py`, ...) and is
-registered below. Library errors become a one-line message and an exit code:
-2 for bad input (`InputError`), 1 for any other failure; never a traceback.
+registered below; shared options live in `options.py`. Every failure becomes a one-line
+message and an exit code: 2 for bad input (`InputError`, a bad option), 1 for any other
+failure (a machine, the disk, memory), 130 for Ctrl-C; never a traceback.
 """
 
-from __future__ import annotations
+# Ctrl-C while Python imports click, numpy and the rest would print a traceback: until the
+# command runs, an interrupt just says so and exits (nothing has been written yet).
+import os
+import signal
 
-import sys
 
-import click
+def _interrupted_early(signum, frame) -> None:
+    os.write(2, b"interrupted\n")
+    os._exit(130)
 
-from onestroke.errors import OnestrokeError
+
+if signal.getsignal(signal.SIGINT) is signal.default_int_handler:  # keep SIG_IGN of background jobs
+    signal.signal(signal.SIGINT, _interrupted_early)
+
+import errno  # noqa: E402 - after the Ctrl-C handler on purpose
+import sys  # noqa: E402
+import warnings  # noqa: E402
+
+import click  # noqa: E402
+
+from onestroke.errors import OnestrokeError  # noqa: E402
+
+MAX_MESSAGE = 500  # characters: a message quoting a huge value is cut in the middle
+
+_OS_HINTS = {
+    errno.ENOSPC: "the disk is full",
+    errno.EDQUOT: "the disk quota is exceeded",
+    errno.EROFS: "the file system is read-only",
+    errno.EACCES: "permission denied",
+    errno.EPERM: "operation not permitted",
+    errno.ENOTDIR: "a part of the path is a file, not a folder",
+    errno.EISDIR: "it is a folder",
+    errno.ENOENT: "no such file or folder",
+    errno.ENAMETOOLONG: "the file name is too long",
+    errno.EIO: "input/output error",
+}
+
+
+def one_line(message: str) -> str:
+    """`message` on one line of at most MAX_MESSAGE characters."""
+    text = " ".join(str(message).split())
+    if len(text) > MAX_MESSAGE:
+        text = text[: MAX_MESSAGE - 205] + " ... " + text[-200:]
+    return text
+
+
+def describe_os_error(error: OSError) -> str:
+    """An OSError as one sentence: what failed, on which file."""
+    reason = _OS_HINTS.get(error.errno) or error.strerror or type(error).__name__
+    name = error.filename if error.filename is not None else None
+    return f"{reason}: {name!s}" if name is not None else reason
 
 
 class OnestrokeGroup(click.Group):
-    """A click group that turns onestroke errors into one-line messages and exit codes."""
+    """A click group that turns every error into a one-line message and an exit code."""
 
     def invoke(self, ctx: click.Context):
+        if signal.getsignal(signal.SIGINT) is _interrupted_early:
+            # From here on Ctrl-C raises KeyboardInterrupt, so atomic writes clean up.
+            signal.signal(signal.SIGINT, signal.default_int_handler)
+        warnings.simplefilter("ignore", RuntimeWarning)  # numpy's overflow/divide chatter
         try:
             return super().invoke(ctx)
         except OnestrokeError as error:
-            click.echo(f"error: {error}", err=True)
-            sys.exit(error.exit_code)
+            self._fail(str(error), error.exit_code)
+        except click.exceptions.UsageError as error:
+            name = error.ctx.command_path if error.ctx is not None else "onestroke"
+            self._fail(f"{error.format_message()} (see '{name} --help')", 2)
+        except (click.exceptions.Exit, click.exceptions.Abort, SystemExit):
+            raise
         except KeyboardInterrupt:
             click.echo("interrupted", err=True)
             sys.exit(130)
         except MemoryError:
-            click.echo("error: out of memory; try a smaller image", err=True)
-            sys.exit(1)
+            self._fail("out of memory; try a smaller image or design", 1)
+        except OSError as error:
+            self._fail(describe_os_error(error), 1)
+        except RecursionError:
+            self._fail("the input is nested too deeply to read", 2)
+        except Exception as error:  # noqa: BLE001 - a bug still gets one line, and a way to report it
+            self._fail(f"internal error ({type(error).__name__}: {error}); please report this with the "
+                       "command line and input", 1)
+
+    @staticmethod
+    def _fail(message: str, code: int) -> None:
+        click.echo(f"error: {one_line(message)}", err=True)
+        sys.exit(code)
 
 
-@click.group(cls=OnestrokeGroup, context_settings={"help_option_names": ["-h", "--help"]})
+# Commands by name, in the order --help lists them; a command's module is imported only when
+# that command runs (or --help lists them), so start-up pays for no other command's imports.
+COMMANDS = {
+    "vectorize": "fabrication.cli.vectorize_cmd:vectorize",
+    "embroider": "fabrication.cli.embroider_cmd:embroider",
+    "laser": "fabrication.cli.laser_cmd:laser",
+    "batch": "fabrication.cli.batch_cmd:batch",
+    "stream": "fabrication.cli.stream_cmd:stream",
+    "preview": "fabrication.cli.preview_cmd:preview",
+    "studio": "fabrication.cli.studio_cmd:studio",
+    "ports": "fabrication.cli.ports_cmd:ports",
+    "emulator": "fabrication.cli.stream_cmd:emulator",
+    "train-classifier": "fabrication.cli.train_cmd:train_classifier",
+    "validate-classifier": "fabrication.cli.train_cmd:validate_classifier",
+}
+
+
+class LazyGroup(OnestrokeGroup):
+    """Imports a command's module when the command is looked up, not at start-up."""
+
+    def list_commands(self, ctx: click.Context) -> list[str]:
+        return list(COMMANDS) + [name for name in super().list_commands(ctx) if name not in COMMANDS]
+
+    def get_command(self, ctx: click.Context, name: str):
+        if name in COMMANDS and name not in self.commands:
+            import importlib
+
+            module, attribute = COMMANDS[name].split(":")
+            self.add_command(getattr(importlib.import_module(module), attribute), name)
+        return super().get_command(ctx, name)
+
+
+@click.group(cls=LazyGroup, context_settings={"help_option_names": ["-h", "--help"]})
 @click.version_option(package_name="onestroke")
 def main() -> None:
     """Turn line drawings into embroidery files and laser G-code."""
-
-
-def _register() -> None:
-    # Each command lives in its own module; registered here in the order --help lists them.
-    from fabrication.cli.embroider_cmd import embroider
-    from fabrication.cli.laser_cmd import laser
-    from fabrication.cli.ports_cmd import ports
-    from fabrication.cli.preview_cmd import preview
-    from fabrication.cli.stream_cmd import emulator, stream
-    from fabrication.cli.studio_cmd import studio
-    from fabrication.cli.train_cmd import train_classifier, validate_classifier
-    from fabrication.cli.vectorize_cmd import vectorize
-
-    for command in (vectorize, embroider, laser, stream, preview, studio, ports, emulator, train_classifier,
-                    validate_classifier):
-        main.add_command(command)
-
-
-_register()

@@ -10,8 +10,8 @@ console = Console(stderr=True, highlight=False)
 
 
 def warn(message: str) -> None:
-    """Print a one-line warning."""
-    console.print(f"[yellow]warning:[/yellow] {message}")
+    """Print a one-line warning (soft wrap: long messages stay on one line in logs)."""
+    console.print(f"[yellow]warning:[/yellow] {message}", soft_wrap=True)
 
 
 def done(message: str) -> None:
@@ -38,6 +38,8 @@ def read_drawing(path: str, *, multi: bool = False, threshold: float | None = No
 
 def edits_option(function):
     """The `--edits FILE` option: replay the studio's corrections of the vectorization."""
-    return click.option("--edits", "edits", default=None, type=click.Path(dir_okay=False, path_type=str),
+    from fabrication.cli.options import InputFile
+
+    return click.option("--edits", "edits", default=None, type=InputFile(),
                         help="Raster input: replay the corrections saved by `onestroke studio` "
                              "(edits JSON; its threshold, blur and mode win over the flags).")(function)

@@ -7,64 +7,97 @@ import time
 
 import click
 
-from fabrication.cli.common import console, done, edits_option
-from onestroke.atomic import check_writable
+from fabrication.cli.common import console, done, edits_option, warn
+from fabrication.cli.options import (Integer, Length, Number, drawing_input_options, input_argument,
+                                     output_option, placement_options)
 from onestroke.errors import InputError
+from onestroke.paths import check_distinct
 
 
-def warn(message: str) -> None:
-    """A one-line warning (soft wrap: long messages stay on one line in logs)."""
-    console.print(f"[yellow]warning:[/yellow] {message}", soft_wrap=True)
+def source_date() -> str:
+    """JEF's date: SOURCE_DATE_EPOCH (reproducible builds) when set, else a fixed value."""
+    import datetime
+
+    from fabrication.embroidery.plan import FIXED_DATE
+
+    value = os.environ.get("SOURCE_DATE_EPOCH")
+    if value is None or not value.strip():
+        return FIXED_DATE
+    try:
+        moment = datetime.datetime.fromtimestamp(int(value), tz=datetime.timezone.utc)
+    except (ValueError, OverflowError, OSError):
+        raise InputError(f"SOURCE_DATE_EPOCH {value!r} is not a number of seconds since 1970") from None
+    return moment.strftime("%Y%m%d%H%M%S")
+
 
 @click.command()
-@click.argument("source", type=click.Path(path_type=str))
-@click.option("-o", "--output", required=True, type=click.Path(path_type=str),
-              help="Embroidery file to write: .pes, .dst, .jef, .exp or .vp3.")
-@click.option("--style", default="running", show_default=True,
-              help="Stitch style: running, triple, zigzag or arrows.")
-@click.option("--size", default=None, help="Longest side of the design, e.g. 90mm, 3.5in [default: 90mm].")
-@click.option("--width", default=None, help="Width of the design instead of --size.")
-@click.option("--height", default=None, help="Height of the design instead of --size.")
-@click.option("--rotate", type=float, default=0.0, show_default=True, help="Degrees, counter-clockwise.")
+@input_argument()
+@output_option(help="Embroidery file to write: .pes, .dst, .jef, .exp or .vp3.")
+@click.option("--style", type=click.Choice(["running", "triple", "zigzag", "arrows"]), default="running",
+              show_default=True, help="Stitch style.")
+@placement_options(default_size="90mm")
 @click.option("--hoop", default="100x100", show_default=True,
               help="Hoop: 100x100 (4x4), 130x180 (5x7), 150x250, 160x260 (6x10), 200x200, or WxH in mm.")
 @click.option("--fit", is_flag=True, help="Scale the design down to fit the hoop instead of refusing it.")
-@click.option("--stitch-length", default=None,
-              help="Running/triple stitch and the arrows' centre walk [default: 2.5mm].")
-@click.option("--tolerance", default=None, help="Largest chord-to-curve distance [default: 0.2mm].")
-@click.option("--stitch-width", "--zigzag-width", "stitch_width", default=None,
-              help="Zigzag width rail to rail [2mm] or arrow spread [2.5mm].")
-@click.option("--spacing", default=None, help="Zigzag peak-to-peak spacing [0.4mm] or arrow spacing [5mm].")
-@click.option("--pull-comp", default=None, help="Zigzag pull compensation added to the width [default: 0.2mm].")
-@click.option("--repeats", type=int, default=None, help="Triple stitch: back-and-forth passes [default: 1].")
-@click.option("--arrow-size", default=None, help="Arrows: arm length along the curve [default: 2mm].")
-@click.option("--min-stitch", default="0.3mm", show_default=True,
-              help="Shorter stitches are merged away (locks excepted).")
-@click.option("--max-stitch", default="12.1mm", show_default=True,
-              help="Longest needle-down stitch per axis (never above the format's limit).")
-@click.option("--trim-distance", default="3mm", show_default=True,
-              help="Strokes further apart are joined by lock, trim and jump.")
-@click.option("--lock", "lock_form", default="half", show_default=True, help="Lock/tack form: half or back_forth.")
-@click.option("--color", "--colour", "color", default="#000000", show_default=True,
-              help="Thread colour: #rrggbb or a name.")
-@click.option("--pes-version", type=int, default=None,
+@click.option("--stitch-length", type=Length(0.1, 12.7), default=None,
+              help="Running/triple stitch and the arrows' centre walk, 0.1-12.7 mm and at least --min-stitch "
+                   "[default: 2.5mm].")
+@click.option("--tolerance", type=Length(0.1, 5.0), default=None,
+              help="Largest chord-to-curve distance, 0.1-5 mm [default: 0.2mm].")
+@click.option("--stitch-width", "--zigzag-width", "stitch_width", type=Length(0.1, 12.0), default=None,
+              help="Zigzag width rail to rail [2mm] or arrow spread [2.5mm]; 0.1-12 mm.")
+@click.option("--spacing", type=Length(0.1, 50.0), default=None,
+              help="Zigzag peak-to-peak spacing [0.4mm] or arrow spacing [5mm]; 0.1-50 mm.")
+@click.option("--pull-comp", type=Length(0.0, 2.0), default=None,
+              help="Zigzag pull compensation added to the width, 0-2 mm [default: 0.2mm].")
+@click.option("--repeats", type=Integer(1, 5), default=None,
+              help="Triple stitch: back-and-forth passes, 1-5 [default: 1].")
+@click.option("--arrow-size", type=Length(0.1, 20.0), default=None,
+              help="Arrows: arm length along the curve, 0.1-20 mm [default: 2mm].")
+@click.option("--underlay", type=click.Choice(["center", "edge", "zigzag", "none"]), default=None,
+              help="Zigzag underlay [default: center when wider than 1.5mm].")
+@click.option("--min-stroke", type=Length(0.0, 100.0), default="1mm", show_default=True,
+              help="Shorter strokes join a neighbour within --trim-distance by travel stitches, or are "
+                   "left out with a warning; 0-100 mm.")
+@click.option("--min-stitch", type=Length(0.1, 3.0), default="0.3mm", show_default=True,
+              help="Shorter stitches are merged away (locks excepted); 0.1-3 mm.")
+@click.option("--max-stitch", type=Length(1.0, 12.7), default="12.1mm", show_default=True,
+              help="Longest needle-down stitch per axis, 1-12.7 mm (never above the format's limit).")
+@click.option("--trim-distance", type=Length(0.0, 1000.0), default="3mm", show_default=True,
+              help="Strokes further apart are joined by lock, trim and jump; 0-1000 mm.")
+@click.option("--lock", "lock_form", type=click.Choice(["half", "back_forth"]), default="half",
+              show_default=True, help="Lock/tack form.")
+@click.option("--color", "--colour", "color", default=None,
+              help="Thread colour (#rrggbb or a name), or a comma-separated list, one per stroke in "
+                   "drawing order [default: the SVG's stroke colours, else black].")
+@click.option("--thread-chart", type=click.Choice(["brother", "janome", "husqvarna", "viking", "janome-sew"]),
+              default=None, help="Pick the nearest thread of one of pyembroidery's catalogues and print its number.")
+@click.option("--name", "design_name", default=None,
+              help="Design name stored in .pes/.dst [default: the input file's stem].")
+@click.option("--start", default=None,
+              help="Where sewing starts: X,Y in mm from the design centre (y down), or 'reverse'.")
+@click.option("--pes-version", type=Integer(1, 6), default=None,
               help="PES version: 6 (default; keeps RGB colours) or 1 (Brother's 64-colour palette).")
-@click.option("--spm", type=float, default=None, help="Machine speed in stitches per minute [default: 600].")
-@click.option("--preview", "preview_path", default=None, type=click.Path(path_type=str),
-              help="Also write a preview image (.png or .svg).")
-@click.option("--preview-width", type=int, default=1000, show_default=True, help="Preview width in px.")
-@click.option("--multi", is_flag=True, help="Raster input: multi-stroke vectorization.")
-@click.option("--threshold", type=float, default=None, help="Raster input: ink threshold in (0, 1).")
-@click.option("--blur", type=float, default=0.0, show_default=True, help="Raster input: Gaussian blur sigma in px.")
-@click.option("--classifier", default="cnn", show_default=True,
-              help="Raster input: crossing classifier, cnn or geometric.")
+@click.option("--spm", type=Number(100, 3000), default=None,
+              help="Machine speed in stitches per minute, 100-3000 [default: 600].")
+@output_option(".png", ".svg", flags=("--preview",), dest="preview_path", required=False,
+               help="Also write a preview image (.png or .svg).")
+@click.option("--preview-width", type=Integer(64, 8000), default=1000, show_default=True,
+              help="Preview width in px, 64-8000.")
+@click.option("--preview-style", type=click.Choice(["realistic", "diagnostic"]), default="realistic",
+              show_default=True,
+              help="realistic: thread on fabric; diagnostic: needle points, jumps, trims, order, hoop.")
+@click.option("--preview-hoop", is_flag=True, help="Draw the hoop in the realistic preview too.")
+@drawing_input_options(prefix="Raster input: ")
 @edits_option
-def embroider(source: str, output: str, style: str, size: str | None, width: str | None, height: str | None,
-              rotate: float, hoop: str, fit: bool, stitch_length: str | None, tolerance: str | None,
-              stitch_width: str | None, spacing: str | None, pull_comp: str | None, repeats: int | None,
-              arrow_size: str | None, min_stitch: str, max_stitch: str, trim_distance: str, lock_form: str,
-              color: str, pes_version: int | None, spm: float | None, preview_path: str | None,
-              preview_width: int, multi: bool, threshold: float | None, blur: float,
+def embroider(source: str, output: str, style: str, size: float | None, width: float | None,
+              height: float | None, rotate: float, hoop: str, fit: bool, stitch_length: float | None,
+              tolerance: float | None, stitch_width: float | None, spacing: float | None,
+              pull_comp: float | None, repeats: int | None, arrow_size: float | None, underlay: str | None,
+              min_stroke: float, min_stitch: float, max_stitch: float, trim_distance: float, lock_form: str,
+              color: str | None, thread_chart: str | None, design_name: str | None, start: str | None,
+              pes_version: int | None, spm: float | None, preview_path: str | None, preview_width: int,
+              preview_style: str, preview_hoop: bool, multi: bool, threshold: float | None, blur: float,
               classifier: str, edits: str | None) -> None:
     """Sew SOURCE (PNG/JPG/SVG/JSON drawing) along its curve into an embroidery file."""
     from fabrication.cli.job_options import embroidery_settings
@@ -78,16 +111,19 @@ def embroider(source: str, output: str, style: str, size: str | None, width: str
     settings = embroidery_settings(
         output=output, style=style, size=size, width=width, height=height, rotate=rotate, hoop=hoop, fit=fit,
         stitch_length=stitch_length, tolerance=tolerance, stitch_width=stitch_width, spacing=spacing,
-        pull_comp=pull_comp, repeats=repeats, arrow_size=arrow_size, min_stitch=min_stitch,
-        max_stitch=max_stitch, trim_distance=trim_distance, lock_form=lock_form, color=color,
-        pes_version=pes_version, spm=spm)
-    check_writable(output)
+        pull_comp=pull_comp, repeats=repeats, arrow_size=arrow_size, underlay=underlay,
+        min_stroke=min_stroke, min_stitch=min_stitch, max_stitch=max_stitch, trim_distance=trim_distance,
+        lock_form=lock_form, color=color, thread_chart=thread_chart, start=start, name=design_name,
+        source=source, date=source_date(), pes_version=pes_version, spm=spm)
+    check_distinct(inputs=[("input", source), ("--edits file", edits)],
+                   outputs=[("output", output), ("--preview", preview_path)])
+    if stitch_length is not None and stitch_length < min_stitch:
+        raise InputError(f"--stitch-length {stitch_length:g} mm is shorter than --min-stitch {min_stitch:g} mm, "
+                         "so every stitch would be merged away; lengthen it or lower --min-stitch")
     if preview_path is not None:
         check_preview_path(preview_path)
-        check_writable(preview_path)
-        preview_options = PreviewOptions(width=preview_width)
-    if not os.path.isfile(source):
-        raise InputError(f"input file {source!r} does not exist")
+        preview_options = PreviewOptions(width=preview_width, style=preview_style,
+                                         hoop=preview_hoop or preview_style == "diagnostic")
     job = settings.job
     the_hoop = job.hoop
     for message in settings.warnings:
@@ -111,6 +147,9 @@ def embroider(source: str, output: str, style: str, size: str | None, width: str
 
     for message in result.warnings:
         warn(message)
+    if color is not None and len(job.plan.colors) > len(result.drawing.strokes):
+        warn(f"--color lists {len(job.plan.colors)} colours for {len(result.drawing.strokes)} "
+             "stroke(s); the extra colours are unused")
     stats = result.stats
     for line in stats.lines():
         console.print(line, soft_wrap=True)

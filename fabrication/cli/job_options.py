@@ -7,6 +7,7 @@ Nothing here prints: warnings come back as one-line messages for the caller to s
 
 from __future__ import annotations
 
+import os
 from dataclasses import dataclass
 
 from onestroke.errors import InputError
@@ -24,6 +25,7 @@ _STYLE_FIELDS = {
     "pull_comp": ("pull_compensation", "--pull-comp"),
     "repeats": ("repeats", "--repeats"),
     "arrow_size": ("size", "--arrow-size"),
+    "underlay": ("underlay", "--underlay"),
 }
 
 
@@ -64,16 +66,24 @@ def embroidery_settings(*, output: str, style: str = "running", size: str | None
                         tolerance: str | None = None, stitch_width: str | None = None,
                         spacing: str | None = None, pull_comp: str | None = None,
                         repeats: int | None = None, arrow_size: str | None = None,
+                        underlay: str | None = None, min_stroke: str = "1mm",
                         min_stitch: str = "0.3mm", max_stitch: str = "12.1mm", trim_distance: str = "3mm",
-                        lock_form: str = "half", color: str = "#000000", pes_version: int | None = None,
-                        spm: float | None = None) -> EmbroiderySettings:
+                        lock_form: str = "half", color: str | None = None, thread_chart: str | None = None,
+                        start: str | None = None, name: str | None = None, source: str | None = None,
+                        date: str | None = None,
+                        pes_version: int | None = None, spm: float | None = None) -> EmbroiderySettings:
     """The `EmbroideryJob` of `onestroke embroider`'s option values, for the format of `output`
-    (a file name or just ".pes"); `InputError` naming the flag for a bad value."""
+    (a file name or just ".pes"); `InputError` naming the flag for a bad value. `color`: one
+    colour or a comma-separated list (one per stroke); None keeps the drawing's colours.
+    `name`: the design name files store (None: the stem of `source`, the input file, else
+    'onestroke'). `date`: YYYYMMDDhhmmss for JEF (None: the fixed default)."""
     from fabrication.embroidery.export import PES_VERSIONS
     from fabrication.embroidery.locks import LockOptions
     from fabrication.embroidery.pipeline import EmbroideryJob
     from fabrication.embroidery.plan import PlanOptions, style_options
-    from fabrication.embroidery.thread import parse_color
+    from fabrication.embroidery.order import parse_start
+    from fabrication.embroidery.plan import FIXED_DATE
+    from fabrication.embroidery.thread import check_chart, parse_colors
     from machines.hoops import load_embroidery_profile
     from onestroke.units import parse_length, parse_positive_length
 
@@ -94,6 +104,8 @@ def embroidery_settings(*, output: str, style: str = "running", size: str | None
         lengths["pull_comp"] = parse_length(pull_comp, what="--pull-comp")
     if repeats is not None:
         lengths["repeats"] = repeats
+    if underlay is not None:
+        lengths["underlay"] = underlay
     style_values = {_STYLE_FIELDS[k][0]: v for k, v in lengths.items()}
     stitch_options = style_options(style, **style_values)
     warnings = [f"{_STYLE_FIELDS[k][1]} has no effect with --style {style}" for k in lengths
@@ -106,12 +118,17 @@ def embroidery_settings(*, output: str, style: str = "running", size: str | None
                                min_stitch=parse_positive_length(min_stitch, what="--min-stitch"),
                                max_stitch=limit,
                                trim_distance=parse_length(trim_distance, what="--trim-distance"),
-                               color=parse_color(color))
+                               min_stroke=parse_length(min_stroke, what="--min-stroke"),
+                               colors=parse_colors(color) if color is not None else (),
+                               thread_chart=check_chart(thread_chart) if thread_chart else None,
+                               start=parse_start(start) if start is not None else None)
     if spm is not None and not spm > 0:
         raise InputError(f"--spm {spm:g} must be greater than zero")
     job = EmbroideryJob(placement=placement, hoop=profile.hoop(hoop), fit=fit, plan=plan_options,
                         stitches_per_minute=spm or profile.stitches_per_minute,
-                        trim_seconds=profile.trim_seconds)
+                        trim_seconds=profile.trim_seconds, date=date or FIXED_DATE,
+                        name=name if name is not None else
+                        (os.path.splitext(os.path.basename(source))[0] if source else "onestroke"))
     if style in ("zigzag", "arrows") and stitch_width is None:
         # `--width 3mm` next to --style zigzag most likely meant the zigzag, not the design.
         for flag, side in (("--width", placement.width), ("--height", placement.height)):

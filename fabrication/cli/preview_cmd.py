@@ -10,14 +10,12 @@ import os
 
 import click
 
-from fabrication.cli.common import console, done
-from onestroke.atomic import check_writable
+from fabrication.cli.common import console, done, warn
+from fabrication.cli.options import Integer, Number, input_argument, output_option
 from onestroke.errors import InputError
+from onestroke.paths import check_distinct
 
 
-def warn(message: str) -> None:
-    """A one-line warning (soft wrap: long messages stay on one line in logs)."""
-    console.print(f"[yellow]warning:[/yellow] {message}", soft_wrap=True)
 
 
 GCODE_SUFFIXES = (".gcode", ".nc", ".gc", ".ngc")
@@ -25,13 +23,13 @@ DRAWING_SUFFIXES = (".svg", ".json")
 
 
 @click.command()
-@click.argument("source", type=click.Path(path_type=str))
-@click.option("-o", "--output", required=True, type=click.Path(path_type=str),
-              help="Preview to write: an image (.png, .svg) or a player page (.html).")
-@click.option("--width", "width_px", type=int, default=1000, show_default=True,
-              help="Image width in px (embroidery and drawings).")
+@input_argument()
+@output_option(".png", ".svg", ".html", ".htm", help="Preview to write: an image (.png, .svg) or a player page (.html).")
+@click.option("--width", "width_px", type=Integer(64, 8000), default=1000, show_default=True,
+              help="Image width in px, 64-8000 (embroidery and drawings).")
 @click.option("--hoop", default=None, help="Embroidery: draw this hoop, e.g. 100x100 or 5x7.")
-@click.option("--spm", type=float, default=None, help="Embroidery: stitches per minute for the time [600].")
+@click.option("--spm", type=Number(100, 3000), default=None,
+              help="Embroidery: stitches per minute for the time, 100-3000 [600].")
 def preview(source: str, output: str, width_px: int, hoop: str | None, spm: float | None) -> None:
     """Draw SOURCE (.pes/.dst/.jef/.exp/.vp3/... , .gcode/.nc, or an .svg/.json drawing) as OUTPUT.
 
@@ -41,15 +39,15 @@ def preview(source: str, output: str, width_px: int, hoop: str | None, spm: floa
     from fabrication.embroidery.read import readable_extensions
 
     suffix = os.path.splitext(source)[1].lower()
+    accepted = readable_extensions() + GCODE_SUFFIXES + DRAWING_SUFFIXES
+    if suffix in accepted:  # an unknown kind is refused for that first, below or by the player
+        check_distinct(inputs=[("input", source)], outputs=[("output", output)])
     if output.lower().endswith((".html", ".htm")):
         return _player_page(source, output, hoop, spm)
-    accepted = readable_extensions() + GCODE_SUFFIXES + DRAWING_SUFFIXES
     if suffix not in accepted:
         raise InputError(f"cannot preview {source!r}; use an embroidery file "
                          f"({', '.join(readable_extensions()[:8])}, ...), G-code "
                          f"({', '.join(GCODE_SUFFIXES)}) or a drawing (.svg, .json)")
-    if not os.path.isfile(source):
-        raise InputError(f"input file {source!r} does not exist")
 
     if suffix in GCODE_SUFFIXES:
         from fabrication.laser.preview import render_gcode_preview
@@ -60,10 +58,10 @@ def preview(source: str, output: str, width_px: int, hoop: str | None, spm: floa
         return
 
     check_preview_path(output)
-    check_writable(output)
     from fabrication.embroidery.preview import PreviewOptions
 
-    options = PreviewOptions(width=width_px)
+    # A file's preview tells the truth (needle points, jumps, trims, order), as before.
+    options = PreviewOptions(width=width_px, style="diagnostic")
     if suffix in DRAWING_SUFFIXES:
         from fabrication.embroidery.preview import render_drawing_preview
 
@@ -87,8 +85,6 @@ def preview(source: str, output: str, width_px: int, hoop: str | None, spm: floa
 
     profile = load_embroidery_profile()
     the_hoop = profile.hoop(hoop) if hoop is not None else None
-    if spm is not None and not spm > 0:
-        raise InputError(f"--spm {spm:g} must be greater than zero")
     read = read_embroidery(source)
     stats = embroidery_stats(read.plan, stitches_per_minute=spm or profile.stitches_per_minute,
                              trim_seconds=profile.trim_seconds, color_changes=read.color_changes)
@@ -118,7 +114,7 @@ def _player_page(source: str, output: str, hoop: str | None, spm: float | None) 
     for message in data.warnings:
         warn(message)
     write_player_html(data, output, source=source)
-    from fabrication.laser.job_time import format_duration
+    from machines.job_time import format_duration
 
     span = (format_duration(data.total) if data.time_unit == "s"
             else f"{data.total:.1f} {data.time_unit} drawn")

@@ -14,20 +14,19 @@ import time
 from pathlib import Path
 
 import click
-import numpy as np
 from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
 
 from fabrication.cli.common import console, done, warn
-from fabrication.laser.job_time import format_duration
+from fabrication.cli.options import BAUD_RATES, Integer, Number, input_argument, machine_options, output_option
+from machines.framing import DEFAULT_FRAME_FEED, framing_lines
 from machines.gcode_program import Program, analyze_program, load_program, program_from_text
+from machines.job_time import estimate_program_time, format_duration
 from machines.job_check import check_job
 from machines.ports import open_port
 from machines.resume import resume_program
 from machines.streamer import GrblStreamer, MachineInfo, StreamError, StreamProgress
 from onestroke.errors import InputError, MachineError
 
-BAUD_RATES = (9600, 19200, 38400, 57600, 115200, 230400, 250000, 500000, 1000000)
-FRAME_FEED = 3000.0  # mm/min: slow enough to follow by eye
 
 
 def _format_seconds(seconds: float) -> str:
@@ -35,37 +34,12 @@ def _format_seconds(seconds: float) -> str:
     return format_duration(max(0.0, float(seconds)))
 
 
-def _line_seconds(path: Path, program: Program, info: MachineInfo, fallback: np.ndarray) -> np.ndarray:
-    """Cumulative planner-model seconds at the end of each program line, from the laser
-    helper's estimator when available (the same one `onestroke laser` prints), else from
-    `machines.planner_model` (what `fallback` holds)."""
-    try:
-        from fabrication.laser.job_time import estimate_gcode_time
-        from machines.laser_profile import LaserProfile
+def _machine_profile(info: MachineInfo, laser_profile):
+    """The connected machine as a profile: its `$$` settings over the given (or default) profile."""
+    from machines.grbl_settings import profile_from_settings
 
-        s = info.settings
-        default = LaserProfile()
-
-        def pick(number: int, value: float) -> float:
-            got = s.get(number)
-            return float(got) if got and got > 0 else value
-
-        profile = LaserProfile(
-            name="connected machine", bed_width=pick(130, default.bed_width), bed_height=pick(131, default.bed_height),
-            max_power=pick(30, default.max_power), laser_mode=bool(s.get(32, 1)),
-            max_rate_x=pick(110, default.max_rate_x), max_rate_y=pick(111, default.max_rate_y),
-            acceleration_x=pick(120, default.acceleration_x), acceleration_y=pick(121, default.acceleration_y),
-            junction_deviation=pick(11, default.junction_deviation), arc_tolerance=pick(12, default.arc_tolerance),
-            steps_per_mm_x=pick(100, default.steps_per_mm_x), steps_per_mm_y=pick(101, default.steps_per_mm_y),
-            rx_buffer=max(16, info.rx_buffer), planner_blocks=max(2, info.planner_blocks))
-        raw = path.read_text(encoding="utf-8").splitlines()
-        per_file_line = np.asarray(estimate_gcode_time(raw, profile).line_seconds, dtype=float)
-        index = np.array([number - 1 for number, _ in program.lines], dtype=int)
-        if len(per_file_line) >= len(raw) and len(index):
-            return per_file_line[index]
-    except Exception:  # noqa: BLE001 - the estimate is a nicety; never fail a job over it
-        pass
-    return fallback
+    return profile_from_settings(info.settings, base=laser_profile, rx_buffer=info.rx_buffer,
+                                 planner_blocks=info.planner_blocks)
 
 
 def _frame_program(stats, info: MachineInfo) -> Program:
@@ -74,12 +48,9 @@ def _frame_program(stats, info: MachineInfo) -> Program:
     if box is None:
         raise InputError("the job does not move; nothing to frame")
     (x0, y0), (x1, y1) = box
-    feed = min(FRAME_FEED, info.settings.get(110, FRAME_FEED), info.settings.get(111, FRAME_FEED))
-    px, py = info.position[0], info.position[1]
-    corners = [(x0, y0), (x1, y0), (x1, y1), (x0, y1), (x0, y0)]
-    lines = ["M5", "G21", f"G53G0X{x0:.3f}Y{y0:.3f}"]
-    lines += [f"G53G1X{x:.3f}Y{y:.3f}F{feed:.0f}" for x, y in corners[1:]]
-    lines.append(f"G53G0X{px:.3f}Y{py:.3f}")
+    feed = min(DEFAULT_FRAME_FEED, info.settings.get(110, DEFAULT_FRAME_FEED),
+               info.settings.get(111, DEFAULT_FRAME_FEED))
+    lines = framing_lines((x0, y0, x1, y1), feed=feed, machine_coordinates=True, return_to=info.position[:2])
     return program_from_text("\n".join(lines), source="frame")
 
 
@@ -128,13 +99,21 @@ def _key_controls(streamer: GrblStreamer, enabled: bool):
         termios.tcsetattr(fd, termios.TCSADRAIN, saved)
 
 
+PROGRESS_EVERY = 5.0  # seconds between plain progress lines when not on a terminal
+
+
 def run_stream(gcode_path, *, port: str, baud: int = 115200, check: bool = False, frame: bool = False,
-               profile: str | os.PathLike | None = None, from_line: int | None = None) -> None:
+               profile: str | os.PathLike | None = None, from_line: int | None = None, reset: bool = True,
+               allow_settings: bool = False, progress_every: float = PROGRESS_EVERY) -> None:
     """Connect to `port`, check the job against the machine, stream it with a progress bar
     and print a summary. `check` streams in GRBL's check mode ($C, nothing moves); `frame`
     only traces the job's bounding box with the beam off. `profile`: a laser profile TOML
     to compare with the machine's settings. `from_line`: resume at this file line (after a
-    failure), moving there with the beam off first. Raises OnestrokeError on any failure."""
+    failure), moving there with the beam off first. `reset`: False attaches without a soft
+    reset (refused while the controller runs a job). `allow_settings`: let `$` lines of the
+    file through (otherwise the pre-check refuses them). `progress_every`: seconds between
+    plain progress lines when the output is not a terminal. Raises OnestrokeError on any
+    failure."""
     path = Path(gcode_path)
     program = load_program(path)
     if from_line is not None:
@@ -154,12 +133,12 @@ def run_stream(gcode_path, *, port: str, baud: int = 115200, check: bool = False
     time_scale = float(getattr(handle, "time_scale", 1.0))
     with GrblStreamer(handle, name=port) as streamer:
         console.print(f"connecting to {port} at {baud} baud ...")
-        info = streamer.connect()
+        info = streamer.connect(reset=reset)
         if info.alarm:
             raise MachineError(f"{port} is locked in ALARM (it booted or was left in alarm): home it with $H, or "
                                "unlock it with $X if it has no homing switches, then run again")
         stats = analyze_program(program, settings=info.settings, start=info.position, offsets=info.offsets,
-                                planner_blocks=info.planner_blocks)
+                                planner_blocks=info.planner_blocks, allow_settings=allow_settings)
         for problem in check_job(stats, info.settings, profile=laser_profile):
             if problem.fatal:
                 raise InputError(f"{path.name}: {problem.message}")
@@ -171,11 +150,15 @@ def run_stream(gcode_path, *, port: str, baud: int = 115200, check: bool = False
             done(f"framed {x1 - x0:.1f} x {y1 - y0:.1f} mm at X{x0:.1f} Y{y0:.1f} (machine) with the beam off "
                  f"in {_format_seconds(result.elapsed)}")
             return
-        line_seconds = _line_seconds(path, program, info, stats.line_seconds)
-        total = float(line_seconds[-1]) if len(line_seconds) else 0.0
+        machine = _machine_profile(info, laser_profile)
+        job = estimate_program_time(program, machine, stats=stats)
+        # cumulative seconds at the end of each streamed line (for the ETA)
+        line_seconds = job.line_seconds[[max(0, number - 1) for number, _ in program.lines]]
+        total = job.total_seconds
         sim = f" (simulated, {time_scale:g}x faster)" if time_scale != 1.0 else ""
         console.print(f"GRBL {info.version}: RX {info.rx_buffer} B, planner {info.planner_blocks} blocks; "
-                      f"{len(program)} lines, estimated {_format_seconds(total)} of machine time{sim}"
+                      f"{len(program)} lines, estimated {_format_seconds(total)} of machine time{sim}, "
+                      f"{job.bound_text(machine)}"
                       + (" - check mode, nothing moves" if check else ""))
         columns = (TextColumn("[bold]{task.description}"), BarColumn(),
                    TextColumn("{task.completed}/{task.total} lines"), TimeElapsedColumn(),
@@ -184,6 +167,7 @@ def run_stream(gcode_path, *, port: str, baud: int = 115200, check: bool = False
         with Progress(*columns, console=console, transient=False, disable=not console.is_terminal) as bar:
             task = bar.add_task("check" if check else "stream", total=len(program), eta="-", state="")
             last = [0.0]
+            plain_next = [time.monotonic() + progress_every]
 
             def on_progress(p: StreamProgress) -> None:
                 now = time.monotonic()
@@ -191,8 +175,13 @@ def run_stream(gcode_path, *, port: str, baud: int = 115200, check: bool = False
                     return
                 last[0] = now
                 remaining = (total - float(line_seconds[p.acked - 1])) / time_scale if p.acked else total
-                bar.update(task, completed=p.acked, eta="-" if check else _format_seconds(remaining),
-                           state=p.state or "")
+                eta = "-" if check else _format_seconds(remaining)
+                bar.update(task, completed=p.acked, eta=eta, state=p.state or "")
+                if not console.is_terminal and now >= plain_next[0]:
+                    # piped or logged: one plain line every few seconds instead of a bar
+                    plain_next[0] = now + progress_every
+                    console.print(f"{p.acked}/{p.total} lines acknowledged ({100.0 * p.acked / max(1, p.total):.0f} %), "
+                                  f"elapsed {_format_seconds(p.elapsed)}, remaining {eta}", highlight=False)
 
             if interactive:
                 console.print("keys: space pause, r resume, +/- feed, </> power, q or Ctrl-C abort")
@@ -223,34 +212,36 @@ def run_stream(gcode_path, *, port: str, baud: int = 115200, check: bool = False
 
 
 @click.command("stream")
-@click.argument("gcode", type=click.Path(dir_okay=True, path_type=Path))
-@click.option("--port", required=True, help="Serial port (/dev/ttyUSB0, COM3) or sim:// for a dry run on an emulator.")
-@click.option("--baud", type=int, default=115200, show_default=True, help="Serial baud rate.")
+@input_argument("gcode")
+@machine_options(port_required=True)
 @click.option("--check", is_flag=True, help="Dry run in GRBL's check mode ($C): parse everything, move nothing.")
 @click.option("--frame", is_flag=True, help="Only trace the job's bounding box with the beam off.")
-@click.option("--profile", type=click.Path(path_type=Path), default=None,
-              help="Laser profile TOML to compare with the machine's settings.")
-@click.option("--from-line", type=int, default=None,
+@click.option("--no-reset", is_flag=True,
+              help="Attach without resetting the controller (refused while it runs a job); default: soft reset.")
+@click.option("--allow-settings", is_flag=True,
+              help="Let '$' commands of the file through (e.g. $32=1); otherwise the pre-check refuses them.")
+@click.option("--from-line", type=Integer(1, 100_000_000), default=None,
               help="Resume at this file line after a failure (the head moves there with the beam off).")
-def stream(gcode: Path, port: str, baud: int, check: bool, frame: bool, profile: Path | None,
-           from_line: int | None) -> None:
+def stream(gcode: str, port: str, baud: int, check: bool, frame: bool, profile_path: str | None,
+           no_reset: bool, allow_settings: bool, from_line: int | None) -> None:
     """Stream GCODE to a GRBL laser over USB serial (pause, resume and abort leave the beam off)."""
-    run_stream(gcode, port=port, baud=baud, check=check, frame=frame, profile=profile, from_line=from_line)
+    if check and frame:
+        raise InputError("--check and --frame cannot be combined: --frame only traces the bounding box; "
+                         "run --check first, then --frame")
+    run_stream(gcode, port=port, baud=baud, check=check, frame=frame, profile=profile_path, from_line=from_line,
+               reset=not no_reset, allow_settings=allow_settings)
 
 
 @click.command("emulator")
-@click.option("--speed", type=float, default=1.0, show_default=True, help="Time scale (1 = a real machine's pace).")
-@click.option("--log", "log_path", type=click.Path(dir_okay=False, path_type=Path), default=None,
-              help="On exit, write every line the emulator executed to this file.")
+@click.option("--speed", type=Number(0.0, 1000.0, low_open=True), default=1.0, show_default=True,
+              help="Time scale, above 0 to 1000 (1 = a real machine's pace).")
+@output_option(flags=("--log",), dest="log_path", required=False,
+               help="On exit, write every line the emulator executed to this file.")
 def emulator(speed: float, log_path: Path | None) -> None:
     """Serve a GRBL 1.1 emulator on a pseudo-terminal until Ctrl-C (for any sender, or tests)."""
     from machines.emulator import EmulatorOptions, GrblEmulator
-    from onestroke.atomic import atomic_write_text, check_writable
+    from onestroke.atomic import atomic_write_text
 
-    if not speed > 0:
-        raise InputError(f"--speed {speed:g} must be greater than zero (1 = real time)")
-    if log_path is not None:
-        check_writable(log_path)
     emu = GrblEmulator(EmulatorOptions(time_scale=speed))
     device = emu.start_pty()
     click.echo(device)

@@ -40,12 +40,29 @@ def studio(source: str, port: int, no_browser: bool, edits_path: str | None, pro
     server = StudioServer(session, port=port).start()
     done(f"studio for {session.drawing_path.name} at {server.url}")
     console.print(f"edits are saved to {session.edits_path}; Ctrl-C stops the studio")
-    if not no_browser:
+    if not no_browser and _graphical():
         import webbrowser
 
         webbrowser.open(server.url)
     try:
         while server.thread.is_alive():
             time.sleep(0.5)
+    except KeyboardInterrupt:
+        console.print("studio stopped")
     finally:
+        if session.sender is not None and session.sender.running:
+            # Never leave a laser running unattended: stop the job before the server goes.
+            session.sender.abort()
+            session.sender.wait(10.0)
         server.stop()
+
+
+def _graphical() -> bool:
+    """Whether a browser window can open: on Linux without a display, webbrowser would
+    start a text browser in this terminal instead; the printed address is enough there."""
+    import os
+    import sys
+
+    if sys.platform.startswith("linux"):
+        return bool(os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY"))
+    return True

@@ -12,41 +12,50 @@ from pathlib import Path
 
 import click
 
+from fabrication.cli.options import InputFile, Integer, Number, output_option
 from onestroke.errors import InputError
 
 WORKERS = os.cpu_count() or 1
+DEFAULT_NAME = "crossing_cnn.onnx"  # in the current folder: never the shipped model by default
 
 
 @click.command("train-classifier")
-@click.option("--seed", type=int, default=0, show_default=True, help="Seed of data, initialisation and batch order.")
-@click.option("--samples", type=int, default=36_000, show_default=True, help="Synthetic training crops.")
-@click.option("--epochs", type=int, default=8, show_default=True)
-@click.option("--batch", type=int, default=128, show_default=True)
-@click.option("--lr", type=float, default=4e-3, show_default=True, help="Learning rate.")
-@click.option("--validation", type=int, default=5_000, show_default=True,
+@click.option("--seed", type=Integer(0, 2**32 - 1), default=0, show_default=True,
+              help="Seed of data, initialisation and batch order.")
+@click.option("--samples", type=Integer(100, 10_000_000), default=36_000, show_default=True,
+              help="Synthetic training crops, 100-10,000,000.")
+@click.option("--epochs", type=Integer(1, 1000), default=8, show_default=True, help="Epochs, 1-1000.")
+@click.option("--batch", type=Integer(1, 65536), default=128, show_default=True, help="Batch size, 1-65536.")
+@click.option("--lr", type=Number(0.0, 10.0, low_open=True), default=4e-3, show_default=True,
+              help="Learning rate, above 0 to 10.")
+@click.option("--validation", type=Integer(1, 10_000_000), default=5_000, show_default=True,
               help="Fresh crops (another seed) measured after export.")
-@click.option("--workers", type=int, default=WORKERS, show_default=True, help="Processes making crops.")
-@click.option("--out", type=click.Path(dir_okay=False, path_type=Path), default=None,
-              help="ONNX file to write (its .json and .md beside it); default: the shipped model.")
+@click.option("--workers", type=Integer(1, 256), default=WORKERS, show_default=True, help="Processes making crops.")
+@output_option(".onnx", flags=("--out",), required=False,
+               help="ONNX file to write (its .json and .md beside it) [default: crossing_cnn.onnx in the current "
+                    "folder; the shipped model is replaced only when named explicitly].")
 def train_classifier(seed: int, samples: int, epochs: int, batch: int, lr: float, validation: int,
-                     workers: int, out: Path | None) -> None:
+                     workers: int, out: str | None) -> None:
     """Train the crossing-vs-touching CNN on CPU, reproducibly from --seed, and export it."""
+    from onestroke.atomic import check_writable
+
+    out_path = Path(out or DEFAULT_NAME)
+    check_writable(out_path)
     try:
-        from vectorize.training.train import DEFAULT_OUT, train_and_export
+        from vectorize.training.train import train_and_export
     except ImportError as error:
         raise InputError(f"training needs PyTorch ({error.name} is missing): pip install -e '.[train]'") from None
     meta = train_and_export(seed=seed, samples=samples, epochs=epochs, batch=batch, lr=lr,
-                            validation=validation, workers=workers, out=out or DEFAULT_OUT,
+                            validation=validation, workers=workers, out=out_path,
                             log=lambda line: click.echo(line, err=True))
     click.echo(json.dumps(meta["validation"], indent=2))
 
 
 @click.command("validate-classifier")
-@click.option("--seed", type=int, default=1000, show_default=True, help="Seed of the fresh crops.")
-@click.option("--count", type=int, default=5000, show_default=True, help="Crops to measure.")
-@click.option("--workers", type=int, default=WORKERS, show_default=True, help="Processes making crops.")
-@click.option("--model", type=click.Path(exists=True, dir_okay=False, path_type=Path), default=None,
-              help="ONNX model; default: the shipped one.")
+@click.option("--seed", type=Integer(0, 2**32 - 1), default=1000, show_default=True, help="Seed of the fresh crops.")
+@click.option("--count", type=Integer(1, 10_000_000), default=5000, show_default=True, help="Crops to measure.")
+@click.option("--workers", type=Integer(1, 256), default=WORKERS, show_default=True, help="Processes making crops.")
+@click.option("--model", type=InputFile(), default=None, help="ONNX model; default: the shipped one.")
 def validate_classifier(seed: int, count: int, workers: int, model: Path | None) -> None:
     """Accuracy of the CNN on freshly generated crops (onnxruntime, 8-fold augmentation)."""
     from vectorize.cnn_classifier import DEFAULT_MODEL

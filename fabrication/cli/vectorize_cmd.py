@@ -8,36 +8,28 @@ import time
 import click
 
 from fabrication.cli.common import console, done, edits_option, warn
-from onestroke.atomic import check_writable
+from fabrication.cli.options import drawing_input_options, input_argument, output_option
 from onestroke.errors import InputError
+from onestroke.paths import check_distinct
 
 
 @click.command()
-@click.argument("source", type=click.Path(dir_okay=True, path_type=str))
-@click.option("-o", "--output", required=True, type=click.Path(path_type=str),
-              help="Output file: .svg (one path per stroke) or .json (control points).")
-@click.option("--multi", is_flag=True, help="Multi-stroke drawing: keep every ink piece, several strokes.")
-@click.option("--threshold", type=float, default=None,
-              help="Ink threshold: gray level in (0, 1), paper = 1 after shading correction; "
-                   "default: Li's method.")
-@click.option("--blur", type=float, default=0.0, show_default=True,
-              help="Gaussian blur sigma in px before thresholding (helps pencil scans).")
-@click.option("--classifier", type=click.Choice(["cnn", "geometric"]), default="cnn", show_default=True,
-              help="How crossings are told from touchings.")
+@input_argument()
+@output_option(".svg", ".json", help="Output file: .svg (one path per stroke) or .json (control points).")
+@drawing_input_options
 @click.option("--debug", "debug_dir", type=click.Path(file_okay=False, path_type=str), default=None,
               help="Write a PNG overlay of every stage into this folder.")
 @edits_option
 def vectorize(source: str, output: str, multi: bool, threshold: float | None, blur: float,
               classifier: str, debug_dir: str | None, edits: str | None) -> None:
     """Vectorize SOURCE into one ordered cubic Bézier curve (or several with --multi)."""
+    check_distinct(inputs=[("input", source), ("--edits file", edits)], outputs=[("output", output)])
+    if debug_dir is not None and os.path.exists(debug_dir) and not os.path.isdir(debug_dir):
+        raise InputError(f"--debug {debug_dir!r} is a file; give a folder for the stage images")
     from vectorize import VectorizeOptions, vectorize_file
     from vectorize.edits import read_edits
     from vectorize.svg_write import write_drawing
 
-    suffix = os.path.splitext(output)[1].lower()
-    if suffix not in (".svg", ".json"):
-        raise InputError(f"cannot write {output!r}: use an .svg or .json output file")
-    check_writable(output)
     replay = read_edits(edits) if edits is not None else None
     started = time.perf_counter()
     options = VectorizeOptions(multi=multi, threshold=threshold, blur=blur, classifier=classifier,

@@ -74,17 +74,18 @@ class Canvas:
 
     # -- items (all coordinates in mm, widths in mm unless said) --------------------
     def segments(self, a: np.ndarray, b: np.ndarray, colors: np.ndarray, width: float,
-                 *, min_px: float = 1.0, opacity: float = 1.0) -> None:
+                 *, min_px: float = 1.0, opacity: float = 1.0, round_caps: bool = False) -> None:
         """Line segments a[i] -> b[i] (S, 2) with colours (S, 3). Below full `opacity`,
-        segments sewn over each other darken, as layers of thread do."""
+        segments sewn over each other darken, as layers of thread do. `round_caps`: round
+        ends in PNG too (SVG lines always have them), so wide strokes join without notches."""
         self.items.append(("segments", self.px(a), self.px(b), np.asarray(colors, np.uint8),
-                           max(width * self.scale, min_px), None, float(opacity)))
+                           max(width * self.scale, min_px), None, float(opacity), bool(round_caps)))
 
     def dashed(self, a: np.ndarray, b: np.ndarray, color, width: float, dash: float) -> None:
         """Dashed segments with dashes and gaps `dash` mm long."""
         self.items.append(("segments", self.px(a), self.px(b),
                            np.tile(np.asarray(color, np.uint8), (len(a), 1)),
-                           max(width * self.scale, 1.0), max(dash * self.scale, 2.0), 1.0))
+                           max(width * self.scale, 1.0), max(dash * self.scale, 2.0), 1.0, False))
 
     def dots(self, points: np.ndarray, color, radius: float, *, min_px: float = 0.8) -> None:
         self.items.append(("dots", self.px(points), tuple(color), max(radius * self.scale, min_px)))
@@ -142,13 +143,17 @@ class Canvas:
         for item in self.items:
             kind = item[0]
             if kind == "segments":
-                _, a, b, colors, width, dash, opacity = item
+                _, a, b, colors, width, dash, opacity, caps = item
                 w = max(1, int(round(width * k)))
                 if dash is not None:
                     a, b, colors = _dash_pieces(a, b, colors, dash)
                 pen, alpha = (draw, ()) if opacity >= 1.0 else (blend, (int(round(opacity * 255)),))
+                r = w / 2.0
                 for (x0, y0), (x1, y1), c in zip((a * k).tolist(), (b * k).tolist(), colors.tolist()):
-                    pen.line((x0, y0, x1, y1), fill=tuple(c) + alpha, width=w)
+                    fill = tuple(c) + alpha
+                    pen.line((x0, y0, x1, y1), fill=fill, width=w)
+                    if caps and w > 2:
+                        pen.ellipse((x1 - r, y1 - r, x1 + r, y1 + r), fill=fill)
             elif kind == "dots":
                 _, p, color, r = item
                 r *= k
@@ -186,7 +191,7 @@ class Canvas:
         for item in self.items:
             kind = item[0]
             if kind == "segments":
-                _, a, b, colors, width, dash, opacity = item
+                _, a, b, colors, width, dash, opacity, _caps = item
                 dash_attr = f' stroke-dasharray="{dash:.1f} {dash:.1f}"' if dash is not None else ""
                 # One path per distinct colour keeps the file small.
                 keys = colors[:, 0].astype(np.int64) << 16 | colors[:, 1].astype(np.int64) << 8 | colors[:, 2]

@@ -8,6 +8,9 @@ pyembroidery writes with `encode: False`: no stitch can become a jump, every for
 back exactly, and its pure-Python encoder (a third of the write time) is skipped. The
 .pes/.pec thumbnails are drawn by `pec_thumbnail` (same bytes, vectorised).
 Per-format numbers and writer settings (PES version, JEF trims) come from the profile.
+The bytes depend on the plan alone: the design name, the JEF date (pyembroidery would
+stamp the current time) and the JEF hoop code come from the plan, not from the clock or
+the design's extent.
 """
 
 from __future__ import annotations
@@ -19,12 +22,17 @@ import numpy as np
 import pyembroidery
 
 from fabrication.embroidery.pec_thumbnail import fast_pec_thumbnails
-from fabrication.embroidery.plan import JUMP, STITCH, TRIM, StitchPlan
+from fabrication.embroidery.plan import COLOR, JUMP, STITCH, TRIM, StitchPlan
 from machines.hoops import EmbroideryFormat, format_for_path
 from onestroke.atomic import atomic_write_bytes
 from onestroke.errors import FabricationError, InputError
 
-_COMMANDS = np.array([pyembroidery.STITCH, pyembroidery.JUMP, pyembroidery.TRIM])
+_COMMANDS = np.array([pyembroidery.STITCH, pyembroidery.JUMP, pyembroidery.TRIM,
+                      pyembroidery.COLOR_CHANGE])
+# JEF hoop codes (pyembroidery's JefWriter constants) and their sewing fields in mm,
+# smallest first: the code written is the smallest field holding the plan's hoop.
+JEF_HOOPS = ((1, 50.0, 50.0), (0, 110.0, 110.0), (3, 126.0, 110.0), (2, 140.0, 200.0), (4, 200.0, 200.0))
+_JEF_HOOP_OFFSET = 0x20  # int32 after the offsets, 0x14, the date, 2 pad bytes and 2 counts
 PES_VERSIONS = (1, 6)
 
 
@@ -57,19 +65,54 @@ def normalized_rows(plan: StitchPlan, fmt: EmbroideryFormat) -> np.ndarray:
     return rows
 
 
+def design_name(plan: StitchPlan) -> str:
+    """The name files store: printable ASCII (fixed-width headers count bytes, not
+    characters), at most 16 characters (the DST label field)."""
+    text = "".join(c if 32 <= ord(c) < 127 else "_" for c in plan.name).strip()
+    return (text or "onestroke")[:16]
+
+
 def to_pattern(plan: StitchPlan, fmt: EmbroideryFormat) -> pyembroidery.EmbPattern:
-    """A pyembroidery pattern of `plan` for `fmt`: one thread, normalized rows, then END."""
+    """A pyembroidery pattern of `plan` for `fmt`: its threads, normalized rows, END."""
     pattern = pyembroidery.EmbPattern()
-    thread = pyembroidery.EmbThread()
-    thread.set_color(*plan.color)
-    thread.description = "onestroke #{:02x}{:02x}{:02x}".format(*plan.color)
-    pattern.add_thread(thread)
+    for thread in plan.threads:
+        emb = pyembroidery.EmbThread()
+        emb.set_color(*thread.color)
+        emb.description = thread.name or "onestroke {}".format(thread.hex)
+        if thread.number is not None:
+            emb.catalog_number = thread.number
+            emb.brand = emb.chart = thread.chart
+        pattern.add_thread(emb)
+    pattern.metadata("name", design_name(plan))
     rows = normalized_rows(plan, fmt)
     rows[:, 2] = _COMMANDS[rows[:, 2]]
     rows = rows.tolist()
     rows.append([rows[-1][0], rows[-1][1], pyembroidery.END])
     pattern.stitches = rows
     return pattern
+
+
+def jef_hoop_code(plan: StitchPlan) -> int | None:
+    """JEF hoop code of the smallest JEF field that holds the plan's hoop (either way
+    round); None when the plan names no hoop or no JEF field holds it (pyembroidery's
+    choice by the design's extent stands)."""
+    if plan.field is None:
+        return None
+    w, h = plan.field
+    for code, fw, fh in JEF_HOOPS:
+        if (w <= fw + 1e-9 and h <= fh + 1e-9) or (h <= fw + 1e-9 and w <= fh + 1e-9):
+            return code
+    return None
+
+
+def writer_settings(plan: StitchPlan, fmt: EmbroideryFormat, *, pes_version: int | None = None) -> dict:
+    """pyembroidery writer settings for `plan` in `fmt` (the profile's, the JEF date)."""
+    settings = {**fmt.settings}
+    if fmt.extension == "jef":
+        settings["date"] = plan.date
+    if pes_version is not None:
+        settings["pes version"] = pes_version
+    return settings
 
 
 def check_plan_fits_format(plan: StitchPlan, fmt: EmbroideryFormat) -> None:
@@ -85,20 +128,27 @@ def check_plan_fits_format(plan: StitchPlan, fmt: EmbroideryFormat) -> None:
 
 def embroidery_bytes(plan: StitchPlan, fmt: EmbroideryFormat, *, pes_version: int | None = None) -> bytes:
     """The file content of `plan` in format `fmt`."""
-    settings = {**fmt.settings, "encode": False}
     if pes_version is not None:
         if fmt.extension != "pes":
             raise InputError(f"a PES version applies to .pes files only, not .{fmt.extension}")
         if pes_version not in PES_VERSIONS:
             raise InputError(f"PES version {pes_version!r} is not supported; use 1 or 6")
-        settings["pes version"] = pes_version
+    settings = {**writer_settings(plan, fmt, pes_version=pes_version), "encode": False}
     check_plan_fits_format(plan, fmt)
+    if plan.color_changes + 1 > fmt.max_colors:
+        raise FabricationError(f"{plan.color_changes + 1} threads exceed the {fmt.max_colors} "
+                               f"colours {fmt.name} holds")
     writer = getattr(pyembroidery, f"write_{fmt.extension}")
     pattern = to_pattern(plan, fmt)
     buffer = io.BytesIO()
     with fast_pec_thumbnails():  # identical bytes, 40 % less .pes write time
         writer(pattern, buffer, settings)
-    return buffer.getvalue()
+    data = buffer.getvalue()
+    code = jef_hoop_code(plan) if fmt.extension == "jef" else None
+    if code is not None:
+        # pyembroidery picks the code from the design's extent; the user named the hoop.
+        data = data[:_JEF_HOOP_OFFSET] + int(code).to_bytes(4, "little") + data[_JEF_HOOP_OFFSET + 4:]
+    return data
 
 
 def write_embroidery(plan: StitchPlan, path: str | os.PathLike, *, pes_version: int | None = None) -> None:
@@ -107,4 +157,5 @@ def write_embroidery(plan: StitchPlan, path: str | os.PathLike, *, pes_version: 
     atomic_write_bytes(path, embroidery_bytes(plan, fmt, pes_version=pes_version))
 
 
-__all__ = ["write_embroidery", "embroidery_bytes", "to_pattern", "plan_units", "STITCH", "JUMP", "TRIM"]
+__all__ = ["write_embroidery", "embroidery_bytes", "to_pattern", "plan_units", "writer_settings",
+           "jef_hoop_code", "STITCH", "JUMP", "TRIM", "COLOR"]

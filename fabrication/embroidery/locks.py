@@ -55,9 +55,34 @@ def lock_points(path: np.ndarray, options: LockOptions = LockOptions()) -> np.nd
     return walk_back(path, length * np.asarray(LOCK_FORMS[options.form]))
 
 
+# A tack's holes keep this far (mm, along the path) from the holes the stitches after it
+# make, so the needle never pierces right beside a hole it made a moment before (0.2 mm
+# plus the files' 0.1 mm grid).
+TACK_CLEARANCE = 0.35
+
+
+def _clear_length(path: np.ndarray, length: float, form: np.ndarray) -> float:
+    """The tack length in [length / 2, length] whose holes (at `form` x length along
+    `path`) lie furthest from the path's own holes, preferring the longest that keeps
+    TACK_CLEARANCE."""
+    cum = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(path, axis=0), axis=1))])[1:]
+    if not len(cum):
+        return length
+    marks = np.unique(form[form > 0])
+    best, best_gap = length, -1.0
+    for candidate in length * np.linspace(1.0, 0.5, 11):
+        gap = float(np.abs((candidate * marks)[:, None] - cum[None, :]).min())
+        if gap >= TACK_CLEARANCE:
+            return float(candidate)
+        if gap > best_gap:
+            best, best_gap = float(candidate), gap
+    return best
+
+
 def tack_points(path: np.ndarray, options: LockOptions = LockOptions()) -> np.ndarray:
     """Needle points (4, 2) to sew before `path` (N, 2) begins: its start, then the lock
-    figure forward along it; the path then continues from its own start."""
-    length = _lock_length(path, options)
+    figure forward along it; the path then continues from its own start. The figure is
+    shortened (to half at most) to keep clear of the path's first holes."""
     form = np.asarray(LOCK_FORMS[options.form])
+    length = _clear_length(path, _lock_length(path, options), form)
     return np.vstack([path[:1], walk_back(path[::-1], length * form[:-1])])

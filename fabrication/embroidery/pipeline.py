@@ -7,10 +7,15 @@ preview stay separate calls (`write_embroidery`, `render_stitch_preview`).
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+import re
+from dataclasses import dataclass, field, replace
+
+import numpy as np
 
 from fabrication.embroidery.hooping import check_plan_in_hoop, fit_to_hoop
-from fabrication.embroidery.plan import PlanOptions, StitchPlan, plan_embroidery, style_reach
+from fabrication.embroidery.arrows import ArrowOptions
+from fabrication.embroidery.needles import BODY, MOTIF
+from fabrication.embroidery.plan import FIXED_DATE, PlanOptions, StitchPlan, plan_embroidery, style_reach
 from fabrication.embroidery.stats import EmbroideryStats, embroidery_stats
 from fabrication.embroidery.zigzag import ZigzagOptions
 from fabrication.placement import PlacementOptions, place
@@ -23,7 +28,9 @@ from vectorize.drawing import Drawing
 class EmbroideryJob:
     """placement: size and rotation of the curve (mm); hoop: the sewing field; fit: scale
     a design that does not fit down instead of refusing it; plan: stitch style and
-    design-wide rules; stitches_per_minute / trim_seconds: the machine, for the time."""
+    design-wide rules; stitches_per_minute / trim_seconds: the machine, for the time;
+    name: the design name files store (PES, DST); date: YYYYMMDDhhmmss stored in JEF
+    (fixed by default so that files are the same bytes every run)."""
 
     placement: PlacementOptions = field(default_factory=lambda: PlacementOptions(size=90.0))
     hoop: Hoop = field(default_factory=lambda: hoop_named("100x100"))
@@ -31,8 +38,12 @@ class EmbroideryJob:
     plan: PlanOptions = field(default_factory=PlanOptions)
     stitches_per_minute: float = 600.0
     trim_seconds: float = 10.0
+    name: str = "onestroke"
+    date: str = FIXED_DATE
 
     def __post_init__(self) -> None:
+        if not re.fullmatch(r"\d{14}", str(self.date)):
+            raise InputError(f"date {self.date!r} must be YYYYMMDDhhmmss")
         if not self.stitches_per_minute > 0:
             raise InputError(f"stitches per minute {self.stitches_per_minute:g} must be greater than zero")
         if not self.trim_seconds >= 0:
@@ -64,18 +75,45 @@ def embroider(drawing: Drawing, job: EmbroideryJob = EmbroideryJob()) -> Embroid
         scale = (x1 - x0) / max(px1 - px0, 1e-12)
         warnings.append(f"scaled down to {x1 - x0:.1f} x {y1 - y0:.1f} mm to fit hoop {job.hoop.label}")
     style = job.plan.style
-    if isinstance(style, ZigzagOptions):
-        if style.width < 1.0:
-            warnings.append(f"a zigzag {style.width:g} mm wide hardly shows; the triple style sews a bold line")
-        elif style.width > 7.0:
-            warnings.append(f"zigzag stitches {style.width:g} mm wide lie loose and snag; "
-                            f"they are split only above {job.plan.max_stitch:g} mm")
+    if isinstance(style, ZigzagOptions) and style.width < 1.0:
+        warnings.append(f"a zigzag {style.width:g} mm wide hardly shows; the triple style sews a bold line")
+    if isinstance(style, ZigzagOptions) and style.width > LOOSE_ZIGZAG:
+        warnings.append(f"zigzag stitches {style.width:g} mm wide lie loose and snag (over "
+                        f"{LOOSE_ZIGZAG:g} mm); use a narrower --stitch-width")
     plan = plan_embroidery(hooped, job.plan)
     check_plan_in_hoop(plan, job.hoop)
-    if plan.skipped:
-        warnings.append(f"{plan.skipped} stroke(s) shorter than the minimum stitch were left out")
+    warnings.extend(plan.dropped)
+    warnings.extend(_long_stitch_warnings(plan, style))
+    plan = replace(plan, name=job.name, field=(job.hoop.width, job.hoop.height), date=job.date)
     stats = embroidery_stats(plan, stitches_per_minute=job.stitches_per_minute,
                              trim_seconds=job.trim_seconds)
     warnings.extend(stats.warnings)
-    return EmbroideryResult(drawing=hooped, plan=plan, stats=stats, hoop=job.hoop,
+    return EmbroideryResult(drawing=plan.sewn, plan=plan, stats=stats, hoop=job.hoop,
                             fit_scale=float(scale), warnings=tuple(warnings))
+
+
+# Stitches longer than this (mm) lie loose on the fabric and snag; zigzags wider than
+# LOOSE_ZIGZAG likewise (satin columns are split above about 7-10 mm).
+LOOSE_STITCH = 7.0
+LOOSE_ZIGZAG = 10.0
+
+
+def _long_stitch_warnings(plan: StitchPlan, style) -> list[str]:
+    """A warning when body or motif stitches (not zigzag, warned by width) exceed
+    LOOSE_STITCH, naming the option that makes them."""
+    if isinstance(style, ZigzagOptions):
+        return []
+    a, b = plan.stitches()
+    end = np.flatnonzero(plan.stitch_mask)
+    role = plan.roles[end]
+    length = np.linalg.norm(b - a, axis=1)
+    loose = ((role == BODY) | (role == MOTIF)) & (length > LOOSE_STITCH + 1e-9)
+    if not loose.any():
+        return []
+    arms = loose & (role == MOTIF)
+    if isinstance(style, ArrowOptions) and arms.any():
+        option = "a smaller --arrow-size or --stitch-width"
+    else:
+        option = "a shorter --stitch-length"
+    return [f"{int(loose.sum())} stitches are longer than {LOOSE_STITCH:g} mm (up to "
+            f"{float(length[loose].max()):.1f} mm): they lie loose and snag; use {option}"]

@@ -14,6 +14,7 @@ and the writer's rounding of points already on the grid is then exact.
 from __future__ import annotations
 
 import heapq
+import math
 from dataclasses import dataclass, field
 from typing import Callable, Union
 
@@ -23,7 +24,9 @@ from fabrication.embroidery.arrows import ArrowOptions, arrow_stitch
 from fabrication.embroidery.locks import LockOptions, lock_points, tack_points
 from fabrication.embroidery.needles import (BODY, LOCK, MOTIF, TACK, TRAVEL, UNDERLAY,
                                             NeedlePoints)
+from fabrication.embroidery.order import Start, check_start, sewing_order
 from fabrication.embroidery.running import RunningOptions, running_stitch
+from fabrication.embroidery.thread import RGB, Thread, check_chart
 from fabrication.embroidery.triple import TripleOptions, triple_stitch
 from fabrication.embroidery.zigzag import ZigzagOptions, zigzag_stitch
 from onestroke.errors import FabricationError, InputError
@@ -32,8 +35,13 @@ from vectorize.stroke import Stroke
 
 StyleOptions = Union[RunningOptions, TripleOptions, ZigzagOptions, ArrowOptions]
 
-# Row kinds of a plan (mapped to pyembroidery's commands by the writer).
-STITCH, JUMP, TRIM = 0, 1, 2
+# Row kinds of a plan (mapped to pyembroidery's commands by the writer). COLOR: change to
+# the next thread here (after the lock and trim of the last block).
+STITCH, JUMP, TRIM, COLOR = 0, 1, 2, 3
+
+# A fixed JEF date (YYYYMMDDhhmmss) so files are the same bytes from run to run; callers
+# pass the build's own date (SOURCE_DATE_EPOCH) through `StitchPlan.date`.
+FIXED_DATE = "20000101000000"
 
 # Style name -> options class; the generator for each class is in _GENERATORS.
 STYLES: dict[str, type] = {
@@ -78,15 +86,24 @@ def style_reach(style: StyleOptions) -> float:
 class PlanOptions:
     """style: options of one stitch style; lock: tack and lock form; min_stitch: shortest
     stitch outside locks, mm; max_stitch: longest needle-down move per axis, mm;
-    trim_distance: strokes further apart are trimmed and jumped, mm; color: thread RGB;
-    grid: the files' coordinate step, mm."""
+    trim_distance: strokes further apart are trimmed and jumped, mm; min_stroke: shorter
+    strokes are joined to a neighbour within the trim distance by travel stitches, or
+    dropped, mm; color: thread RGB of strokes without a colour of their own; colors: one
+    RGB per stroke in drawing order (overrides the strokes' colours; the last repeats);
+    thread_chart: catalogue the threads are picked from (see `thread.THREAD_CHARTS`);
+    start: None, 'reverse' or a point (x, y) mm where sewing starts; grid: the files'
+    coordinate step, mm."""
 
     style: StyleOptions = field(default_factory=RunningOptions)
     lock: LockOptions = field(default_factory=LockOptions)
     min_stitch: float = 0.3
     max_stitch: float = 12.1
     trim_distance: float = 3.0
-    color: tuple[int, int, int] = (0, 0, 0)
+    min_stroke: float = 1.0
+    color: RGB = (0, 0, 0)
+    colors: tuple[RGB, ...] = ()
+    thread_chart: str | None = None
+    start: Start = None
     grid: float = 0.1
 
     def __post_init__(self) -> None:
@@ -101,28 +118,63 @@ class PlanOptions:
                              f"{self.min_stitch:g} mm")
         if not self.trim_distance >= 0:
             raise InputError(f"trim distance {self.trim_distance:g} mm must be >= 0")
-        if len(self.color) != 3 or not all(0 <= int(c) <= 255 for c in self.color):
-            raise InputError(f"thread colour {self.color!r} must be three values 0-255")
+        if not 0 <= self.min_stroke <= 100:
+            raise InputError(f"minimum stroke {self.min_stroke:g} mm must lie in [0, 100] mm")
+        walk = getattr(self.style, "stitch_length", None)
+        if walk is not None and walk < self.min_stitch:
+            raise InputError(f"stitch length {walk:g} mm is shorter than the minimum stitch "
+                             f"{self.min_stitch:g} mm; every stitch would be merged away")
+        for rgb in (self.color, *self.colors):
+            Thread(color=rgb)  # validates
+        if self.thread_chart is not None:
+            object.__setattr__(self, "thread_chart", check_chart(self.thread_chart))
+        object.__setattr__(self, "start", check_start(self.start))
 
 
 @dataclass(frozen=True, eq=False)
 class StitchPlan:
     """Rows in sewing order. points (N, 2) mm on the 0.1 mm grid; kinds (N,) STITCH (needle
-    down here), JUMP (move here needle up) or TRIM (cut at the current point); roles (N,)
-    needle roles (BODY, TACK, LOCK, ...); params (N,): stroke index + curve parameter t
-    (NaN on jumps and trims); strokes (N,): index of the drawing's stroke each row sews
-    (-1 on trims and jumps); color: thread RGB; skipped: strokes too short to sew."""
+    down here), JUMP (move here needle up), TRIM (cut at the current point) or COLOR (next
+    thread); roles (N,) needle roles (BODY, TACK, LOCK, ...); params (N,): stroke index +
+    curve parameter t (NaN on jumps and trims); strokes (N,): index of the sewn stroke each
+    row sews (-1 on trims and jumps); threads: one per colour block; blocks (N,): colour
+    block of each row (None: all 0); sewn: the strokes as sewn (rows index into it);
+    dropped: one line per stroke left out; name: the design name files store; field: the
+    hoop (width, height) mm the design is meant for; date: YYYYMMDDhhmmss for JEF."""
 
     points: np.ndarray
     kinds: np.ndarray
     roles: np.ndarray
     params: np.ndarray
     strokes: np.ndarray
-    color: tuple[int, int, int] = (0, 0, 0)
-    skipped: int = 0
+    threads: tuple[Thread, ...] = (Thread(color=(0, 0, 0)),)
+    blocks: np.ndarray | None = None
+    sewn: Drawing | None = None
+    dropped: tuple[str, ...] = ()
+    name: str = "onestroke"
+    field: tuple[float, float] | None = None
+    date: str = FIXED_DATE
+
+    def __post_init__(self) -> None:
+        if self.blocks is None:
+            object.__setattr__(self, "blocks", np.zeros(len(self.points), dtype=np.int64))
 
     def __len__(self) -> int:
         return len(self.points)
+
+    @property
+    def color(self) -> RGB:
+        """RGB of the first thread."""
+        return self.threads[0].color
+
+    @property
+    def skipped(self) -> int:
+        """How many strokes were left out."""
+        return len(self.dropped)
+
+    @property
+    def color_changes(self) -> int:
+        return int((self.kinds == COLOR).sum())
 
     @property
     def needle_mask(self) -> np.ndarray:
@@ -143,7 +195,7 @@ class StitchPlan:
 
     def bounds(self) -> tuple[float, float, float, float]:
         """(xmin, ymin, xmax, ymax) mm of every needle point and jump target."""
-        pts = self.points[self.kinds != TRIM]
+        pts = self.points[self.kinds <= JUMP]
         if not len(pts):
             return (0.0, 0.0, 0.0, 0.0)
         lo, hi = pts.min(axis=0), pts.max(axis=0)
@@ -164,97 +216,183 @@ def _lock_paths(body: NeedlePoints) -> tuple[np.ndarray, np.ndarray]:
     return body.points[ahead], body.points[::-1][back][::-1]
 
 
-def _assemble(drawing: Drawing, options: PlanOptions):
-    """Rows before cleanup: float points, kinds, roles, params; and the skipped count."""
+def _chains(drawing: Drawing, block: tuple[int, ...], options: PlanOptions) -> tuple[list[list[int]], list[str]]:
+    """Group sewn strokes into chains sewn with one tack and one lock. A stroke shorter
+    than `min_stroke` joins its nearer neighbour (same thread, within the trim distance)
+    by a travel stitch; a chain still shorter than `min_stroke` in all is dropped (a knot
+    of tacks and locks on a speck), with a line naming its strokes."""
+    strokes = drawing.strokes
+    n = len(strokes)
+    lengths = [s.length for s in strokes]
+    gap = [np.inf] + [float(np.linalg.norm(strokes[i].start - strokes[i - 1].end))
+                      if block[i] == block[i - 1] else np.inf for i in range(1, n)]
+    joined = [False] * n  # joined[i]: stroke i continues the chain of stroke i - 1
+    for i in range(n):
+        if lengths[i] >= options.min_stroke:
+            continue
+        before = gap[i]
+        after = gap[i + 1] if i + 1 < n else np.inf
+        if before <= options.trim_distance and before <= after:
+            joined[i] = True
+        elif after <= options.trim_distance:
+            joined[i + 1] = True
+    chains: list[list[int]] = []
+    for i in range(n):
+        if joined[i] and chains:
+            chains[-1].append(i)
+        else:
+            chains.append([i])
+    kept, dropped = [], []
+    for chain in chains:
+        total = sum(lengths[i] for i in chain)
+        if total >= max(options.min_stroke, options.min_stitch):
+            kept.append(chain)
+            continue
+        for i in chain:
+            x, y = strokes[i].start
+            dropped.append(f"stroke {i + 1} ({lengths[i]:.2f} mm at {x:.1f}, {y:.1f} mm) was left out: "
+                           f"shorter than --min-stroke {options.min_stroke:g} mm and more than "
+                           f"--trim-distance {options.trim_distance:g} mm from a stroke of its thread")
+    return kept, dropped
+
+
+def _chain_points(drawing: Drawing, chain: list[int], options: PlanOptions, offset: float):
+    """Needle points of one chain: each long stroke by the style's generator, short ones
+    as a plain running stitch with the TRAVEL role; params are stroke index + t."""
     generate = _GENERATORS[type(options.style)]
-    pts, kinds, roles, params, owners = [], [], [], [], []
+    parts, params, owners = [], [], []
+    for index in chain:
+        stroke = drawing.strokes[index]
+        if stroke.length >= options.min_stroke:
+            body = generate(stroke, options.style, offset)
+        else:
+            walk = running_stitch(stroke, RunningOptions(stitch_length=max(options.min_stroke, 0.5)))
+            body = NeedlePoints.of(walk.points, walk.t, TRAVEL)
+        offset += stroke.length
+        parts.append(body)
+        params.append(index + body.t)
+        owners.append(np.full(len(body), index, dtype=np.int64))
+    merged = NeedlePoints.concat(parts)
+    # Monotone parameters over the chain let the lock paths follow it from stroke to stroke.
+    merged = NeedlePoints(merged.points, np.concatenate(params), merged.roles)
+    return merged, np.concatenate(owners), offset
+
+
+def _assemble(drawing: Drawing, block: tuple[int, ...], options: PlanOptions):
+    """Rows before cleanup: float points, kinds, roles, params, owners, blocks; and the
+    lines about dropped strokes."""
+    pts, kinds, roles, params, owners, blocks = [], [], [], [], [], []
     current: np.ndarray | None = None
-    offset, skipped = 0.0, 0
+    current_block = block[0] if block else 0
+    offset = 0.0
 
     def add(p, kind, role, param, owner):
         p = np.atleast_2d(p)
-        owners.append(np.full(len(p), owner, dtype=np.int64))
+        owners.append(np.broadcast_to(np.asarray(owner, dtype=np.int64), (len(p),)))
         pts.append(p)
         kinds.append(np.full(len(p), kind, dtype=np.uint8))
         roles.append(np.broadcast_to(np.asarray(role, dtype=np.uint8), (len(p),)))
         params.append(np.broadcast_to(np.asarray(param, dtype=float), (len(p),)))
+        blocks.append(np.full(len(p), current_block, dtype=np.int64))
 
-    for index, stroke in enumerate(drawing.strokes):
-        length = stroke.length
-        if length < options.min_stitch:
-            skipped += 1
-            offset += length
-            continue
-        body = generate(stroke, options.style, offset)
-        offset += length
+    chains, dropped = _chains(drawing, block, options)
+    for chain in chains:
+        body, owner, offset = _chain_points(drawing, chain, options, offset)
         path = body.points
         connect = TACK
-        if current is not None:
-            if np.linalg.norm(path[0] - current) > options.trim_distance:
+        if current is None:
+            current_block = block[chain[0]]
+        else:
+            if block[chain[0]] != current_block:
+                add(current, TRIM, TRAVEL, np.nan, -1)
+                current_block = block[chain[0]]
+                add(current, COLOR, TRAVEL, np.nan, -1)
+                add(path[0], JUMP, TRAVEL, np.nan, -1)
+            elif np.linalg.norm(path[0] - current) > options.trim_distance:
                 add(current, TRIM, TRAVEL, np.nan, -1)
                 add(path[0], JUMP, TRAVEL, np.nan, -1)
             else:
                 connect = TRAVEL  # a short stitch from the last stroke's end
         head, tail = _lock_paths(body)
-        add(tack_points(head, options.lock), STITCH, [connect, TACK, TACK, TACK], index + body.t[0], index)
+        first, last = chain[0], chain[-1]
+        add(tack_points(head, options.lock), STITCH, [connect, TACK, TACK, TACK], body.t[0], first)
         body_roles = body.roles.copy()
         body_roles[0] = TACK  # the stitch into the start closes the tack
-        add(path, STITCH, body_roles, index + body.t, index)
-        add(lock_points(tail, options.lock), STITCH, LOCK, index + body.t[-1], index)
+        add(path, STITCH, body_roles, body.t, owner)
+        add(lock_points(tail, options.lock), STITCH, LOCK, body.t[-1], last)
         current = path[-1]
     if not pts:
-        raise InputError("no stroke is long enough to stitch "
-                         f"(all shorter than the minimum stitch {options.min_stitch:g} mm)")
+        raise InputError("no stroke is long enough to stitch (all shorter than --min-stroke "
+                         f"{options.min_stroke:g} mm and far from the others)")
     return (np.concatenate(pts), np.concatenate(kinds), np.concatenate(roles),
-            np.concatenate(params), np.concatenate(owners), skipped)
+            np.concatenate(params), np.concatenate(owners), np.concatenate(blocks), tuple(dropped))
 
 
 def _merge_short(units: np.ndarray, kinds: np.ndarray, roles: np.ndarray, min_units: float) -> np.ndarray:
     """Keep-mask: drop zero-length stitches anywhere and body stitches shorter than
     `min_units` (grid units). When the short stitch ends a body (the lock's anchor), the
-    body point before it goes instead. Only short places are visited one by one."""
+    body point before it goes instead. Only short places are visited, in row order; the
+    previous kept row is found through pointers that skip dropped rows with path
+    compression, so the work stays near linear however many rows merge (a run of a
+    million tiny stitches included)."""
     n = len(units)
-    keep = np.ones(n, dtype=bool)
     sewn = np.zeros(n, dtype=bool)
     sewn[1:] = (kinds[1:] == STITCH) & (kinds[:-1] == STITCH)
     d = np.full(n, np.inf)
     d[1:] = np.hypot(*(units[1:] - units[:-1]).T)
     work = np.flatnonzero(sewn & ((d == 0) | ((d < min_units) & _DROPPABLE[roles]))).tolist()
+    if not work:
+        return np.ones(n, dtype=bool)
     heapq.heapify(work)
+    # Plain Python lists: the loop touches single rows, where numpy scalars are slow.
+    ux, uy = units[:, 0].tolist(), units[:, 1].tolist()
+    kind, role = kinds.tolist(), roles.tolist()
+    droppable = _DROPPABLE.tolist()
+    kept = [True] * n
+    # below[i]: a row at or before i - 1 from which the search for the kept row before i
+    # starts; dropped rows are skipped and the pointers shortened on the way.
+    below = list(range(-1, n - 1))
 
     def previous_kept(i: int) -> int:
-        k = i - 1
-        while not keep[k]:
-            k -= 1
+        k = below[i]
+        trail = []
+        while not kept[k]:
+            trail.append(k)
+            k = below[k]
+        for j in trail:
+            below[j] = k
+        below[i] = k
         return k
 
     while work:
         i = heapq.heappop(work)
-        k = previous_kept(i)
-        if not keep[i] or kinds[k] != STITCH or kinds[i] != STITCH:
+        if not kept[i]:
             continue
-        dist = float(np.hypot(*(units[i] - units[k])))
+        k = previous_kept(i)
+        if kind[k] != STITCH or kind[i] != STITCH:
+            continue
+        dist = math.hypot(ux[i] - ux[k], uy[i] - uy[k])
         if dist == 0:
-            keep[i] = False
-        elif dist < min_units and _DROPPABLE[roles[i]]:
-            anchor = i + 1 < n and roles[i + 1] == LOCK and kinds[i + 1] == STITCH
+            kept[i] = False
+        elif dist < min_units and droppable[role[i]]:
+            anchor = i + 1 < n and role[i + 1] == LOCK and kind[i + 1] == STITCH
             if not anchor:
-                keep[i] = False
-            elif _DROPPABLE[roles[k]] and kinds[k - 1] == STITCH:
-                keep[k] = False  # the lock's anchor stays; the body point before it goes
+                kept[i] = False
+            elif droppable[role[k]] and k > 0 and kind[previous_kept(k)] == STITCH:
+                kept[k] = False  # the lock's anchor stays; the body point before it goes
                 heapq.heappush(work, i)
                 continue
             else:
                 # The body shrank to one short stitch: drop its end, the lock stands in.
-                keep[i] = False
+                kept[i] = False
         else:
             continue
         if i + 1 < n:
             heapq.heappush(work, i + 1)  # the next stitch now starts further back
-    return keep
+    return np.array(kept, dtype=bool)
 
 
-def _split_long(units, kinds, roles, params, owners, max_units: int):
+def _split_long(units, kinds, roles, params, owners, blocks, max_units: int):
     """Split needle-down moves longer than `max_units` per axis into real stitches, on the grid."""
     sewn = np.zeros(len(units), dtype=bool)
     sewn[1:] = (kinds[1:] == STITCH) & (kinds[:-1] == STITCH)
@@ -263,7 +401,7 @@ def _split_long(units, kinds, roles, params, owners, max_units: int):
     pieces = np.where(sewn, -(-step // max_units), 1)
     pieces = np.maximum(pieces, 1)
     if pieces.max() == 1:
-        return units, kinds, roles, params, owners
+        return units, kinds, roles, params, owners, blocks
     # Row i becomes pieces[i] rows: intermediate points on the way from row i - 1.
     owner = np.repeat(np.arange(len(units)), pieces)
     k = np.arange(owner.size) - np.repeat(np.cumsum(pieces) - pieces, pieces) + 1
@@ -273,22 +411,39 @@ def _split_long(units, kinds, roles, params, owners, max_units: int):
     new_units = prev + np.floor((units[owner] - prev) * frac[:, None] + 0.5).astype(np.int64)
     prev_param = params[np.maximum(owner - 1, 0)]
     new_params = prev_param + (params[owner] - prev_param) * frac
-    return new_units, kinds[owner], roles[owner], new_params, owners[owner]
+    return new_units, kinds[owner], roles[owner], new_params, owners[owner], blocks[owner]
 
 
 def plan_embroidery(drawing: Drawing, options: PlanOptions = PlanOptions()) -> StitchPlan:
-    """Stitch every stroke of `drawing` (mm, centred on (0, 0)) into one `StitchPlan`."""
+    """Stitch every stroke of `drawing` (mm, centred on (0, 0)) into one `StitchPlan`:
+    colour blocks in sewing order (see `order.sewing_order`), rows indexing `plan.sewn`."""
     if drawing.unit != "mm":
         raise InputError(f"place the drawing in mm before stitching (it is in {drawing.unit})")
     if not drawing.strokes:
         raise InputError("the drawing has no strokes to stitch")
-    points, kinds, roles, params, owners, skipped = _assemble(drawing, options)
+    order = sewing_order(drawing, colors=options.colors, default=options.color,
+                         start=options.start, thread_chart=options.thread_chart)
+    sewn = order.drawing
+    points, kinds, roles, params, owners, blocks, dropped = _assemble(sewn, order.block, options)
+    # Source stroke numbers in the messages, not positions in the sewing order.
+    dropped = tuple(_renumber(line, order.source) for line in dropped)
     units = np.rint(points / options.grid).astype(np.int64)
     keep = _merge_short(units, kinds, roles, options.min_stitch / options.grid - 1e-9)
-    units, kinds, roles, params, owners = units[keep], kinds[keep], roles[keep], params[keep], owners[keep]
+    rows = (units[keep], kinds[keep], roles[keep], params[keep], owners[keep], blocks[keep])
     max_units = int(np.floor(options.max_stitch / options.grid + 1e-9))
-    units, kinds, roles, params, owners = _split_long(units, kinds, roles, params, owners, max_units)
+    units, kinds, roles, params, owners, blocks = _split_long(*rows, max_units)
     if not np.any(kinds == STITCH):
         raise FabricationError("no needle points left after merging short stitches")
+    used = np.unique(blocks)
+    # A block whose strokes were all dropped has no thread in the file.
+    remap = np.full(len(order.threads), -1, dtype=np.int64)
+    remap[used] = np.arange(len(used))
     return StitchPlan(points=units * options.grid, kinds=kinds, roles=roles, params=params,
-                      strokes=owners, color=tuple(int(c) for c in options.color), skipped=skipped)
+                      strokes=owners, threads=tuple(order.threads[i] for i in used),
+                      blocks=remap[blocks], sewn=sewn, dropped=dropped)
+
+
+def _renumber(line: str, source: tuple[int, ...]) -> str:
+    """'stroke 3 ...' (position in the sewing order) -> the stroke's number in the input."""
+    head, number, rest = line.split(" ", 2)
+    return f"{head} {source[int(number) - 1] + 1} {rest}"

@@ -10,6 +10,7 @@ import pyembroidery
 
 from fabrication.embroidery.needles import BODY
 from fabrication.embroidery.plan import JUMP, STITCH, TRIM, StitchPlan
+from fabrication.embroidery.thread import Thread
 from onestroke.errors import InputError
 
 # pyembroidery commands that end a run of thread like a trim does.
@@ -68,5 +69,6 @@ def read_embroidery(path: str | os.PathLike) -> EmbroideryFile:
     threads = tuple(tuple(int(v) for v in (t.get_red(), t.get_green(), t.get_blue()))
                     for t in pattern.threadlist) or ((0, 0, 0),)
     plan = StitchPlan(points=points, kinds=kinds, roles=np.full(len(points), BODY, dtype=np.uint8),
-                      params=params, strokes=np.where(kinds == STITCH, 0, -1), color=threads[0])
+                      params=params, strokes=np.where(kinds == STITCH, 0, -1),
+                      threads=tuple(Thread(color=c) for c in threads), blocks=blocks)
     return EmbroideryFile(plan=plan, threads=threads, color_changes=changes, blocks=blocks)

@@ -7,7 +7,20 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial import cKDTree
 
+from fabrication.embroidery.needles import LOCK, TACK
 from fabrication.embroidery.plan import JUMP, STITCH, TRIM, StitchPlan
+from fabrication.embroidery.thread import Thread
+
+
+@dataclass(frozen=True, kw_only=True)
+class ColorStats:
+    """One colour block: its thread, needle penetrations, thread length (mm) and the
+    sewing time of its stitches and trims (s; the colour change itself counts in the total)."""
+
+    thread: Thread
+    stitches: int
+    thread_length: float
+    seconds: float
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -16,8 +29,8 @@ class EmbroideryStats:
     the lead-in to the first point not at all); trims; color_changes; thread_length: sum
     of needle-down stitch lengths, mm; width / height: extent of the needle points, mm;
     seconds: estimated sewing time; max_density: most needle points within
-    `density_radius` of one needle point (itself included); dense_points: needle points
-    with `density_limit` or more."""
+    `density_radius` of one needle point, both outside tacks and locks (itself included);
+    dense_points: needle points with more than `density_limit`; colors: per block."""
 
     stitches: int
     jumps: int
@@ -32,6 +45,7 @@ class EmbroideryStats:
     dense_points: int
     density_radius: float
     density_limit: int
+    colors: tuple[ColorStats, ...] = ()
 
     @property
     def too_dense(self) -> bool:
@@ -41,7 +55,7 @@ class EmbroideryStats:
     def warnings(self) -> tuple[str, ...]:
         if not self.too_dense:
             return ()
-        return (f"{self.dense_points} needle points have {self.density_limit} or more needle points "
+        return (f"{self.dense_points} needle points have more than {self.density_limit} needle points "
                 f"within {self.density_radius:g} mm (up to {self.max_density}): too dense, the thread "
                 "may pile up or break; use a longer stitch or a wider spacing",)
 
@@ -56,13 +70,25 @@ class EmbroideryStats:
             f"time      {minutes} min {seconds:02d} s at {self.stitches_per_minute:g} spm",
             f"density   max {self.max_density} within {self.density_radius:g} mm"
             + ("  TOO DENSE" if self.too_dense else ""),
-        ]
+        ] + self.color_lines()
+
+    def color_lines(self) -> list[str]:
+        """One line per colour block: thread (catalogue number), stitches, thread, time."""
+        lines = []
+        for k, c in enumerate(self.colors, start=1):
+            minutes, seconds = divmod(int(round(c.seconds)), 60)
+            lines.append(f"colour {k}  {c.thread.label}: {c.stitches:,} stitches, "
+                         f"{c.thread_length / 1000:.2f} m, {minutes} min {seconds:02d} s")
+        return lines
 
 
 def embroidery_stats(plan: StitchPlan, *, stitches_per_minute: float = 600.0,
-                     trim_seconds: float = 10.0, color_changes: int = 0,
+                     trim_seconds: float = 10.0, color_changes: int | None = None,
                      density_radius: float = 0.5, density_limit: int = 6) -> EmbroideryStats:
-    """Measure `plan`. Time = stitches / stitches_per_minute + (trims + colour changes) x trim_seconds."""
+    """Measure `plan`. Time = stitches / stitches_per_minute + (trims + colour changes) x
+    trim_seconds; colour changes default to the plan's own."""
+    if color_changes is None:
+        color_changes = plan.color_changes
     needles = plan.points[plan.kinds == STITCH]
     a, b = plan.stitches()
     thread = float(np.linalg.norm(b - a, axis=1).sum()) if len(a) else 0.0
@@ -73,15 +99,31 @@ def embroidery_stats(plan: StitchPlan, *, stitches_per_minute: float = 600.0,
     jumps = int(run_start[first_needle:].sum())
     trims = int((kinds == TRIM).sum())
     if len(needles):
-        counts = cKDTree(needles).query_ball_point(needles, density_radius, return_length=True)
-        max_density, dense = int(counts.max()), int((counts >= density_limit).sum())
+        # Tacks and locks are dense on purpose: density is measured outside them.
+        roles = plan.roles[plan.kinds == STITCH]
+        sewn = needles[(roles != TACK) & (roles != LOCK)]
+        if not len(sewn):
+            sewn = needles
+        counts = cKDTree(sewn).query_ball_point(sewn, density_radius, return_length=True)
+        max_density, dense = int(counts.max()), int((counts > density_limit).sum())
         lo, hi = needles.min(axis=0), needles.max(axis=0)
     else:
         max_density, dense, lo, hi = 0, 0, np.zeros(2), np.zeros(2)
     seconds = len(needles) / stitches_per_minute * 60.0 + (trims + color_changes) * trim_seconds
+    colors = []
+    stitch_end = np.flatnonzero(plan.stitch_mask)
+    lengths = np.linalg.norm(b - a, axis=1) if len(a) else np.zeros(0)
+    for k, spool in enumerate(plan.threads):
+        mine = plan.blocks == k
+        count = int((mine & (kinds == STITCH)).sum())
+        block_trims = int((mine & (kinds == TRIM)).sum())
+        colors.append(ColorStats(thread=spool, stitches=count,
+                                 thread_length=float(lengths[mine[stitch_end]].sum()),
+                                 seconds=count / stitches_per_minute * 60.0 + block_trims * trim_seconds))
     return EmbroideryStats(stitches=int(len(needles)), jumps=jumps, trims=trims,
                            color_changes=int(color_changes), thread_length=thread,
                            width=float(hi[0] - lo[0]), height=float(hi[1] - lo[1]),
                            seconds=float(seconds), stitches_per_minute=float(stitches_per_minute),
                            max_density=max_density, dense_points=dense,
-                           density_radius=density_radius, density_limit=density_limit)
+                           density_radius=density_radius, density_limit=density_limit,
+                           colors=tuple(colors))

@@ -5,11 +5,16 @@ perpendicular to the local direction by width/2 + pull_compensation/2, alternati
 The direction is the chord over +-reach around the point: the tangent on straight parts
 and arcs, a fan round a sharp corner.
 On tight inner curves the inside points crowd: every other inner point is inset
-(Ink/Stitch's short stitches), the inside reach is capped below the curve radius, and a
-rail point still closer than `min_gap` to the previous one on its rail is dropped (the
-outside fans round a shared inner point). Wide zigzags get a centre-walk underlay sewn
-there and back first (back between the holes of the way out), and zigs longer than
-`max_stitch` are split at staggered points.
+(Ink/Stitch's short stitches; 30 % where points on the rail come closer than 0.35 mm,
+deep enough that the inset holes stay 0.35 mm from their rail neighbours), the inside
+reach is capped below the curve radius, and a rail point still closer than `min_gap` to
+one of the last few on its rail is dropped (the outside fans round a shared inner point):
+no needle goes into a hole next to one it made a moment before. Zigs longer than `max_stitch` are split at
+staggered points. Underlay (sewn first, there and back so the zigzag starts where the
+stroke does), as satin columns use: 'center' a walk along the curve (back between the
+holes of the way out), 'edge' a walk along each rail inset from the edge, 'zigzag' a
+sparse zigzag inset from the edges, out and back in opposite phase; by default a centre
+walk once the zigzag is wider than `underlay_min_width`.
 """
 
 from __future__ import annotations
@@ -29,27 +34,33 @@ from vectorize.stroke import Stroke
 # The inside reach stays below this fraction of the curve radius, so inner points never
 # pass the centre of curvature (they would sew loops and run backwards).
 MAX_INNER_REACH = 0.75
+UNDERLAYS = ("center", "edge", "zigzag", "none")
 
 
 @dataclass(frozen=True, kw_only=True)
 class ZigzagOptions:
     """width: rail to rail in mm; spacing: peak to peak along the curve in mm;
     pull_compensation: mm added to the width (half per side) since the thread pulls the
-    fabric in; underlay: None = centre walk when width > underlay_min_width;
+    fabric in; underlay: 'center', 'edge', 'zigzag' or 'none' (True = 'center', False =
+    'none'), None = 'center' when width > underlay_min_width; underlay_inset: how far
+    edge and zigzag underlay stay inside the edges, mm; underlay_spacing: peak to peak of
+    the zigzag underlay, mm;
     short_stitch_distance / short_stitch_inset: inset every other inner point by this
     fraction of the reach where inner points come closer than that distance; min_gap: the
-    closest two needle points may come on one rail (0.25 mm keeps them >= 0.1 mm apart
+    closest two needle points may come on one rail (0.35 mm keeps them >= 0.2 mm apart
     after snapping to the files' 0.1 mm grid); max_stitch: longer zigs are split."""
 
     width: float = 2.0
     spacing: float = 0.4
     pull_compensation: float = 0.2
-    underlay: bool | None = None
+    underlay: bool | str | None = None
     underlay_min_width: float = 1.5
     underlay_stitch_length: float = 2.0
-    short_stitch_distance: float = 0.25
-    short_stitch_inset: float = 0.15
-    min_gap: float = 0.25
+    underlay_inset: float = 0.4
+    underlay_spacing: float = 3.0
+    short_stitch_distance: float = 0.35
+    short_stitch_inset: float = 0.3
+    min_gap: float = 0.35
     max_stitch: float = 12.1
     tolerance: float = 0.2
 
@@ -65,6 +76,17 @@ class ZigzagOptions:
         if not self.max_stitch > 1.0:
             raise InputError(f"max stitch {self.max_stitch:g} mm must be over 1 mm")
         RunningOptions(stitch_length=self.underlay_stitch_length, tolerance=self.tolerance)
+        if isinstance(self.underlay, str):
+            key = self.underlay.strip().lower().replace("centre", "center")
+            if key not in UNDERLAYS:
+                raise InputError(f"underlay {self.underlay!r} is not one of {', '.join(UNDERLAYS)}")
+            object.__setattr__(self, "underlay", key)
+        elif self.underlay is not None and not isinstance(self.underlay, bool):
+            raise InputError(f"underlay {self.underlay!r} is not one of {', '.join(UNDERLAYS)}")
+        if not self.underlay_inset >= 0:
+            raise InputError(f"underlay inset {self.underlay_inset:g} mm must be >= 0")
+        if not self.underlay_spacing >= 0.5:
+            raise InputError(f"underlay spacing {self.underlay_spacing:g} mm must be at least 0.5 mm")
 
     @property
     def reach(self) -> float:
@@ -72,8 +94,17 @@ class ZigzagOptions:
         return (self.width + self.pull_compensation) / 2.0
 
     @property
+    def underlay_kind(self) -> str:
+        """'center', 'edge', 'zigzag' or 'none' after the defaults."""
+        if self.underlay is None:
+            return "center" if self.width > self.underlay_min_width else "none"
+        if isinstance(self.underlay, bool):
+            return "center" if self.underlay else "none"
+        return self.underlay
+
+    @property
     def has_underlay(self) -> bool:
-        return self.width > self.underlay_min_width if self.underlay is None else bool(self.underlay)
+        return self.underlay_kind != "none"
 
 
 def _drop_crowded(points: np.ndarray, min_gap: float, inner: np.ndarray, *, window: int = 6) -> np.ndarray:
@@ -165,10 +196,48 @@ def zigzag_stitch(stroke: Stroke, options: ZigzagOptions = ZigzagOptions()) -> N
     zig = NeedlePoints.of(points, t, BODY)
     if not options.has_underlay:
         return zig
+    return NeedlePoints.concat([_underlay(stroke, curve, options), zig])
+
+
+def _offset(stroke: Stroke, t: np.ndarray, offset: np.ndarray) -> np.ndarray:
+    """Points at parameters t pushed along the left normal by `offset` (mm, signed)."""
+    tangent = stroke.tangents_at(t)
+    normal = np.column_stack([-tangent[:, 1], tangent[:, 0]])
+    return stroke.points_at(t) + normal * np.asarray(offset, dtype=float).reshape(-1, 1)
+
+
+def _underlay(stroke: Stroke, curve, options: ZigzagOptions) -> NeedlePoints:
+    """Underlay needle points, there and back: they end on the stroke's start."""
     walk = running_stitch(stroke, RunningOptions(stitch_length=options.underlay_stitch_length,
                                                  tolerance=options.tolerance), curve=curve)
-    # The walk back pierces halfway between the holes of the walk out, ending on the start.
-    back_t = np.concatenate([0.5 * (walk.t[:-1] + walk.t[1:])[::-1], [walk.t[0]]])
-    under = NeedlePoints.of(np.concatenate([walk.points, stroke.points_at(back_t)]),
-                            np.concatenate([walk.t, back_t]), UNDERLAY)
-    return NeedlePoints.concat([under, zig])
+    kind = options.underlay_kind
+    inset = max(0.0, options.width / 2.0 - options.underlay_inset)
+    if kind == "center" or inset < 0.2:
+        # The walk back pierces halfway between the holes of the walk out, ending on the start.
+        back_t = np.concatenate([0.5 * (walk.t[:-1] + walk.t[1:])[::-1], [walk.t[0]]])
+        return NeedlePoints.of(np.concatenate([walk.points, stroke.points_at(back_t)]),
+                               np.concatenate([walk.t, back_t]), UNDERLAY)
+    # The inner side of a tight curve cannot reach past its centre of curvature.
+    kappa = np.interp(walk.t, curve.t, curve.curvature)
+    room = MAX_INNER_REACH / np.maximum(np.abs(kappa), 1e-12)
+    left = np.minimum(inset, np.where(kappa > 0, room, np.inf))
+    right = np.minimum(inset, np.where(kappa < 0, room, np.inf))
+    if kind == "edge":
+        out = _offset(stroke, walk.t, left)
+        back = _offset(stroke, walk.t[::-1], -right[::-1])
+        pts = np.concatenate([walk.points[:1], out, back, walk.points[:1]])
+        t = np.concatenate([walk.t[:1], walk.t, walk.t[::-1], walk.t[:1]])
+        return NeedlePoints.of(pts, t, UNDERLAY)
+    # Zigzag underlay: a sparse zigzag out, the opposite phase back.
+    steps = max(2, int(round(2.0 * curve.length / options.underlay_spacing)))
+    s = np.linspace(0.0, curve.length, steps + 1)
+    t = curve.t_at(s)
+    k = np.interp(t, curve.t, curve.curvature)
+    room = MAX_INNER_REACH / np.maximum(np.abs(k), 1e-12)
+    side = np.where(np.arange(len(s)) % 2 == 0, 1.0, -1.0)
+    reach = np.minimum(inset, np.where(side * k > 0, room, np.inf))
+    out = _offset(stroke, t, side * reach)
+    back = _offset(stroke, t[::-1], (-side * np.minimum(inset, np.where(-side * k > 0, room, np.inf)))[::-1])
+    pts = np.concatenate([walk.points[:1], out, back, walk.points[:1]])
+    tt = np.concatenate([walk.t[:1], t, t[::-1], walk.t[:1]])
+    return NeedlePoints.of(pts, tt, UNDERLAY)

@@ -2,6 +2,6 @@
 
 Modules, one job each: `toolpath` (placement to the machine frame, flattening, order),
 `travel_order` (greedy + 2-opt stroke order), `arcs` (G2/G3 fitting), `gcode_write`,
-`gcode_read` (parser and strict validator), `job_time` (GRBL planner model),
-`raster_time` (raster-engraving comparison), `framing`, `preview`.
+`raster_time` (raster-engraving comparison), `preview`. What GRBL does with the G-code
+(validation, arcs, planner, job time, framing) is asked of `machines/`.
 """

@@ -1,10 +1,12 @@
 """Preview of a GRBL G-code file as PNG or SVG (chosen by the output's extension).
 
-Shows the truth of the file, not of the plan: every move is read back with `gcode_read`.
+Shows the truth of the file, not of the plan: every move is read back through GRBL's own
+reading of it (`machines.gcode_program`: arcs drawn as the chords GRBL cuts).
 Burn moves are coloured along the job's order (blue first, through purple and red, to
 yellow last), travel is dashed grey, the first burn is marked with a green ring, machine
 (0, 0) with a cross. The main view is zoomed on the job; a thumbnail shows it on the bed
-outline (travel leaving the view is clipped). The side panel prints the GRBL planner-model time and the length/feed figure.
+outline (travel leaving the view is clipped). The side panel prints the job time
+(`machines.job_time`), which bound sets it (planner or serial link), and the length/feed figure.
 """
 
 from __future__ import annotations
@@ -16,8 +18,9 @@ from pathlib import Path
 import numpy as np
 from PIL import Image, ImageDraw, ImageFont
 
-from fabrication.laser.gcode_read import GcodeMoves, parse_gcode, read_gcode_file
-from fabrication.laser.job_time import JobTime, estimate_moves_time, format_duration
+from machines.gcode_program import ProgramStats, analyze_program, load_program
+from machines.grbl_settings import settings_from_profile
+from machines.job_time import JobTime, estimate_program_time, format_duration
 from machines.laser_profile import LaserProfile, load_laser_profile
 from onestroke.atomic import atomic_open, atomic_write_text, check_writable
 from onestroke.errors import InputError
@@ -48,23 +51,19 @@ class _Scene:
     text: list[str]
 
 
-def _arc_points(a, b, c, kind, max_angle=0.05):
-    ra, rb = a - c, b - c
-    sweep = np.arctan2(ra[0] * rb[1] - ra[1] * rb[0], float(ra @ rb))
-    if kind == 3 and sweep <= 1e-9:
-        sweep += 2 * np.pi
-    if kind == 2 and sweep >= -1e-9:
-        sweep -= 2 * np.pi
-    n = max(2, int(np.ceil(abs(sweep) / max_angle)))
-    t = np.arctan2(ra[1], ra[0]) + sweep * np.arange(1, n + 1) / n
-    pts = c + np.hypot(*ra) * np.c_[np.cos(t), np.sin(t)]
-    pts[-1] = b
-    return pts
+def _bound_text(job: JobTime) -> str:
+    if job.bound == "link":
+        return f"bound: serial link (planner {format_duration(job.planner_seconds)})"
+    return "bound: GRBL planner"
 
 
-def _scene(moves: GcodeMoves, job: JobTime, profile: LaserProfile, name: str) -> _Scene:
+def _scene(stats: ProgramStats, job: JobTime, profile: LaserProfile, name: str, n_lines: int) -> _Scene:
+    moves, seg = stats.moves, stats.segments
     burn_mask = moves.laser_on
     lengths = np.hypot(*(moves.end - moves.start).T)
+    # each move's points as GRBL cuts it (chord ends of its segments)
+    first = np.searchsorted(seg.move, np.arange(len(moves)))
+    last = np.searchsorted(seg.move, np.arange(len(moves)), side="right")
     along = np.cumsum(np.where(burn_mask, lengths, 0.0))
     total = max(along[-1] if len(along) else 0.0, 1e-12)
     burn, travel, current, colours = [], [], [], []
@@ -80,8 +79,7 @@ def _scene(moves: GcodeMoves, job: JobTime, profile: LaserProfile, name: str) ->
             continue
         if start is None:
             start = a
-        pts = _arc_points(a, b, moves.centre[k], moves.kind[k]) if moves.kind[k] >= 2 and np.isfinite(
-            moves.centre[k, 0]) else b[None]
+        pts = seg.end[first[k]:last[k], :2] if last[k] > first[k] else b[None]
         if not current:
             current.append(a[None])
         current.append(pts)
@@ -98,10 +96,11 @@ def _scene(moves: GcodeMoves, job: JobTime, profile: LaserProfile, name: str) ->
         bounds = (0.0, 0.0, profile.bed_width, profile.bed_height)
     burn_len, travel_len = job.burn_length, job.travel_length
     text = [name if len(name) <= 34 else name[:31] + "...",
-            f"time (GRBL planner): {format_duration(job.total_seconds)}",
+            f"time: {format_duration(job.total_seconds)}",
+            _bound_text(job),
             f"length / feed: {format_duration(job.naive_seconds)} (common senders)",
             f"burn {burn_len:.0f} mm, travel {travel_len:.0f} mm",
-            f"{moves.n_lines} lines, {job.blocks} planner blocks",
+            f"{n_lines} lines, {job.blocks} planner blocks",
             f"{'burn area' if burn else 'moves (no burn)'} {bounds[2] - bounds[0]:.1f} x "
             f"{bounds[3] - bounds[1]:.1f} mm",
             f"bed {profile.bed_width:g} x {profile.bed_height:g} mm",
@@ -265,11 +264,11 @@ def render_gcode_preview(gcode_path: str | os.PathLike, out_path: str | os.PathL
         raise InputError(f"preview {str(out_path)!r} must end in {' or '.join(FORMATS)}")
     check_writable(out_path)
     profile = profile or load_laser_profile()
-    lines = read_gcode_file(gcode_path)
-    moves = parse_gcode(lines, laser_mode=profile.laser_mode)
-    if len(moves) == 0:
+    program = load_program(gcode_path)
+    stats = analyze_program(program, settings=settings_from_profile(profile), planner_blocks=profile.planner_blocks)
+    if len(stats.moves) == 0:
         raise InputError(f"G-code file {str(gcode_path)!r} holds no moves to preview")
-    job = estimate_moves_time(moves, profile)
-    scene = _scene(moves, job, profile, Path(gcode_path).name)
+    job = estimate_program_time(program, profile, stats=stats)
+    scene = _scene(stats, job, profile, Path(gcode_path).name, program.n_lines)
     (_render_png if suffix == ".png" else _render_svg)(scene, out_path)
     return job

@@ -9,15 +9,16 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from fabrication.laser.gcode_write import GcodeOptions, comment_line, gcode_lines, gcode_text
-from fabrication.laser.job_time import JobTime, estimate_gcode_time, format_duration
 from fabrication.laser.toolpath import Toolpath, ToolpathOptions, plan_toolpath
+from machines.job_time import JobTime, estimate_job_time, format_duration
+from onestroke.errors import OnestrokeError
 from vectorize.drawing import Drawing
 
 
 @dataclass(frozen=True, kw_only=True, eq=False)
 class LaserProgram:
     """toolpath: the planned burn (mm, machine frame); lines: the program without line
-    endings, header comments first; time: GRBL planner model estimate of `lines`."""
+    endings, header comments first; time: `machines.job_time` estimate of `lines`."""
 
     toolpath: Toolpath
     lines: tuple[str, ...]
@@ -35,14 +36,17 @@ def laser_program(drawing: Drawing, profile, toolpath_options: ToolpathOptions,
     name) goes into the header comment."""
     toolpath = plan_toolpath(drawing, profile, toolpath_options)
     lines = gcode_lines(toolpath, profile, gcode_options)
-    job = estimate_gcode_time(lines, profile)
+    job = estimate_job_time(lines, profile)  # machines/ reads the G-code as GRBL will
+    if job.errors:  # the writer's bug, not the user's input: say so before writing anything
+        line, text = job.errors[0]
+        raise OnestrokeError(f"internal error: GRBL would refuse generated line {line}: {text}")
     w, h = toolpath.size
     power = gcode_options.power
     comments = (
         f"onestroke laser: {name}",
         f"{w:.1f} x {h:.1f} mm, {len(toolpath.paths)} stroke(s), {gcode_options.passes} pass(es)",
         f"feed {gcode_options.feed:g} mm/min, power {power * 100:g}% (S{power * profile.max_power:g})",
-        f"estimated time {format_duration(job.total_seconds)} (GRBL planner model)",
+        f"estimated time {format_duration(job.total_seconds)} ({job.bound_text(profile)})",
         f"profile: {profile.name}",
     )
     return LaserProgram(toolpath=toolpath, lines=tuple(comment_line(c) for c in comments) + tuple(lines),

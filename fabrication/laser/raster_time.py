@@ -4,7 +4,7 @@ The burned paths are drawn into a bitmap of `interval` mm pixels with the beam's
 width; each row with ink becomes one bidirectional scan, as raster senders do it
 ("skip blank" rows and margins): a G0 to the first ink of the row, then collinear G1
 moves across it with the beam switched per run of ink (laser mode, so no stops). The
-moves go through the same GRBL planner model as vector jobs (`job_time.block_times`).
+moves go through the same GRBL planner model as vector jobs (`machines.planner_model.plan_times`).
 """
 
 from __future__ import annotations
@@ -14,9 +14,10 @@ from dataclasses import dataclass
 import numpy as np
 from PIL import Image, ImageDraw
 
-from fabrication.laser.job_time import block_times
 from fabrication.laser.toolpath import Toolpath
+from machines.grbl_settings import kinematics_from_profile
 from machines.laser_profile import LaserProfile
+from machines.planner_model import plan_times
 from onestroke.errors import InputError
 
 MAX_PIXELS = 40_000_000
@@ -83,6 +84,6 @@ def raster_time(toolpath: Toolpath, profile: LaserProfile, *, interval: float = 
         return RasterTime(0.0, 0, interval, 0)
     pts = np.array(points)
     rapid_arr = np.array(rapid)
-    seconds = block_times(pts[:-1], pts[1:], np.full(len(rapid_arr), float(feed)), rapid_arr,
-                          np.zeros(len(rapid_arr), dtype=bool), profile)
+    seconds = plan_times(pts[:-1], pts[1:], np.full(len(rapid_arr), float(feed)), rapid_arr,
+                         np.zeros(len(rapid_arr), dtype=bool), kinematics_from_profile(profile))
     return RasterTime(float(seconds.sum()), len(row_ids), interval, len(rapid_arr))

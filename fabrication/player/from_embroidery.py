@@ -2,7 +2,8 @@
 
 Time model (the one the stats print): every needle point takes 60 / stitches_per_minute
 s, every trim and every colour change `trim_seconds` (a colour change read from a file is
-also a TRIM row of the plan, so it costs both, as in the stats), jumps take no time.
+a TRIM row of the plan that is also counted as a colour change, so it costs both, as in
+the stats), jumps take no time.
 """
 
 from __future__ import annotations
@@ -11,7 +12,8 @@ import os
 
 import numpy as np
 
-from fabrication.embroidery.plan import JUMP, STITCH, TRIM, StitchPlan
+from fabrication.embroidery.plan import COLOR as PLAN_COLOR
+from fabrication.embroidery.plan import STITCH, TRIM, StitchPlan
 from fabrication.embroidery.stats import EmbroideryStats, embroidery_stats
 from fabrication.player.data import COLOR, DOWN, DRAW, TRAVEL, PlayerData, hex_color
 from fabrication.player.data import TRIM as ROW_TRIM
@@ -29,30 +31,32 @@ def stitch_player_data(plan: StitchPlan, *, title: str = "stitches",
                        stats: EmbroideryStats | None = None) -> PlayerData:
     """`PlayerData` of a stitch plan (mm, +y down).
 
-    blocks (N,) int: colour block of each row (None: one block in `plan.color`); a row
-    whose block differs from the previous row's is a colour change. threads: RGB per
-    block (missing ones get filler colours). hoop: (xmin, ymin, xmax, ymax) mm outline.
+    blocks (N,) int: colour block of each row (None: the plan's own `blocks`). threads:
+    RGB per block (None: the plan's threads; blocks past the end get filler colours).
+    A colour change is a COLOR row of the plan, or (in a file read back) a TRIM row whose
+    block differs from the previous row's. hoop: (xmin, ymin, xmax, ymax) mm outline.
     stats: the plan's stats for the info lines (None: measured here).
     """
     kinds_in = np.asarray(plan.kinds)
     n = len(kinds_in)
-    blocks = np.zeros(n, dtype=np.int64) if blocks is None else np.asarray(blocks, dtype=np.int64)
-    threads = tuple(threads) if threads else (tuple(plan.color),)
+    blocks = np.asarray(plan.blocks if blocks is None else blocks, dtype=np.int64)
+    threads = tuple(threads) if threads else tuple(tuple(t.color) for t in plan.threads)
     change = np.zeros(n, dtype=bool)
     change[1:] = blocks[1:] != blocks[:-1]
     change[:1] = blocks[:1] != 0
+    trim = kinds_in == TRIM
+    colour = (kinds_in == PLAN_COLOR) | (trim & change)
     stitch = kinds_in == STITCH
     previous_stitch = np.r_[False, stitch[:-1]]
-    kinds = np.full(n, TRAVEL, dtype=np.uint8)
+    kinds = np.full(n, TRAVEL, dtype=np.uint8)  # JUMP rows stay TRAVEL
     kinds[stitch & previous_stitch] = DRAW
     kinds[stitch & ~previous_stitch] = DOWN
-    kinds[kinds_in == TRIM] = ROW_TRIM
-    kinds[(kinds_in == TRIM) & change] = COLOR
-    kinds[(kinds_in == JUMP)] = TRAVEL
+    kinds[trim] = ROW_TRIM
+    kinds[colour] = COLOR
 
     # cumulative counts, then the stats' own expression, so the last time is its figure
     needles = np.cumsum(stitch)
-    cuts = np.cumsum(kinds_in == TRIM) + np.cumsum(change & (kinds_in == TRIM))
+    cuts = np.cumsum(trim) + np.cumsum(colour)
     times = needles / stitches_per_minute * 60.0 + cuts * trim_seconds
 
     used = int(blocks.max()) + 1 if n else 1
@@ -60,7 +64,7 @@ def stitch_player_data(plan: StitchPlan, *, title: str = "stitches",
                     for b in range(used))
     if stats is None:
         stats = embroidery_stats(plan, stitches_per_minute=stitches_per_minute,
-                                 trim_seconds=trim_seconds, color_changes=int((change & (kinds_in == TRIM)).sum()))
+                                 trim_seconds=trim_seconds, color_changes=int(colour.sum()))
     return PlayerData(
         source="embroidery", title=title, points=np.asarray(plan.points, dtype=float), kinds=kinds,
         colors=blocks, palette=palette, times=times, numbers=needles, number_label="stitch",

@@ -1,9 +1,9 @@
-"""Player rows from a G-code program, timed by the GRBL planner model.
+"""Player rows from a G-code program, timed by `machines.job_time` (GRBL's model).
 
-Each move becomes the chords GRBL cuts it into (arcs: `$12` chords; lines: one row).
-Times come from the planner model's cumulative time per source line, so the player's
-clock ends on the job-time estimate; within a line the time is shared along the chords
-by length.
+Each move becomes the chords GRBL cuts it into (arcs: `$12` chords; lines: one row), as
+`machines.gcode_program` reads them. Times come from the estimate's cumulative time per
+source line, so the player's clock ends on the job-time estimate; within a line the time
+is shared along the chords by length.
 """
 
 from __future__ import annotations
@@ -12,10 +12,11 @@ import os
 
 import numpy as np
 
-from fabrication.laser.gcode_read import parse_gcode, read_gcode_file
-from fabrication.laser.job_time import estimate_moves_time, expand_arcs, format_duration
 from fabrication.laser.preview import order_colours
 from fabrication.player.data import DRAW, TRAVEL, PlayerData, ramp_palette
+from machines.gcode_program import analyze_program, load_program, program_from_lines
+from machines.grbl_settings import settings_from_profile
+from machines.job_time import estimate_program_time, format_duration
 from machines.laser_profile import LaserProfile, load_laser_profile
 from onestroke.errors import InputError
 
@@ -27,13 +28,21 @@ def gcode_player_data(lines, *, title: str = "G-code",
     profile: the machine (time model, bed outline); None uses the default profile. Burn
     moves are coloured along the job's order like the PNG preview; travel is TRAVEL.
     """
+    program = program_from_lines([text.rstrip("\r\n") for text in lines], source=title)
+    return _player_data(program, title, profile)
+
+
+def _player_data(program, title: str, profile: LaserProfile | None) -> PlayerData:
     profile = profile or load_laser_profile()
-    moves = parse_gcode(list(lines), laser_mode=profile.laser_mode)
-    if len(moves) == 0:
+    stats = analyze_program(program, settings=settings_from_profile(profile), planner_blocks=profile.planner_blocks)
+    moves, seg = stats.moves, stats.segments
+    if len(moves) == 0 or len(seg) == 0:
         raise InputError(f"G-code {title!r} holds no moves to play")
-    job = estimate_moves_time(moves, profile)
-    segments, owner = expand_arcs(moves, profile.arc_tolerance)
-    line = moves.line[owner]
+    job = estimate_program_time(program, profile, stats=stats)
+    n_lines = len(job.line_seconds)
+    segments = np.stack([seg.start[:, :2], seg.end[:, :2]], axis=1)
+    owner = seg.move
+    line = job.block_line
     chord = np.hypot(*(segments[:, 1] - segments[:, 0]).T)
 
     # chords of one line share that line's planner time by length (equally if all are 0)
@@ -54,19 +63,19 @@ def gcode_player_data(lines, *, title: str = "G-code",
     # row 0 is where the head starts (the first move's start), then one row per chord
     points = np.vstack([segments[:1, 0], segments[:, 1]])
     kinds = np.r_[TRAVEL, np.where(burn, DRAW, TRAVEL)].astype(np.uint8)
-    info = (f"time (GRBL planner) {format_duration(job.total_seconds)}",
+    info = (f"time {format_duration(job.total_seconds)} ({'serial link' if job.bound == 'link' else 'planner'} bound)",
             f"length / feed {format_duration(job.naive_seconds)}",
             f"burn {job.burn_length:.0f} mm, travel {job.travel_length:.0f} mm",
-            f"{moves.n_lines} lines, {job.blocks} planner blocks",
+            f"{n_lines} lines, {job.blocks} planner blocks",
             f"bed {profile.bed_width:g} x {profile.bed_height:g} mm")
     return PlayerData(
         source="gcode", title=title, points=points, kinds=kinds, colors=np.r_[0, colors],
         palette=palette, times=np.r_[0.0, times], numbers=np.r_[line[0], line] + 1,
-        number_label="line", number_total=int(moves.n_lines), total=float(job.total_seconds),
+        number_label="line", number_total=int(n_lines), total=float(job.total_seconds),
         unit="mm", time_unit="s", y_up=True,
         frame=(0.0, 0.0, float(profile.bed_width), float(profile.bed_height)), info=info)
 
 
 def gcode_file_player_data(path: str | os.PathLike, *, profile: LaserProfile | None = None) -> PlayerData:
     """`PlayerData` of a G-code file (.gcode, .nc, ...)."""
-    return gcode_player_data(read_gcode_file(path), title=os.path.basename(str(path)), profile=profile)
+    return _player_data(load_program(path), os.path.basename(str(path)), profile)

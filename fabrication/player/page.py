@@ -15,6 +15,7 @@ from pathlib import Path
 from fabrication.player.data import PlayerData
 from onestroke.atomic import atomic_write_text, check_writable
 from onestroke.errors import InputError
+from onestroke.paths import check_distinct
 
 PAGE_SUFFIXES = (".html", ".htm")
 
@@ -63,8 +64,7 @@ def write_player_html(data: PlayerData, path: str | os.PathLike, *,
     path = Path(path)
     if path.suffix.lower() not in PAGE_SUFFIXES:
         raise InputError(f"player page {str(path)!r} must end in .html")
-    if source is not None and path.exists() and os.path.samefile(path, source):
-        raise InputError(f"output {str(path)!r} is the input file; choose another name")
+    check_distinct(inputs=[("input", source)], outputs=[("output", path)])
     check_writable(path)
     atomic_write_text(path, player_html(data))
     return path

@@ -10,6 +10,7 @@ edits file, a laser profile) and downloads are made in memory.
 
 from __future__ import annotations
 
+import hashlib
 import json
 import re
 import secrets
@@ -26,8 +27,15 @@ from onestroke.errors import InputError, OnestrokeError
 from vectorize.edits import Edits, edits_from_dict
 
 MAX_BODY = 1 << 20  # 1 MiB: an edits list and option values are a few kB
-COOKIE = "onestroke_studio"
-STATIC = {"app.js": "text/javascript", "style.css": "text/css", "index.html": "text/html"}
+COOKIE = "onestroke_studio"  # + a digest of the token: cookies ignore ports, two studios must not mix
+
+
+def cookie_name(token: str) -> str:
+    return f"{COOKIE}_{hashlib.sha256(token.encode()).hexdigest()[:10]}"
+STATIC = {"app.js": "text/javascript", "api.js": "text/javascript", "panels.js": "text/javascript",
+          "style.css": "text/css", "index.html": "text/html"}
+# The toolpath player's files, served from its own package (`fabrication.player`).
+PLAYER = {"player.js": "text/javascript", "player.css": "text/css"}
 IMAGE_TYPES = {".png": "image/png", ".jpg": "image/jpeg", ".jpeg": "image/jpeg", ".svg": "image/svg+xml",
                ".gif": "image/gif", ".webp": "image/webp"}
 
@@ -52,7 +60,7 @@ class Guard:
             if "=" in part:
                 key, value = part.strip().split("=", 1)
                 cookies[key] = value
-        offered = [query.get("token", ""), headers.get("x-studio-token", ""), cookies.get(COOKIE, "")]
+        offered = [query.get("token", ""), headers.get("x-studio-token", ""), cookies.get(cookie_name(self.token), "")]
         by_url = secrets.compare_digest(offered[0].encode(), self.token.encode())
         return any(secrets.compare_digest(o.encode(), self.token.encode()) for o in offered), by_url
 
@@ -117,12 +125,16 @@ def create_app(session: StudioSession, *, token: str, hosts: set[str]) -> Guard:
 
     async def index(request: Request):
         response = Response(_static("index.html"), media_type="text/html")
-        response.set_cookie(COOKIE, token, httponly=True, samesite="strict")
+        response.set_cookie(cookie_name(token), token, httponly=True, samesite="strict")
         response.headers["Cache-Control"] = "no-store"
         return response
 
     async def static(request: Request):
         name = request.path_params["name"]
+        if name in PLAYER:
+            from fabrication.player import asset_text
+
+            return Response(asset_text(name), media_type=PLAYER[name])
         if name not in STATIC:
             return PlainTextResponse("not found", status_code=404)
         return Response(_static(name), media_type=STATIC[name])

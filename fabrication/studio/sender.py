@@ -13,6 +13,9 @@ from machines.streamer import GrblStreamer, StreamProgress
 from onestroke.errors import OnestrokeError
 
 
+ACTIVE = ("connecting", "streaming", "paused", "aborting")
+
+
 class LaserSender:
     """One job to one port. `status()` is a plain dict for the page."""
 
@@ -31,6 +34,9 @@ class LaserSender:
         return self
 
     def _run(self) -> None:
+        # The final state is set only once the port is closed: a "done" job can be sent
+        # again at once.
+        state, message = "failed", ""
         try:
             handle = open_port(self.port, baud=self.baud)
             with GrblStreamer(handle, name=self.port) as streamer:
@@ -40,12 +46,14 @@ class LaserSender:
                     raise OnestrokeError(f"{self.port} is locked in ALARM: home it ($H) or unlock it ($X) first")
                 self.state = "streaming"
                 result = streamer.stream(self.program, on_progress=self._on_progress)
-                self.state, self.message = "done", f"{result.lines} lines in {result.elapsed:.1f} s"
+                state, message = "done", f"{result.lines} lines in {result.elapsed:.1f} s"
         except OnestrokeError as error:
-            aborted = self.state == "aborting"
-            self.state, self.message = ("aborted" if aborted else "failed"), str(error)
+            state, message = ("aborted" if self.state == "aborting" else "failed"), str(error)
+        except Exception as error:  # noqa: BLE001 - a thread has no caller: the page shows it
+            state, message = "failed", f"{type(error).__name__}: {error}"
         finally:
             self._streamer = None
+            self.state, self.message = state, message
 
     def _on_progress(self, progress: StreamProgress) -> None:
         self.progress = progress
@@ -67,7 +75,8 @@ class LaserSender:
 
     @property
     def running(self) -> bool:
-        return self._thread.is_alive()
+        """True until the job ended and its port is closed."""
+        return self.state in ACTIVE
 
     def wait(self, timeout: float) -> None:
         self._thread.join(timeout)

@@ -9,12 +9,16 @@ with the same options.
 
 from __future__ import annotations
 
+import json
 import os
 import threading
 from pathlib import Path
 
 import numpy as np
 
+# Imported here, in the importing (main) thread: the package installs a Ctrl-C handler when
+# imported, which Python allows only there, and the API calls run in worker threads.
+from fabrication.cli.job_options import embroidery_settings, laser_settings
 from onestroke.atomic import atomic_write_text
 from onestroke.errors import InputError
 from vectorize import VectorizeOptions, vectorize_file
@@ -98,7 +102,6 @@ class StudioSession:
     # -- make it ---------------------------------------------------------------------
     def embroidery(self, edits: Edits, values: dict, extension: str = "pes"):
         """(settings, result) of `onestroke embroider` for these option values."""
-        from fabrication.cli.job_options import embroidery_settings
         from fabrication.embroidery.pipeline import embroider
 
         if extension not in EMBROIDERY_FORMATS:
@@ -106,25 +109,25 @@ class StudioSession:
         values = _clean(values, EMBROIDERY_FIELDS)
         if extension != "pes":
             values.pop("pes_version", None)
-        settings = embroidery_settings(output=f"design.{extension}", **values)
+        # The input's stem names the design in the file, as `onestroke embroider` does.
+        settings = embroidery_settings(output=f"design.{extension}", source=str(self.drawing_path), **values)
         drawing = self.vectorize(edits).drawing
         return settings, embroider(drawing, settings.job)
 
     def embroidery_preview(self, edits: Edits, values: dict) -> dict:
-        """Needle points with their kinds (mm), hoop, stats lines and warnings."""
-        from fabrication.embroidery.plan import STITCH, TRIM
+        """The stitches for the player (`fabrication.player`), stats lines and warnings."""
+        from fabrication.player import stitch_player_data
 
         settings, result = self.embroidery(edits, values)
-        plan, stats = result.plan, result.stats
-        return {"points": np.round(plan.points, 2).tolist(), "kinds": plan.kinds.astype(int).tolist(),
-                "stitch": int(STITCH), "trim": int(TRIM), "color": "#%02x%02x%02x" % tuple(plan.color),
-                "hoop": {"name": result.hoop.name, "width": result.hoop.width, "height": result.hoop.height},
-                "stats": stats.lines(), "stitches": stats.stitches, "seconds": stats.seconds,
-                "warnings": list(settings.warnings) + list(result.warnings)}
+        job, stats, hoop = settings.job, result.stats, result.hoop
+        data = stitch_player_data(result.plan, title=self.drawing_path.stem, stats=stats,
+                                  stitches_per_minute=job.stitches_per_minute, trim_seconds=job.trim_seconds,
+                                  hoop=(-hoop.width / 2, -hoop.height / 2, hoop.width / 2, hoop.height / 2))
+        return {"player": json.loads(data.to_json()), "stats": stats.lines(), "stitches": stats.stitches,
+                "seconds": stats.seconds, "warnings": list(settings.warnings) + list(result.warnings)}
 
     def laser(self, edits: Edits, values: dict):
         """(settings, program) of `onestroke laser` for these option values."""
-        from fabrication.cli.job_options import laser_settings
         from fabrication.laser.program import laser_program
 
         values = _clean(values, LASER_FIELDS)
@@ -137,16 +140,18 @@ class StudioSession:
         return settings, program
 
     def laser_preview(self, edits: Edits, values: dict) -> dict:
-        """Burn paths (mm, +y up), the bed, and the planner's time estimate."""
-        from fabrication.laser.job_time import format_duration
+        """The G-code's moves for the player on the planner's time axis, and the estimate."""
+        from machines.job_time import format_duration
+        from fabrication.player import gcode_player_data
 
         settings, program = self.laser(edits, values)
-        toolpath, time = program.toolpath, program.time
-        return {"paths": [np.round(p.points, 3).tolist() for p in toolpath.paths], "bed": list(toolpath.bed),
-                "bounds": list(toolpath.bounds), "seconds": time.total_seconds,
+        time = program.time
+        data = gcode_player_data(program.lines, title=self.drawing_path.stem, profile=settings.profile)
+        return {"player": json.loads(data.to_json()), "seconds": time.total_seconds,
                 "time": format_duration(time.total_seconds), "naive": format_duration(time.naive_seconds),
                 "burn_length": round(float(time.burn_length), 1), "travel_length": round(float(time.travel_length), 1),
-                "lines": len(program.lines), "warnings": list(settings.warnings)}
+                "lines": len(program.lines), "profile": settings.profile.name,
+                "warnings": list(settings.warnings)}
 
     def export(self, kind: str, edits: Edits, values: dict) -> tuple[str, str, bytes]:
         """(file name, media type, content) of one download."""

@@ -1,9 +1,10 @@
-"""`sim://[?speed=N&profile=FILE.toml&rx=128&blocks=15&laser=1&travel=400x400]`: GRBL as a serial port.
+"""`sim://[?speed=N&profile=FILE.toml&rx=128&blocks=15&laser=1&travel=400x400&drop_hold=0]`: GRBL as a serial port.
 
 The URL opens a `GrblEmulator` on a real pseudo-terminal and talks to it through an
 ordinary `serial.Serial` on that pty, so the host side is the same code path as a USB
 adapter. `speed` is the time scale (default 10: ten times faster than a real machine);
-`profile` a laser profile TOML whose machine to emulate (bed, $30, rates, accelerations).
+`profile` a laser profile TOML whose machine to emulate (bed, $30, rates, accelerations);
+`drop_hold=N` loses the first N feed holds (`!`) on the way, to rehearse a stop.
 """
 
 from __future__ import annotations
@@ -13,7 +14,7 @@ import urllib.parse
 import serial
 from serial.serialutil import PortNotOpenError, SerialBase, SerialException
 
-from machines.emulator import EmulatorOptions, GrblEmulator
+from machines.emulator import EmulatorOptions, Faults, GrblEmulator
 
 DEFAULT_SPEED = 10.0
 
@@ -23,7 +24,7 @@ def parse_sim_url(url: str) -> EmulatorOptions:
     parts = urllib.parse.urlsplit(url)
     if parts.scheme != "sim":
         raise ValueError(f"expected a sim:// URL, got {url!r}")
-    speed, rx, blocks, settings = DEFAULT_SPEED, 128, 15, {}
+    speed, rx, blocks, settings, faults = DEFAULT_SPEED, 128, 15, {}, {}
     for key, values in urllib.parse.parse_qs(parts.query, keep_blank_values=True).items():
         value = values[-1]
         try:
@@ -35,10 +36,12 @@ def parse_sim_url(url: str) -> EmulatorOptions:
                 rx = int(value)
             elif key == "blocks":
                 blocks = int(value)
+            elif key == "drop_hold":
+                faults["drop_hold"] = int(value)
             elif key == "laser":
                 settings[32] = float(int(value))
             elif key == "profile":
-                from machines.emulator import settings_from_profile
+                from machines.grbl_settings import settings_from_profile
                 from machines.laser_profile import load_laser_profile
 
                 try:
@@ -52,12 +55,13 @@ def parse_sim_url(url: str) -> EmulatorOptions:
                 raise KeyError(key)
         except KeyError:
             raise ValueError(f"unknown sim:// parameter {key!r}; use speed, rx, blocks, laser, travel, "
-                             "profile") from None
+                             "profile, drop_hold") from None
         except ValueError as error:
             if str(error).startswith("sim://"):
                 raise
             raise ValueError(f"bad value {value!r} for sim:// parameter {key!r}") from None
-    return EmulatorOptions(time_scale=speed, rx_buffer=rx, planner_blocks=blocks, settings=settings)
+    return EmulatorOptions(time_scale=speed, rx_buffer=rx, planner_blocks=blocks, settings=settings,
+                           faults=Faults(**faults))
 
 
 class Serial(SerialBase):

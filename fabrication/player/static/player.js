@@ -96,7 +96,8 @@ function buildDom(root) {
   dom.stage = el("div", { class: "osp-stage" }, [dom.canvas]);
   root.append(
     el("div", { class: "osp-head" }, [dom.title, readout]),
-    el("div", { class: "osp-main" }, [dom.stage, el("aside", { class: "osp-side" }, [dom.info, dom.legend])]),
+    el("div", { class: "osp-main" }, [dom.stage, el("aside", { class: "osp-side" }, [dom.info, dom.legend,
+      el("p", { class: "osp-keys", text: "space play / pause · ← → step · wheel or + − zoom · drag pan · 0 fit" })])]),
     el("div", { class: "osp-controls" }, [
       dom.back, dom.play, dom.next, dom.scrub, el("label", {}, ["speed ", speed]),
       dom.zoomOut, dom.zoomIn, dom.fit,

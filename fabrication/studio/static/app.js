@@ -1,11 +1,11 @@
 // onestroke studio: the page. Plain JS, no build step; every computation is the server's
 // (the library's), the page only draws, keeps the edits history and sends edits back.
 "use strict";
+import { $, busy, call, report } from "./api.js";
+import { refreshPanel, setupPanels } from "./panels.js";
 
-const TOKEN = new URLSearchParams(location.search).get("token") || "";
 const PAIRINGS = ["crossing", "touching", "third"];
 const COLORS = { crossing: "#1565c0", touching: "#ef6c00", third: "#8e24aa", other: "#757575", start: "#2e7d32" };
-const $ = (id) => document.getElementById(id);
 
 const studio = {
   state: null,            // last answer of /api/state
@@ -20,44 +20,8 @@ const studio = {
 };
 window.studio = studio;
 
-// ---------------------------------------------------------------- server calls
-async function call(path, body, raw = false) {
-  const init = { headers: { "X-Studio-Token": TOKEN } };
-  if (body !== undefined) {
-    init.method = "POST";
-    init.headers["Content-Type"] = "application/json";
-    init.body = JSON.stringify(body);
-  }
-  const response = await fetch(path, init);
-  if (!response.ok) {
-    let message = response.statusText;
-    try { message = (await response.json()).error || message; } catch (e) { /* not JSON */ }
-    throw new Error(message);
-  }
-  return raw ? response : response.json();
-}
-
-let busyCount = 0;
-function busy(on) {
-  busyCount += on ? 1 : -1;
-  $("busy").hidden = busyCount <= 0;
-  document.body.classList.toggle("busy", busyCount > 0);
-}
-
-function report(error) {
-  $("warnings").innerHTML = "";
-  const li = document.createElement("li");
-  li.textContent = "error: " + error.message;
-  $("warnings").appendChild(li);
-}
-
 // ---------------------------------------------------------------- edits and history
 function currentEdits() { return studio.history[studio.at]; }
-
-function blankEdits() {
-  return { format: "onestroke-edits", version: 1, threshold: null, blur: null, multi: null, tolerance: 8, edits: [] };
-}
-
 async function apply(edits, push = true) {
   if (push) {
     studio.history = studio.history.slice(0, studio.at + 1);
@@ -67,8 +31,10 @@ async function apply(edits, push = true) {
   updateButtons();
   const ticket = ++studio.requests;
   busy(true);
+  const started = performance.now();
   try {
     const state = await call("api/state", { edits });
+    state.answered = (performance.now() - started) / 1000;
     if (ticket === studio.requests) show(state);
   } catch (error) {
     report(error);
@@ -171,6 +137,7 @@ function draw() {
   });
   junctionMarkers(g);
   if (studio.pen < 1 || studio.playing) penMarker(g, t, penAt);
+  else $("where").textContent = `${Math.round(t.total)} px, ${s.strokes.length} stroke${s.strokes.length === 1 ? "" : "s"}`;
 }
 
 function arrows(g, t) {
@@ -236,7 +203,7 @@ function show(state) {
   const r = state.report;
   $("summary").textContent = `${r.strokes} stroke${r.strokes === 1 ? "" : "s"}, ${r.intersections} crossing` +
     `${r.intersections === 1 ? "" : "s"}, ${state.edits.edits.length} edit${state.edits.edits.length === 1 ? "" : "s"}` +
-    ` · ${r.seconds.toFixed(2)} s`;
+    ` · ${(state.answered ?? r.seconds).toFixed(2)} s`;
   $("summary").dataset.order = JSON.stringify(state.strokes.map((s) => s.points[0]));
   const list = $("junctions"); list.innerHTML = "";
   for (const j of state.graph.junctions.filter((j) => j.role === "crossing")) {
@@ -350,145 +317,6 @@ function play() {
   requestAnimationFrame(frame);
 }
 
-// ---------------------------------------------------------------- make-it panels
-function formValues(id) {
-  const values = {};
-  for (const el of $(id).elements) {
-    if (!el.name) continue;
-    values[el.name] = el.type === "checkbox" ? el.checked : el.value;
-  }
-  return values;
-}
-function panelOptions(kind) {
-  if (kind === "embroidery") return formValues("embroidery-form");
-  if (kind === "laser") return formValues("laser-form");
-  return {};
-}
-function activeTab() { return document.querySelector("nav .tab.active").dataset.tab; }
-
-let panelTicket = 0;
-async function refreshPanel() {
-  const tab = activeTab();
-  if (tab === "refine" || !studio.state) return;
-  const ticket = ++panelTicket;
-  busy(true);
-  try {
-    const data = await call(`api/${tab}`, { edits: currentEdits(), options: panelOptions(tab) });
-    if (ticket !== panelTicket) return;
-    if (tab === "embroidery") showStitches(data); else showToolpath(data);
-  } catch (error) {
-    $(`${tab}-warnings`).innerHTML = `<li>error: ${error.message}</li>`;
-  } finally {
-    busy(false);
-  }
-}
-
-function previewCanvas(id) {
-  const c = $(id), dpr = window.devicePixelRatio || 1;
-  c.width = Math.round(c.clientWidth * dpr); c.height = Math.round(c.clientHeight * dpr);
-  const g = c.getContext("2d");
-  g.setTransform(dpr, 0, 0, dpr, 0, 0);
-  g.clearRect(0, 0, c.clientWidth, c.clientHeight);
-  return [g, c.clientWidth, c.clientHeight];
-}
-
-function showStitches(data) {
-  const [g, w, h] = previewCanvas("stitches");
-  const hw = data.hoop.width, hh = data.hoop.height;
-  const k = 0.92 * Math.min(w / hw, h / hh);
-  const X = (x) => w / 2 + x * k, Y = (y) => h / 2 + y * k;  // hoop centred on (0, 0), +y down
-  g.strokeStyle = "#bbb"; g.setLineDash([4, 4]); g.strokeRect(X(-hw / 2), Y(-hh / 2), hw * k, hh * k); g.setLineDash([]);
-  const pts = data.points, kinds = data.kinds;
-  g.lineWidth = 1.2;
-  for (let i = 1; i < pts.length; i++) {
-    if (kinds[i] === data.trim) {
-      g.strokeStyle = "#d32f2f"; const [x, y] = [X(pts[i][0]), Y(pts[i][1])];
-      g.beginPath(); g.moveTo(x - 3, y - 3); g.lineTo(x + 3, y + 3); g.moveTo(x + 3, y - 3); g.lineTo(x - 3, y + 3); g.stroke();
-      continue;
-    }
-    const jump = kinds[i] !== data.stitch || kinds[i - 1] !== data.stitch;
-    g.strokeStyle = jump ? "rgba(120,120,120,0.6)" : data.color;
-    g.setLineDash(jump ? [3, 3] : []);
-    g.beginPath(); g.moveTo(X(pts[i - 1][0]), Y(pts[i - 1][1])); g.lineTo(X(pts[i][0]), Y(pts[i][1])); g.stroke();
-  }
-  g.setLineDash([]);
-  g.fillStyle = "#333";
-  for (let i = 0; i < pts.length; i += Math.max(1, Math.floor(pts.length / 4000))) {
-    if (kinds[i] === data.stitch) g.fillRect(X(pts[i][0]) - 0.6, Y(pts[i][1]) - 0.6, 1.2, 1.2);
-  }
-  $("embroidery-stats").textContent = data.stats.join("\n");
-  $("embroidery-warnings").innerHTML = data.warnings.map((m) => `<li>${escapeHtml(m)}</li>`).join("");
-}
-
-function showToolpath(data) {
-  const [g, w, h] = previewCanvas("toolpath");
-  const [x0, y0, x1, y1] = data.bounds;
-  const m = 0.08 * Math.max(x1 - x0, y1 - y0, 1);
-  const k = Math.min(w / (x1 - x0 + 2 * m), h / (y1 - y0 + 2 * m));
-  const X = (x) => (x - x0 + m) * k, Y = (y) => h - (y - y0 + m) * k;  // machine +y up
-  let last = [0, 0];
-  const n = data.paths.length;
-  data.paths.forEach((path, i) => {
-    g.strokeStyle = "rgba(120,120,120,0.7)"; g.setLineDash([3, 3]); g.lineWidth = 1;
-    g.beginPath(); g.moveTo(X(last[0]), Y(last[1])); g.lineTo(X(path[0][0]), Y(path[0][1])); g.stroke();
-    g.setLineDash([]); g.lineWidth = 1.6; g.strokeStyle = hue(n > 1 ? i / (n - 1) : 0);
-    g.beginPath(); g.moveTo(X(path[0][0]), Y(path[0][1]));
-    for (const p of path) g.lineTo(X(p[0]), Y(p[1]));
-    g.stroke();
-    last = path[path.length - 1];
-  });
-  $("laser-time").textContent = `estimated ${data.time} (GRBL planner model; length/feed says ${data.naive}) · ` +
-    `burn ${data.burn_length} mm, travel ${data.travel_length} mm · ${data.lines} lines`;
-  $("laser-warnings").innerHTML = data.warnings.map((m) => `<li>${escapeHtml(m)}</li>`).join("");
-}
-
-function escapeHtml(text) {
-  return text.replace(/[&<>"]/g, (c) => ({ "&": "&amp;", "<": "&lt;", ">": "&gt;", '"': "&quot;" }[c]));
-}
-
-async function download(kind) {
-  busy(true);
-  try {
-    const tab = ["pes", "dst", "jef", "exp", "vp3"].includes(kind) ? "embroidery" : kind === "gcode" ? "laser" : "refine";
-    const response = await call(`api/export/${kind}`, { edits: currentEdits(), options: panelOptions(tab) }, true);
-    const blob = await response.blob();
-    const name = /filename="([^"]+)"/.exec(response.headers.get("Content-Disposition") || "")?.[1] || `drawing.${kind}`;
-    const a = document.createElement("a");
-    a.href = URL.createObjectURL(blob); a.download = name;
-    document.body.appendChild(a); a.click(); a.remove();
-    setTimeout(() => URL.revokeObjectURL(a.href), 10000);
-  } catch (error) {
-    report(error);
-  } finally {
-    busy(false);
-  }
-}
-
-// ---------------------------------------------------------------- send to laser
-let sendTimer = null;
-async function sendAction(action) {
-  try {
-    const status = action === "send"
-      ? await call("api/send", { edits: currentEdits(), options: panelOptions("laser"), port: $("port").value })
-      : await call(`api/send/${action}`, {});
-    showSend(status);
-    if (!sendTimer) sendTimer = setInterval(pollSend, 300);
-  } catch (error) {
-    $("send-status").textContent = "error: " + error.message;
-  }
-}
-async function pollSend() {
-  const status = await call("api/send");
-  showSend(status);
-  if (!["connecting", "streaming", "paused", "aborting"].includes(status.state)) { clearInterval(sendTimer); sendTimer = null; }
-}
-function showSend(s) {
-  $("send-progress").max = s.total || 1; $("send-progress").value = s.acked || 0;
-  $("send-status").textContent = `${s.state}${s.total ? ` · ${s.acked}/${s.total} lines` : ""}` +
-    `${s.machine ? ` · ${s.machine}` : ""}${s.message ? ` · ${s.message}` : ""}`;
-  $("send-status").dataset.state = s.state;
-}
-
 // ---------------------------------------------------------------- wiring
 function settingsEdit(change) {
   const edits = JSON.parse(JSON.stringify(currentEdits()));
@@ -520,15 +348,7 @@ function setup() {
   $("multi").onchange = () => settingsEdit({ multi: $("multi").checked });
   $("play").onclick = play;
   $("scrub").oninput = () => { studio.playing = false; $("play").textContent = "▶ Play"; studio.pen = $("scrub").value / 1000; draw(); };
-  for (const tab of document.querySelectorAll("nav .tab")) {
-    tab.onclick = () => {
-      document.querySelectorAll("nav .tab").forEach((t) => t.classList.toggle("active", t === tab));
-      document.querySelectorAll(".panel").forEach((p) => { p.hidden = p.id !== `tab-${tab.dataset.tab}`; });
-      refreshPanel();
-    };
-  }
-  for (const form of ["embroidery-form", "laser-form"]) $(form).addEventListener("change", refreshPanel);
-  for (const button of document.querySelectorAll("[data-export]")) button.onclick = () => download(button.dataset.export);
+  setupPanels(() => (studio.state ? currentEdits() : null));
   $("save").onclick = async () => {
     try { const r = await call("api/edits", { edits: currentEdits() }); $("summary").textContent += ` · saved ${r.saved}`; }
     catch (error) { report(error); }
@@ -541,7 +361,6 @@ function setup() {
     try { apply(JSON.parse(await file.text())); } catch (error) { report(error); }
     $("open").value = "";
   };
-  for (const action of ["send", "pause", "resume", "abort"]) $(action).onclick = () => sendAction(action);
   studio.image.onload = draw;
   studio.image.src = "api/image";
   (async () => {

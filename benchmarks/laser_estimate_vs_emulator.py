@@ -1,0 +1,110 @@
+"""Benchmark: the job-time estimate against the emulator running the job, streamed.
+
+For every job of benchmarks/laser_time.py (straight lines, the dense spiral, vectorized
+drawings, the examples) and for dense 4,000-line jobs of 0.1 mm segments, it prints:
+- estimate: machines.job_time (planner and serial link modelled; what `onestroke laser`
+  and `onestroke stream` print), and which bound it says dominates;
+- planner: the estimate's planner-only figure;
+- emulator: the machine time of a real character-counting stream (GrblStreamer over a
+  pty at 115,200 baud, 2 ms parse per line) into the GRBL emulator (`sim://`'s machine),
+  run in a child process like firmware on its own CPU: wall time x time scale, from the
+  first byte sent to Idle at the end; median of --repeat runs;
+- diff: estimate / emulator - 1.
+The emulator runs `time_scale` times faster than a machine (wire, parsing and motion all
+scale); the host's own overhead does not scale, so a high scale overstates the time of
+dense jobs. Medians; say the load (`uptime`) with the figures.
+
+    python benchmarks/laser_estimate_vs_emulator.py [--scale 2] [--repeat 1] [--only dense]
+"""
+
+from __future__ import annotations
+
+import argparse
+import multiprocessing as mp
+import os
+import statistics
+import sys
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))
+sys.path.insert(0, str(ROOT / "benchmarks"))
+
+from laser_time import PROFILE, jobs  # noqa: E402
+from machines.emulator import EmulatorOptions, GrblEmulator  # noqa: E402
+from machines.gcode_program import program_from_lines  # noqa: E402
+from machines.job_time import estimate_program_time  # noqa: E402
+from machines.ports import open_port  # noqa: E402
+from machines.streamer import GrblStreamer  # noqa: E402
+from stream_bench import make_job  # noqa: E402
+
+
+def dense_job(lines: int, step: float, feed: float) -> list[str]:
+    """stream_bench's dense single-stroke curve: `lines` G1 moves of `step` mm at `feed` mm/min."""
+    return make_job(lines, step, feed).splitlines()
+
+
+def _serve(conn, scale: float) -> None:
+    emulator = GrblEmulator(EmulatorOptions(time_scale=scale, parse_time=PROFILE.parse_time,
+                                            baud=PROFILE.baud))
+    conn.send(emulator.start_pty())
+    conn.recv()
+    emulator.wait_idle(30.0)
+    conn.send(emulator.stats())
+    emulator.stop()
+
+
+def emulated_seconds(lines: list[str], scale: float) -> tuple[float, float]:
+    """(machine seconds of a character-counting stream, emulator's planner-limited seconds)."""
+    ctx = mp.get_context("fork")
+    parent, child = ctx.Pipe()
+    process = ctx.Process(target=_serve, args=(child, scale), daemon=True)
+    process.start()
+    device = parent.recv()
+    try:
+        with GrblStreamer(open_port(device)) as streamer:
+            streamer.connect()
+            result = streamer.stream(program_from_lines(lines))
+    finally:
+        parent.send("stop")
+    stats = parent.recv()
+    process.join(5)
+    return result.elapsed * scale, stats.planner_limited_time
+
+
+def row(label: str, lines: list[str], scale: float, repeat: int) -> float:
+    job = estimate_program_time(program_from_lines(lines), PROFILE)
+    runs = [emulated_seconds(lines, scale) for _ in range(repeat)]
+    emulated = statistics.median(r[0] for r in runs)
+    diff = job.total_seconds / emulated - 1
+    print(f"{label:46s} {len(lines):6d} {job.total_seconds:9.3f} {job.bound:>7s} {job.planner_seconds:9.3f} "
+          f"{emulated:9.3f} {diff:+7.2%}  (emulator planner-limited {runs[0][1]:.3f})", flush=True)
+    return diff
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--scale", type=float, default=2.0, help="emulator time scale")
+    parser.add_argument("--repeat", type=int, default=1)
+    parser.add_argument("--only", choices=["all", "jobs", "dense"], default="all")
+    args = parser.parse_args()
+    load = os.getloadavg()[0]
+    print(f"emulator {args.scale:g}x, {PROFILE.baud} baud, parse {PROFILE.parse_time * 1000:g} ms/line, "
+          f"RX {PROFILE.rx_buffer} B, {PROFILE.planner_blocks} blocks; load average {load:.1f}")
+    print(f"{'job':46s} {'lines':>6s} {'estimate':>9s} {'bound':>7s} {'planner':>9s} {'emulator':>9s} {'diff':>7s}")
+    diffs = []
+    if args.only in ("all", "jobs"):
+        for label, lines in jobs():
+            diffs.append(row(label, lines, args.scale, args.repeat))
+    if args.only in ("all", "dense"):
+        print("dense jobs: 4,000 lines; the emulator's time is what a character-counting stream at "
+              f"{PROFILE.baud} baud allows")
+        for step, feed in ((0.1, 3000), (0.1, 5000), (0.1, 6000), (0.05, 3000), (0.05, 6000)):
+            diffs.append(row(f"dense {step:g} mm segments, F{feed}", dense_job(4000, step, feed), args.scale,
+                             args.repeat))
+    print(f"largest |diff|: {max(abs(d) for d in diffs):.2%}; finished {time.strftime('%H:%M:%S')}")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,110 @@
+"""Benchmark: how fast the studio answers an edit (the page's POST /api/state round trip).
+
+Prints wall-clock medians and, below them, the CPU seconds the answer took in this
+process (all threads): on a loaded machine the wall time includes waiting for a core.
+
+Run from the repo root: `python benchmarks/studio_edit.py [DRAWING ...]` (default: the
+1000 px examples loops.png, touch-drawing.png and hershey ampersand). After the first
+vectorization, each edit kind is sent REPEATS times through Starlette's test client, the
+way the page sends it, and the median answer time is printed per kind. Every answer is
+for an edit the cache has not seen in that form (a new threshold or blur value, a split
+or merge with the simplification cache emptied first), so the figures are for the stages
+each kind really re-runs: pairing -> traversal and fitting; start/reverse -> nothing but the
+orientation (the fitted curve of the same earlier edits is cached); split/merge ->
+simplification on; threshold/blur/multi -> everything from binarization.
+"""
+
+from __future__ import annotations
+
+import os
+import sys
+import time
+from pathlib import Path
+from statistics import median
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))
+
+from starlette.testclient import TestClient  # noqa: E402
+
+from fabrication.studio.app import create_app  # noqa: E402
+from fabrication.studio.session import StudioSession  # noqa: E402
+from vectorize.edits import PAIRINGS  # noqa: E402
+
+REPEATS = 7
+DEFAULT = ["examples/loops.png", "examples/touch-drawing.png", "examples/hershey-HersheySans1-ampersand.png"]
+
+
+def bench(path: Path) -> dict[str, float]:
+    session = StudioSession(path, edits_path=Path(os.devnull))
+    host = "127.0.0.1:1"
+    client = TestClient(create_app(session, token="t", hosts={host}), base_url=f"http://{host}")
+    client.headers["X-Studio-Token"] = "t"
+    first = time.perf_counter()
+    base = client.get("/api/state").json()
+    first = time.perf_counter() - first
+    edits = base["edits"]
+    crossings = [j for j in base["graph"]["junctions"] if j["role"] == "crossing"] or [None]
+    stroke = base["strokes"][0]["points"]
+
+    cpu: dict[str, list[float]] = {}
+
+    def post(extra: dict, items: list) -> float:
+        start, start_cpu = time.perf_counter(), time.process_time()
+        answer = client.post("/api/state", json={"edits": dict(edits, **extra, edits=items)})
+        assert answer.status_code == 200, answer.text
+        post.cpu = time.process_time() - start_cpu
+        return time.perf_counter() - start
+
+    class Times(dict):
+        """kind -> wall seconds; the CPU seconds of the same answer go to `cpu`."""
+
+        def add(self, kind: str, seconds: float) -> None:
+            self.setdefault(kind, []).append(seconds)
+            cpu.setdefault(kind, []).append(post.cpu)
+
+    times = Times()
+    for rep in range(REPEATS):
+        j = crossings[rep % len(crossings)]
+        if j is not None:
+            other = PAIRINGS[(PAIRINGS.index(j["decision"]) + 1 + rep % 2) % 3]
+            session.cache.solved.clear()
+            times.add("pairing", post({}, [{"kind": "pairing", "at": j["at"], "pairing": other}]))
+            session.cache.simplified.clear()
+            session.cache.solved.clear()
+            times.add("split", post({}, [{"kind": "split", "at": j["at"]}]))
+            split = client.post("/api/state", json={"edits": dict(edits, edits=[{"kind": "split", "at": j["at"]}])})
+            branch = min(split.json()["graph"]["branches"] or [{"at": j["at"]}],
+                         key=lambda b: (b["at"][0] - j["at"][0]) ** 2 + (b["at"][1] - j["at"][1]) ** 2)
+            session.cache.simplified.clear()
+            session.cache.solved.clear()
+            times.add("merge", post({}, [{"kind": "split", "at": j["at"]}, {"kind": "merge", "at": branch["at"]}]))
+        post({}, [])  # the page shows the automatic result before the user picks an end
+        times.add("start", post({}, [{"kind": "start", "at": stroke[-1] if rep % 2 == 0 else stroke[0]}]))
+        times.add("reverse", post({}, [{"kind": "reverse", "at": stroke[len(stroke) // 2]}]))
+        times.add("threshold", post({"threshold": round(0.40 + 0.02 * rep, 2)}, []))
+        times.add("blur", post({"blur": 0.5 + 0.25 * rep}, []))
+        session.cache.front.pop(next((k for k in session.cache.front if k[2]), None), None)
+        times.add("multi", post({"multi": True}, []))
+    result = {k: median(v) for k, v in times.items() if v}
+    result["first"] = first
+    return result, {k: median(v) for k, v in cpu.items() if v}
+
+
+def main() -> None:
+    paths = [Path(p) for p in (sys.argv[1:] or DEFAULT)]
+    print(f"load: {os.getloadavg()[0]:.2f} (1 min), {os.cpu_count()} cores; median of {REPEATS} per edit kind, seconds")
+    kinds = ("first", "pairing", "start", "reverse", "split", "merge", "threshold", "blur", "multi")
+    print(f"{'drawing':40s} " + " ".join(f"{k:>9s}" for k in kinds))
+    for path in paths:
+        from PIL import Image
+
+        with Image.open(path) as picture:
+            size = "x".join(map(str, picture.size))
+        wall, cpu = bench(path)
+        print(f"{path.name + ' ' + size:40s} " + " ".join(f"{wall.get(k, float('nan')):9.3f}" for k in kinds))
+        print(f"{'  CPU s of this process':40s} " + " ".join(f"{cpu.get(k, float('nan')):9.3f}" for k in kinds))
+
+
+if __name__ == "__main__":
+    main()

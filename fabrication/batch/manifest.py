@@ -1,0 +1,77 @@
+"""The batch manifest: which outputs were made from which input with which options.
+
+A small JSON file in the output folder. An output is current when it exists, is not older
+than its input and the manifest records it with the same options key; a second run skips
+such outputs. An input that failed is remembered with its size and time, so that a rerun
+does not try an unchanged bad file again (unless asked to).
+"""
+
+from __future__ import annotations
+
+import json
+import os
+from pathlib import Path
+
+from onestroke.atomic import atomic_write_text
+
+MANIFEST_NAME = "onestroke-batch-manifest.json"
+
+
+def _stamp(path: Path) -> tuple[int, int]:
+    stat = path.stat()
+    return stat.st_mtime_ns, stat.st_size
+
+
+class Manifest:
+    """Read once at the start, updated per finished file, saved atomically (`save`)."""
+
+    def __init__(self, out_dir: str | os.PathLike) -> None:
+        self.path = Path(out_dir) / MANIFEST_NAME
+        self.outputs: dict[str, dict] = {}
+        self.failed: dict[str, dict] = {}
+        try:
+            payload = json.loads(self.path.read_text(encoding="utf-8"))
+            if payload.get("format") == "onestroke-batch-manifest":
+                self.outputs = dict(payload.get("outputs", {}))
+                self.failed = dict(payload.get("failed", {}))
+        except (OSError, ValueError, AttributeError):
+            pass  # no manifest yet, or an unreadable one: everything is made again
+        self.root = Path(out_dir).resolve()
+
+    def _key(self, output: Path) -> str:
+        return output.relative_to(self.root).as_posix()
+
+    def is_current(self, source: Path, name: str, output: Path, key: str) -> bool:
+        """True if `output` was made from `source` with options `key` and is not older."""
+        record = self.outputs.get(self._key(output))
+        if not record or record.get("input") != name or record.get("key") != key:
+            return False
+        try:
+            return output.stat().st_mtime_ns >= source.stat().st_mtime_ns
+        except OSError:
+            return False
+
+    def earlier_failure(self, source: Path, name: str, key: str) -> str | None:
+        """The error of an earlier run on this unchanged input with the same options, if any."""
+        record = self.failed.get(name)
+        try:
+            if record and record.get("key") == key and tuple(record.get("stamp", ())) == _stamp(source):
+                return record.get("error")
+        except OSError:
+            pass
+        return None
+
+    def made(self, name: str, output: Path, key: str) -> None:
+        self.outputs[self._key(output)] = {"input": name, "key": key}
+        self.failed.pop(name, None)
+
+    def failure(self, source: Path, name: str, key: str, error: str) -> None:
+        try:
+            self.failed[name] = {"key": key, "stamp": list(_stamp(source)), "error": error}
+        except OSError:
+            pass  # the input went away: nothing to remember it by
+
+    def save(self) -> None:
+        payload = {"format": "onestroke-batch-manifest", "version": 1,
+                   "outputs": dict(sorted(self.outputs.items())), "failed": dict(sorted(self.failed.items()))}
+        atomic_write_text(self.path, json.dumps(payload, indent=1) + "\n")

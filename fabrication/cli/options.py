@@ -1,0 +1,301 @@
+"""CLI options declared once: click parameter types over `onestroke.units` and one decorator
+per option group (drawing input, placement, output, machine).
+
+Every command spells and checks an option the same way. Values are checked while click
+parses the command line, before any file is read or written; a bad value raises
+`InputError` (one line, exit 2) naming the flag and its documented range. This module
+imports no numpy or library package at import time: `onestroke --help` and the start of
+every command stay fast. Values come back in the library's units (mm, mm/min, percent),
+which `onestroke.units` and `job_options` read back unchanged.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+from collections.abc import Callable
+
+import click
+
+from onestroke import units
+from onestroke.errors import InputError
+
+# Documented ranges (the README's option table repeats them).
+MAX_DESIGN_MM = 10_000.0   # --size/--width/--height: a 10 m design is past any bed or hoop
+MIN_DESIGN_MM = 0.1
+MAX_BLUR_PX = 25.0         # Gaussian sigma on the working image (longest side about 1000-2000 px)
+BAUD_RATES = (9600, 19200, 38400, 57600, 115200, 230400, 250000, 500000, 1000000)
+
+
+def _flag(param: click.Parameter | None) -> str:
+    """The option's long spelling (--size) or the argument's name (SOURCE), for messages."""
+    if param is None:
+        return "value"
+    if isinstance(param, click.Argument):
+        return param.human_readable_name
+    return max(param.opts, key=len)
+
+
+def _range_text(low: float | None, high: float | None, low_open: bool, high_open: bool, unit: str) -> str:
+    def show(v: float) -> str:
+        return f"{v:g}{unit}"
+    if low is not None and high is not None:
+        return f"{'above' if low_open else 'from'} {show(low)} {'to below' if high_open else 'to'} {show(high)}"
+    if low is not None:
+        return f"{'above' if low_open else 'at least'} {show(low)}"
+    return f"{'below' if high_open else 'at most'} {show(high)}"
+
+
+def check_range(value: float, *, what: str, text=None, low: float | None = None, high: float | None = None,
+                low_open: bool = False, high_open: bool = False, unit: str = "", quote: bool = True) -> float:
+    """`value` if finite and within [low, high] (open ends as asked), else `InputError`.
+    `text`: what the user typed, shown in the message (quoted if `quote`)."""
+    shown = repr(value if text is None else text) if quote else str(value if text is None else text).strip()
+    if not math.isfinite(value):
+        raise InputError(f"{what} {shown} is not a finite number")
+    too_low = low is not None and (value <= low if low_open else value < low)
+    too_high = high is not None and (value >= high if high_open else value > high)
+    if too_low or too_high:
+        raise InputError(f"{what} {shown} must be {_range_text(low, high, low_open, high_open, unit)}")
+    return value
+
+
+class _Ranged(click.ParamType):
+    """Base of the numeric types: parse, then check the documented range."""
+
+    unit = ""
+    quote = True  # lengths, speeds, percentages: show the typed text with its unit in quotes
+
+    def __init__(self, low: float | None = None, high: float | None = None, *, low_open: bool = False,
+                 high_open: bool = False) -> None:
+        self.low, self.high, self.low_open, self.high_open = low, high, low_open, high_open
+
+    def parse(self, text, what: str) -> float:
+        raise NotImplementedError
+
+    def convert(self, value, param, ctx):
+        what = _flag(param)
+        number = self.parse(value, what)
+        return check_range(number, what=what, text=value, low=self.low, high=self.high, low_open=self.low_open,
+                           high_open=self.high_open, unit=self.unit, quote=self.quote)
+
+    def get_metavar(self, param, ctx=None) -> str:
+        return self.name.upper()
+
+
+class Number(_Ranged):
+    """A plain finite float (degrees, px, a fraction) within a documented range."""
+
+    name = "number"
+    quote = False
+
+    def __init__(self, low=None, high=None, *, unit: str = "", **kwargs) -> None:
+        super().__init__(low, high, **kwargs)
+        self.unit = unit
+
+    def parse(self, text, what: str) -> float:
+        try:
+            return float(text)
+        except (TypeError, ValueError):
+            raise InputError(f"{what} {text!r} is not a number") from None
+
+
+class Integer(_Ranged):
+    """An integer within a documented range."""
+
+    name = "integer"
+    quote = False
+
+    def parse(self, text, what: str) -> float:
+        try:
+            return int(str(text).strip())
+        except ValueError:
+            raise InputError(f"{what} {text!r} is not a whole number") from None
+
+    def convert(self, value, param, ctx):
+        return int(super().convert(value, param, ctx))
+
+
+class Length(_Ranged):
+    """A length with a unit ("2.5mm", "3in", "9cm"; a bare number is mm), returned in mm."""
+
+    name = "length"
+    unit = " mm"
+
+    def parse(self, text, what: str) -> float:
+        return units.parse_length(text, what=what)
+
+
+class Speed(_Ranged):
+    """A speed ("1500mm/min", "25mm/s"; a bare number is mm/min), returned in mm/min."""
+
+    name = "speed"
+    unit = " mm/min"
+
+    def parse(self, text, what: str) -> float:
+        return units.parse_speed(text, what=what)
+
+
+class Percent(_Ranged):
+    """A percentage ("60%"; a bare number is percent), returned in percent (0-100), which
+    `onestroke.units.parse_fraction` reads back as the same value."""
+
+    name = "percent"
+    unit = "%"
+
+    def parse(self, text, what: str) -> float:
+        return units.parse_fraction(text, what=what) * 100.0
+
+
+class InputFile(click.ParamType):
+    """An existing, readable file (not a folder): checked before any work."""
+
+    name = "file"
+
+    def convert(self, value, param, ctx):
+        path = os.fspath(value)
+        what = "input file" if isinstance(param, click.Argument) or param is None else _flag(param)
+        if os.path.isdir(path):
+            raise InputError(f"{what} {path!r} is a directory, not a file")
+        if not os.path.exists(path):
+            raise InputError(f"{what} {path!r} does not exist")
+        if not os.access(path, os.R_OK):
+            raise InputError(f"{what} {path!r} is not readable (permission denied)")
+        return path
+
+
+class OutputFile(click.ParamType):
+    """A file to write, with one of `suffixes`, in an existing writable folder."""
+
+    name = "file"
+
+    def __init__(self, suffixes: tuple[str, ...]) -> None:
+        self.suffixes = tuple(s.lower() for s in suffixes)
+
+    def convert(self, value, param, ctx):
+        from onestroke.atomic import check_writable
+
+        path = os.fspath(value)
+        suffix = os.path.splitext(path)[1].lower()
+        if self.suffixes and suffix not in self.suffixes:
+            raise InputError(f"cannot write {path!r} ({_flag(param)}): {suffix or 'no extension'!r} is not "
+                             "supported; use a "
+                             f"{', '.join(self.suffixes[:-1])}{' or ' if len(self.suffixes) > 1 else ''}"
+                             f"{self.suffixes[-1]} file")
+        check_writable(path)
+        return path
+
+
+class Port(click.ParamType):
+    """A serial device path, a pyserial URL, or `sim://[?options]` (nothing between // and ?)."""
+
+    name = "port"
+
+    def convert(self, value, param, ctx):
+        text = str(value).strip()
+        if not text:
+            raise InputError(f"{_flag(param)} is empty; give a serial port such as /dev/ttyUSB0 or COM3 "
+                             "(onestroke ports lists them), or sim:// for a dry run")
+        if text.lower().startswith("sim:"):
+            import urllib.parse
+
+            parts = urllib.parse.urlsplit(text)
+            if not text.lower().startswith("sim://") or parts.netloc or parts.path not in ("", "/"):
+                raise InputError(f"{_flag(param)} {text!r}: the emulator is spelled sim:// with options after "
+                                 "'?', e.g. sim://?speed=20")
+        return text
+
+
+class BaudRate(Integer):
+    """One of the serial rates GRBL boards use."""
+
+    name = "baud"
+
+    def convert(self, value, param, ctx):
+        rate = super().convert(value, param, ctx)
+        if rate not in BAUD_RATES:
+            raise InputError(f"{_flag(param)} {value} is not a serial rate GRBL uses; use one of "
+                             f"{', '.join(map(str, BAUD_RATES))} (GRBL 1.1 default: 115200)")
+        return rate
+
+
+# -- decorators ---------------------------------------------------------------------------------
+
+def _apply(function: Callable, decorators: list[Callable]) -> Callable:
+    for decorator in reversed(decorators):
+        function = decorator(function)
+    return function
+
+
+def input_argument(name: str = "source", **kwargs) -> Callable:
+    """The drawing or file a command reads: must exist and be a readable file."""
+    return click.argument(name, type=InputFile(), **kwargs)
+
+
+def output_option(*suffixes: str, help: str, required: bool = True, flags: tuple[str, ...] = ("-o", "--output"),
+                  dest: str | None = None) -> Callable:
+    """An output file option with its accepted suffixes, checked writable before any work."""
+    names = flags + ((dest,) if dest else ())
+    return click.option(*names, required=required, default=None, type=OutputFile(suffixes), help=help)
+
+
+def drawing_input_options(function: Callable | None = None, *, prefix: str = "") -> Callable:
+    """--multi, --threshold, --blur, --classifier: how a raster drawing is vectorized.
+
+    The command receives `multi`, `threshold` (None or in (0, 1)), `blur` (px) and
+    `classifier`, as `common.read_drawing` takes them. `prefix` (e.g. "Raster input: ")
+    starts each help text on commands that also read SVG.
+    """
+    def text(words: str) -> str:
+        return prefix + words if prefix else words[0].upper() + words[1:]
+
+    decorators = [
+        click.option("--multi", is_flag=True, help=text("multi-stroke drawing: keep every ink piece, "
+                                                        "several strokes.")),
+        click.option("--threshold", type=Number(0.0, 1.0, low_open=True, high_open=True), default=None,
+                     help=text("ink threshold, a gray level in (0, 1) with paper = 1 after shading "
+                               "correction; default: Li's method.")),
+        click.option("--blur", type=Number(0.0, MAX_BLUR_PX, unit=" px"), default=0.0, show_default=True,
+                     help=text(f"Gaussian blur sigma in px (0-{MAX_BLUR_PX:g}) before thresholding; helps "
+                               "pencil scans and noisy photos.")),
+        click.option("--classifier", type=click.Choice(["cnn", "geometric"]), default="cnn", show_default=True,
+                     help=text("how crossings are told from touchings.")),
+    ]
+    def decorate(f: Callable) -> Callable:
+        return _apply(f, decorators)
+
+    return decorate(function) if function is not None else decorate
+
+
+def placement_options(default_size: str | None = None) -> Callable:
+    """--size, --width, --height, --rotate: how large the design is (mm) and its turn (degrees).
+
+    The command receives `size`, `width`, `height` (mm or None) and `rotate`, as
+    `job_options` takes them; `default_size` is only named in the help (the job applies it).
+    """
+    side = Length(MIN_DESIGN_MM, MAX_DESIGN_MM)
+    shown = f" [default: {default_size}]" if default_size else ""
+    return lambda function: _apply(function, [
+        click.option("--size", type=side, default=None,
+                     help=f"Longest side of the design, e.g. 90mm, 3.5in ({MIN_DESIGN_MM:g} mm to "
+                          f"{MAX_DESIGN_MM / 1000:g} m){shown}."),
+        click.option("--width", type=side, default=None, help="Width of the design instead of --size."),
+        click.option("--height", type=side, default=None, help="Height of the design instead of --size."),
+        click.option("--rotate", type=Number(-360.0, 360.0, unit=" degrees"), default=0.0, show_default=True,
+                     help="Degrees counter-clockwise, -360 to 360."),
+    ])
+
+
+def machine_options(*, port_required: bool = False, port_help: str | None = None) -> Callable:
+    """--port, --baud, --profile: the GRBL machine a job is for or is sent to.
+
+    The command receives `port` (str or None), `baud` (int) and `profile_path` (str or None).
+    """
+    return lambda function: _apply(function, [
+        click.option("--port", type=Port(), required=port_required, default=None,
+                     help=port_help or "Serial port (/dev/ttyUSB0, COM3) or sim:// for a dry run on the emulator."),
+        click.option("--baud", type=BaudRate(), default=115200, show_default=True,
+                     help="Serial baud rate (GRBL 1.1: 115200)."),
+        click.option("--profile", "profile_path", type=InputFile(), default=None,
+                     help="Laser profile TOML (bed, $30, rates, accelerations...); default: built-in 400x400 mm."),
+    ])

@@ -1,0 +1,119 @@
+// onestroke studio: the make-it panels (embroidery, laser), downloads and "send to laser".
+// Every figure and file comes from the server, i.e. from the library calls the CLI makes.
+"use strict";
+import { $, busy, call, escapeHtml, report } from "./api.js";
+import { createPlayer } from "./player.js";
+
+let edits = () => null;  // the page's current edits state (set by setupPanels)
+
+// ---------------------------------------------------------------- make-it panels
+function formValues(id) {
+  const values = {};
+  for (const el of $(id).elements) {
+    if (!el.name) continue;
+    values[el.name] = el.type === "checkbox" ? el.checked : el.value;
+  }
+  return values;
+}
+function panelOptions(kind) {
+  if (kind === "embroidery") return formValues("embroidery-form");
+  if (kind === "laser") return formValues("laser-form");
+  return {};
+}
+function activeTab() { return document.querySelector("nav .tab.active").dataset.tab; }
+
+let panelTicket = 0;
+export async function refreshPanel() {
+  const tab = activeTab();
+  if (tab === "refine" || !edits()) return;
+  const ticket = ++panelTicket;
+  busy(true);
+  try {
+    const data = await call(`api/${tab}`, { edits: edits(), options: panelOptions(tab) });
+    if (ticket !== panelTicket) return;
+    if (tab === "embroidery") showStitches(data); else showToolpath(data);
+  } catch (error) {
+    $(`${tab}-warnings`).innerHTML = `<li>error: ${error.message}</li>`;
+  } finally {
+    busy(false);
+  }
+}
+
+// Stitches and laser moves play in the project's player (fabrication/player), one per panel.
+const players = {};
+function showPlayer(kind, data) {
+  if (!players[kind]) players[kind] = createPlayer($(`${kind}-player`), data);
+  else players[kind].load(data);
+  players[kind].seek(data.total);  // the finished job first; Play starts it from the beginning
+  window.studio.players = players;
+}
+
+function showStitches(data) {
+  showPlayer("embroidery", data.player);
+  $("embroidery-stats").textContent = data.stats.join("\n");
+  $("embroidery-warnings").innerHTML = data.warnings.map((m) => `<li>${escapeHtml(m)}</li>`).join("");
+}
+
+function showToolpath(data) {
+  showPlayer("laser", data.player);
+  $("laser-time").textContent = `estimated ${data.time} (GRBL planner model; length/feed says ${data.naive}) · ` +
+    `burn ${data.burn_length} mm, travel ${data.travel_length} mm · ${data.lines} lines · profile: ${data.profile}`;
+  $("laser-warnings").innerHTML = data.warnings.map((m) => `<li>${escapeHtml(m)}</li>`).join("");
+}
+
+async function download(kind) {
+  busy(true);
+  try {
+    const tab = ["pes", "dst", "jef", "exp", "vp3"].includes(kind) ? "embroidery" : kind === "gcode" ? "laser" : "refine";
+    const response = await call(`api/export/${kind}`, { edits: edits(), options: panelOptions(tab) }, true);
+    const blob = await response.blob();
+    const name = /filename="([^"]+)"/.exec(response.headers.get("Content-Disposition") || "")?.[1] || `drawing.${kind}`;
+    const a = document.createElement("a");
+    a.href = URL.createObjectURL(blob); a.download = name;
+    document.body.appendChild(a); a.click(); a.remove();
+    setTimeout(() => URL.revokeObjectURL(a.href), 10000);
+  } catch (error) {
+    report(error);
+  } finally {
+    busy(false);
+  }
+}
+
+// ---------------------------------------------------------------- send to laser
+let sendTimer = null;
+async function sendAction(action) {
+  try {
+    const status = action === "send"
+      ? await call("api/send", { edits: edits(), options: panelOptions("laser"), port: $("port").value })
+      : await call(`api/send/${action}`, {});
+    showSend(status);
+    if (!sendTimer) sendTimer = setInterval(pollSend, 300);
+  } catch (error) {
+    $("send-status").textContent = "error: " + error.message;
+  }
+}
+async function pollSend() {
+  const status = await call("api/send");
+  showSend(status);
+  if (!["connecting", "streaming", "paused", "aborting"].includes(status.state)) { clearInterval(sendTimer); sendTimer = null; }
+}
+function showSend(s) {
+  $("send-progress").max = s.total || 1; $("send-progress").value = s.acked || 0;
+  $("send-status").textContent = `${s.state}${s.total ? ` · ${s.acked}/${s.total} lines` : ""}` +
+    `${s.machine ? ` · ${s.machine}` : ""}${s.message ? ` · ${s.message}` : ""}`;
+  $("send-status").dataset.state = s.state;
+}
+
+export function setupPanels(currentEdits) {
+  edits = currentEdits;
+  for (const tab of document.querySelectorAll("nav .tab")) {
+    tab.onclick = () => {
+      document.querySelectorAll("nav .tab").forEach((t) => t.classList.toggle("active", t === tab));
+      document.querySelectorAll(".panel").forEach((p) => { p.hidden = p.id !== `tab-${tab.dataset.tab}`; });
+      refreshPanel();
+    };
+  }
+  for (const form of ["embroidery-form", "laser-form"]) $(form).addEventListener("change", refreshPanel);
+  for (const button of document.querySelectorAll("[data-export]")) button.onclick = () => download(button.dataset.export);
+  for (const action of ["send", "pause", "resume", "abort"]) $(action).onclick = () => sendAction(action);
+}

@@ -1,0 +1,195 @@
+"""How long a G-code job takes on a GRBL 1.1h laser: the one job-time estimate of onestroke.
+
+Two bounds, both modelled:
+- the planner: GRBL's motion planner run over the whole program (`planner_model.plan_times`,
+  the same core the emulator runs block by block);
+- the link and the parser: a character-counting sender at the profile's baud rate into
+  GRBL's RX buffer (`rx_buffer`, 128 bytes), and `parse_time` per line on the controller
+  (2 ms for an ATmega328). A line is parsed once its last byte arrived and the previous
+  line is done; it needs a free planner block (one of `planner_blocks`) for each move,
+  and its `ok` frees its bytes in the sender's count. Blocks run in order, each as soon
+  as it is planned and the previous one has finished.
+Dense jobs of very short moves (0.05-0.1 mm at high feed) are bound by the link and the
+parser; everything else by the planner. `JobTime.bound` says which.
+
+Public API: `estimate_job_time(lines, profile)` and `estimate_program_time(program,
+profile)` -> `JobTime` (with per-line and per-block seconds for progress and players).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from machines.gcode_program import GcodeMoves, Program, ProgramStats, analyze_program, program_from_lines
+from machines.grbl_settings import settings_from_profile
+from machines.laser_profile import LaserProfile
+
+# A USB-serial adapter delivers a burst about half a millisecond after it was written
+# (about 1 ms for a round trip, grbl.md); the emulator uses the same figure.
+USB_LATENCY = 0.0005
+BITS_PER_BYTE = 10  # 8-N-1: start bit, 8 data bits, stop bit
+OK_BYTES = 4  # "ok\r\n"
+
+
+@dataclass(frozen=True, kw_only=True)
+class JobTime:
+    """Seconds a job takes on GRBL, with the break-down.
+
+    total_seconds: the job, the slower of the two bounds interleaved line by line.
+    planner_seconds: the job if lines arrived instantly (planner-limited).
+    link_seconds: time for the last line to be sent, parsed and acknowledged.
+    bound: "planner" or "link" - which one sets the pace (link: total more than 2 %
+    above the planner figure). line_seconds (n_lines,): cumulative seconds at the end of
+    each source line (for an ETA while streaming). block_seconds (B,): each planner
+    block's seconds (planner-limited); block_line (B,) its 0-based source line.
+    burn_seconds / travel_seconds: planner seconds of motion with the beam able to fire
+    (M3/M4, S > 0, not G0) and of the rest; burn_length / travel_length: mm.
+    naive_seconds: length / feed, what common senders show. blocks: planner blocks.
+    errors: (file line, text) of lines GRBL would refuse (see `analyze_program`).
+    """
+
+    total_seconds: float
+    planner_seconds: float
+    link_seconds: float
+    bound: str
+    line_seconds: np.ndarray
+    block_seconds: np.ndarray
+    block_line: np.ndarray
+    burn_seconds: float
+    travel_seconds: float
+    burn_length: float
+    travel_length: float
+    naive_seconds: float
+    blocks: int
+    errors: tuple[tuple[int, str], ...] = ()
+
+    def bound_text(self, profile: LaserProfile) -> str:
+        """One phrase saying which bound sets the job's pace."""
+        if self.bound == "link":
+            return (f"bound by the serial link and parser ({profile.baud} baud, {profile.parse_time * 1000:g} ms a "
+                    f"line; the planner alone: {format_duration(self.planner_seconds)})")
+        return "bound by GRBL's planner"
+
+
+def link_schedule(program: Program, stats: ProgramStats, *, baud: int, rx_buffer: int, parse_time: float,
+                  planner_blocks: int, latency: float = USB_LATENCY) -> tuple[np.ndarray, np.ndarray]:
+    """When each line is acknowledged and each block ends, streamed by character counting.
+
+    Returns (ack (len(program),), block_end (B,)) in seconds from the first byte sent.
+    """
+    byte_time = BITS_PER_BYTE / float(baud)
+    ok_time = latency + OK_BYTES * byte_time
+    seg = stats.segments
+    blocks_of = [[] for _ in range(len(program))]
+    for b, index in enumerate(seg.index.tolist()):
+        if seg.seconds[b] > 0:
+            blocks_of[index].append(b)
+    duration = seg.seconds.tolist()
+    syncs, dwell = stats.syncs.tolist(), stats.dwell.tolist()
+    block_end = np.zeros(len(seg))
+    ack = np.zeros(len(program))
+    inflight: list[tuple[float, int]] = []  # (ack time, bytes) of lines sent, oldest first
+    head = 0
+    used = 0
+    wire_free = 0.0  # when the host's last byte has arrived at the controller
+    parser_free = 0.0
+    ends: list[float] = []  # end time of each block queued so far, in order
+    last_end = 0.0
+    for i, (_, text) in enumerate(program.lines):
+        size = len(text) + 1
+        send = 0.0
+        # character counting: wait for the oldest answers until this line fits
+        while used + size > rx_buffer and head < len(inflight):
+            send = max(send, inflight[head][0])
+            used -= inflight[head][1]
+            head += 1
+        arrived = max(send + latency, wire_free) + size * byte_time
+        wire_free = arrived
+        done = max(arrived, parser_free) + parse_time
+        if syncs[i]:  # M3/M4/M5, M8/M9, G4, S without motion: the planner drains first
+            done = max(done, last_end) + dwell[i]
+            last_end = done
+        for b in blocks_of[i]:
+            if len(ends) >= planner_blocks:  # a free planner block: the one 15 back has run
+                done = max(done, ends[-planner_blocks])
+            last_end = max(last_end, done) + duration[b]
+            ends.append(last_end)
+            block_end[b] = last_end
+        parser_free = done
+        ack[i] = done + ok_time
+        inflight.append((ack[i], size))
+        used += size
+    return ack, block_end
+
+
+def estimate_program_time(program: Program, profile: LaserProfile, *, stats: ProgramStats | None = None,
+                          link: bool = True, allow_settings: bool = False) -> JobTime:
+    """`JobTime` of `program` on the machine `profile` describes (see the module doc).
+
+    link: False models the planner alone (lines arrive instantly). allow_settings: see
+    `analyze_program` (False: `$` lines are reported in `errors`).
+    """
+    if stats is None:
+        stats = analyze_program(program, settings=settings_from_profile(profile),
+                                planner_blocks=profile.planner_blocks, allow_settings=allow_settings)
+    seg, moves = stats.segments, stats.moves
+    seconds = seg.seconds
+    planner = stats.total_seconds
+    n_lines = max(program.n_lines, max((n for n, _ in program.lines), default=0))
+    if link and len(program):
+        ack, block_end = link_schedule(program, stats, baud=profile.baud, rx_buffer=profile.rx_buffer,
+                                       parse_time=profile.parse_time, planner_blocks=profile.planner_blocks)
+        link_total = float(ack[-1])
+        total = max(float(block_end.max()) if len(block_end) else 0.0, link_total, planner)
+        line_done = np.maximum(ack, np.maximum.accumulate(_line_ends(stats, block_end, len(program))))
+    else:
+        link_total, total = 0.0, planner
+        line_done = stats.line_seconds
+    line_seconds = np.zeros(n_lines)
+    numbers = np.array([n - 1 for n, _ in program.lines], dtype=int)
+    if len(numbers):
+        line_seconds[numbers] = line_done
+        line_seconds = np.maximum.accumulate(line_seconds)
+    chord = np.linalg.norm(seg.end - seg.start, axis=1) if len(seg) else np.zeros(0)
+    burn_seg = moves.laser_on[seg.move] if len(seg) and len(moves) else np.zeros(len(seg), dtype=bool)
+    feed = np.where(seg.rapid, profile.rapid_rate, np.nan_to_num(seg.feed, nan=profile.rapid_rate))
+    naive = float((chord / np.maximum(feed, 1e-9)).sum() * 60.0 + stats.dwell.sum())
+    return JobTime(
+        total_seconds=total, planner_seconds=planner, link_seconds=link_total,
+        bound="link" if total > planner * 1.02 + 1e-9 else "planner", line_seconds=line_seconds,
+        block_seconds=seconds, block_line=numbers[seg.index] if len(seg) else np.zeros(0, dtype=int),
+        burn_seconds=float(seconds[burn_seg].sum()), travel_seconds=float(seconds[~burn_seg].sum()),
+        burn_length=float(chord[burn_seg].sum()), travel_length=float(chord[~burn_seg].sum()),
+        naive_seconds=naive, blocks=int((seconds > 0).sum()), errors=stats.errors)
+
+
+def _line_ends(stats: ProgramStats, block_end: np.ndarray, n: int) -> np.ndarray:
+    out = np.zeros(n)
+    if len(block_end):
+        np.maximum.at(out, stats.segments.index, block_end)
+    return out
+
+
+def estimate_job_time(lines: Sequence[str], profile: LaserProfile, *, link: bool = True) -> JobTime:
+    """`JobTime` of G-code given as lines (str, without line ends)."""
+    return estimate_program_time(program_from_lines(lines), profile, link=link)
+
+
+def read_moves(lines: Sequence[str], profile: LaserProfile) -> tuple[GcodeMoves, ProgramStats]:
+    """Every motion command of `lines` as GRBL reads it (for previews and checks)."""
+    program = program_from_lines(lines)
+    stats = analyze_program(program, settings=settings_from_profile(profile), planner_blocks=profile.planner_blocks)
+    return stats.moves, stats
+
+
+def format_duration(seconds: float) -> str:
+    """'1:02:03', '2:05' or '12.3 s'."""
+    if seconds < 60:
+        return f"{seconds:.1f} s"
+    whole = int(round(seconds))
+    h, rest = divmod(whole, 3600)
+    m, s = divmod(rest, 60)
+    return f"{h}:{m:02d}:{s:02d}" if h else f"{m}:{s:02d}"

@@ -1,0 +1,75 @@
+"""The GRBL emulator on a real pseudo-terminal, driven with plain pyserial: shared fixtures
+of the transport, protocol and motion tests."""
+
+import time
+
+import pytest
+import serial
+
+from machines.emulator import EmulatorOptions, GrblEmulator
+
+
+class Link:
+    """A raw pyserial connection to an emulator, reading whole lines."""
+
+    def __init__(self, **options):
+        self.emu = GrblEmulator(EmulatorOptions(**options))
+        self.port = serial.Serial(self.emu.start_pty(), 115200, timeout=0.05)
+        self.buffer = b""
+
+    def lines(self, wait=0.3, until=None):
+        out, deadline = [], time.monotonic() + wait
+        while time.monotonic() < deadline:
+            self.buffer += self.port.read(self.port.in_waiting or 1)
+            while b"\n" in self.buffer:
+                line, _, self.buffer = self.buffer.partition(b"\n")
+                line = line.strip()
+                if line:
+                    out.append(line.decode("latin-1"))
+                    if until is not None and until(out[-1]):
+                        return out
+        return out
+
+    def send(self, data, until=None, wait=2.0):
+        self.port.write(data)
+        return self.lines(wait, until)
+
+    def close(self):
+        self.port.close()
+        self.emu.stop()
+
+
+@pytest.fixture
+def link():
+    made = []
+
+    def make(**options):
+        options.setdefault("time_scale", 50.0)
+        made.append(Link(**options))
+        made[-1].lines(0.2)  # boot welcome
+        return made[-1]
+
+    yield make
+    for item in made:
+        item.close()
+
+
+def answered(line):
+    return line == "ok" or line.startswith("error:")
+
+
+@pytest.fixture
+def emulator():
+    """make(**EmulatorOptions) -> a started emulator on a pty (default 40x), stopped afterwards."""
+    made = []
+
+    def make(**options):
+        options.setdefault("time_scale", 40.0)
+        emu = GrblEmulator(EmulatorOptions(**options))
+        emu.start_pty()
+        made.append(emu)
+        return emu
+
+    yield make
+    for emu in made:
+        emu.stop()

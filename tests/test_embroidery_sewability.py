@@ -1,0 +1,119 @@
+"""What an embroiderer checks (issue 13): no piled-up holes, no knots on specks, loose
+stitches warned about, and the short-stroke rule; measured on real plans over a table of
+drawings and styles."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from embroidery_fixtures import (STYLE_NAMES, design, needle_runs, repeated_penetrations, spiral,
+                                 worst_density)
+from fabrication.embroidery.needles import LOCK, TACK, TRAVEL
+from fabrication.embroidery.pipeline import EmbroideryJob, embroider
+from fabrication.embroidery.plan import STITCH, PlanOptions, plan_embroidery, style_options
+from fabrication.embroidery.stats import embroidery_stats
+from fabrication.placement import PlacementOptions
+from machines.hoops import hoop_named
+from vectorize.drawing import Drawing
+from vectorize.stroke import Stroke
+
+
+def _line(a, b) -> Stroke:
+    return Stroke.from_polyline(np.array([a, b], dtype=float))
+
+
+def _loops() -> Drawing:
+    """Three loops of a cursive line (like examples/loops.png): tight curves, a crossing."""
+    t = np.linspace(0.0, 3 * 2 * np.pi, 600)
+    x, y = 8.0 * t / (2 * np.pi) + 6.0 * np.cos(t), -9.0 * np.sin(t)
+    return Drawing((Stroke.from_polyline(np.c_[x, y]),), 40, 20, "mm")
+
+
+DRAWINGS = {
+    "design": design,
+    "tight spiral": lambda: Drawing((spiral(0, 0, 2.0, 9.0, 3.0, n=48),), 20, 20, "mm"),
+    "loops": _loops,
+    "hairpin": lambda: Drawing((Stroke.from_polyline(np.array([[0, 0], [20, 0], [20, 0.8], [0, 0.8]])),),
+                               20, 1, "mm"),
+}
+
+
+@pytest.mark.parametrize("drawing", list(DRAWINGS))
+@pytest.mark.parametrize("style", STYLE_NAMES)
+def test_no_repeated_holes_and_no_dense_places_outside_locks(drawing, style):
+    plan = plan_embroidery(DRAWINGS[drawing](), PlanOptions(style=style_options(style)))
+    assert repeated_penetrations(plan) == 0
+    density = worst_density(plan)
+    assert density <= 6
+    # The stats report the same worst density, and no warning when it is fine.
+    stats = embroidery_stats(plan)
+    assert stats.max_density == density and not stats.too_dense
+
+
+def test_the_penetration_check_sees_a_bean_stitch_in_the_same_holes():
+    """The measure is not blind: the classic bean stitch (0, 1, 0, 1, 2, 1, 2 ...) re-enters
+    its holes two penetrations later, and is caught."""
+    plan = plan_embroidery(Drawing((_line([0, 0], [20, 0]),), 20, 1, "mm"),
+                           PlanOptions(style=style_options("running")))
+    rows = np.flatnonzero(plan.roles == 0)  # body rows
+    bean = np.concatenate([[rows[0]], np.ravel([[i, i - 1, i] for i in rows[1:]])])
+    order = np.concatenate([np.arange(rows[0]), bean, np.arange(rows[-1] + 1, len(plan))])
+    from dataclasses import replace
+
+    copied = replace(plan, points=plan.points[order], kinds=plan.kinds[order], roles=plan.roles[order],
+                     params=plan.params[order], strokes=plan.strokes[order], blocks=plan.blocks[order])
+    assert repeated_penetrations(copied) > 0
+
+
+@pytest.mark.parametrize("style, options, flag", [
+    ("running", dict(stitch_length=9.0), "--stitch-length"),
+    ("triple", dict(stitch_length=9.0), "--stitch-length"),
+    ("arrows", dict(size=8.0, width=6.0, spacing=12.0), "--arrow-size"),
+    ("zigzag", dict(width=11.0), "--stitch-width"),
+])
+def test_long_stitches_are_warned_about_naming_the_option(style, options, flag):
+    drawing = Drawing((_line([0, 0], [60, 0]), _line([60, 10], [0, 30])), 60, 30, "mm")
+    job = EmbroideryJob(placement=PlacementOptions(size=60.0), hoop=hoop_named("130x180"),
+                        plan=PlanOptions(style=style_options(style, **options)))
+    result = embroider(drawing, job)
+    assert any("snag" in w and flag in w for w in result.warnings), result.warnings
+    quiet = embroider(drawing, EmbroideryJob(placement=PlacementOptions(size=60.0), hoop=hoop_named("130x180"),
+                                             plan=PlanOptions(style=style_options(style))))
+    assert not any("snag" in w for w in quiet.warnings)
+
+
+def test_a_speck_next_to_a_stroke_is_joined_by_travel_stitches_without_a_knot():
+    spur = _line([30.3, 0.2], [30.5, 0.5])  # 0.36 mm, 0.36 mm from the line's end
+    drawing = Drawing((_line([0, 0], [30, 0]), spur, _line([30.5, 3], [30.5, 20])), 40, 20, "mm")
+    plan = plan_embroidery(drawing, PlanOptions())
+    needle = plan.kinds == STITCH
+    # One tack per chain, one lock: the spur has neither of its own; its stitches travel.
+    spur_rows = np.flatnonzero(needle & (plan.strokes == 1))
+    assert len(spur_rows) and set(plan.roles[spur_rows]) <= {TRAVEL, LOCK}
+    assert (plan.roles[needle] == LOCK).sum() == 2 * 4  # the line+spur chain, the last line
+    assert (plan.roles[needle] == TACK).sum() == 5 + 4  # the second is reached by a travel stitch
+    assert not plan.dropped
+    # No knot: counting every needle point, locks included, around the spur.
+    pts = plan.points[needle]
+    around = np.linalg.norm(pts - np.array([30.4, 0.35]), axis=1) < 0.5
+    assert around.sum() <= 6
+
+
+def test_a_lone_speck_is_left_out_with_a_warning_naming_it():
+    drawing = Drawing((_line([0, 0], [30, 0]), _line([10, 15], [10.4, 15.2])), 30, 20, "mm")
+    result = embroider(drawing, EmbroideryJob(placement=PlacementOptions(size=30.0)))
+    assert set(np.unique(result.plan.strokes[result.plan.kinds == STITCH])) == {0}
+    assert any(w.startswith("stroke 2 ") and "--min-stroke" in w for w in result.warnings), result.warnings
+    # Its tack, lock and trim are gone with it: one run of thread, no trim.
+    assert len(needle_runs(result.plan)) == 1
+    # --min-stroke 0 sews it as before, with its own tack and lock.
+    kept = plan_embroidery(result.drawing, PlanOptions(min_stroke=0.0))
+    assert (kept.kinds != STITCH).any() and not kept.dropped
+
+
+def test_every_stroke_still_starts_with_a_tack_and_ends_with_a_lock():
+    plan = plan_embroidery(design(), PlanOptions(style=style_options("zigzag")))
+    for run in needle_runs(plan):
+        roles = plan.roles[run]
+        assert roles[1] == TACK and roles[-1] == LOCK

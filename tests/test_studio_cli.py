@@ -1,0 +1,51 @@
+"""`onestroke studio` as a user runs it: a real process on 127.0.0.1, its printed address,
+the page and the API answering, Ctrl-C stopping it; bad input refused in one line."""
+
+from __future__ import annotations
+
+import os
+import re
+import signal
+import subprocess
+import sys
+from pathlib import Path
+
+import httpx
+from click.testing import CliRunner
+
+from fabrication.cli import main
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def test_studio_serves_the_page_and_stops_on_ctrl_c(tmp_path):
+    env = dict(os.environ, PYTHONPATH=str(ROOT))
+    process = subprocess.Popen(
+        [sys.executable, "-c", "import signal; signal.signal(signal.SIGINT, signal.default_int_handler); "
+         "from fabrication.cli import main; main()", "studio", str(ROOT / "examples" / "loops.png"),
+         "--no-browser", "--edits", str(tmp_path / "e.json")],
+        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env)
+    try:
+        line = process.stdout.readline()
+        url = re.search(r"http://127\.0\.0\.1:\d+/\?token=\S+", line)
+        assert url, line + process.stderr.read()
+        with httpx.Client() as client:
+            page = client.get(url.group(0))
+            assert page.status_code == 200 and "onestroke studio" in page.text
+            state = client.get(url.group(0).split("?")[0] + "api/state")  # the cookie carries the token
+            assert state.status_code == 200 and state.json()["report"]["strokes"] == 1
+            assert httpx.get(url.group(0).split("?")[0] + "api/state").status_code == 403
+    finally:
+        process.send_signal(signal.SIGINT)
+        out, err = process.communicate(timeout=20)
+    assert process.returncode == 0, err
+    assert "Traceback" not in err
+
+
+def test_studio_refuses_bad_input(tmp_path):
+    run = CliRunner().invoke(main, ["studio", str(tmp_path / "missing.png"), "--no-browser"])
+    assert run.exit_code == 2 and "does not exist" in run.output
+    (tmp_path / "bad.json").write_text("{")
+    run = CliRunner().invoke(main, ["studio", str(ROOT / "examples" / "loops.png"), "--no-browser",
+                                    "--edits", str(tmp_path / "bad.json")])
+    assert run.exit_code == 2 and "not JSON" in run.output
