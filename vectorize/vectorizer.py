@@ -201,7 +201,7 @@ def _order(graph: MedialGraph, ink, options: VectorizeOptions, ends: int, clock:
     if refine is not None:
         refine.fix_pairings(junctions, ranked, costs)
     if options.multi:
-        ordering, tried = order_strokes(graph, simple, ranked, costs, stroke_width=w, search=False)
+        ordering, tried = order_strokes(graph, simple, ranked, costs, stroke_width=w)
     else:
         ordering, tried = _single_route(graph, simple, ranked, costs, w)
     clock.lap("traversal")
