@@ -1,6 +1,10 @@
 """The GRBL emulator on a real pseudo-terminal, driven with plain pyserial: shared fixtures
 of the transport, protocol and motion tests."""
 
+import os
+import signal
+import subprocess
+import sys
 import time
 
 import pytest
@@ -73,3 +77,18 @@ def emulator():
     yield make
     for emu in made:
         emu.stop()
+
+
+def hear_ctrl_c():
+    """In a child about to exec: take Ctrl-C (SIGINT) again. A shell starts background
+    jobs with SIGINT ignored, and a child inherits that, so a test suite run in the
+    background would otherwise send its Ctrl-C to a process that cannot hear it."""
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+
+
+def stream_in_child(path, port: str) -> subprocess.Popen:
+    """`onestroke stream PATH --port PORT` in a child process (stderr piped, hears Ctrl-C)."""
+    env = {**os.environ, "PYTHONUNBUFFERED": "1"}
+    return subprocess.Popen([sys.executable, "-c", "from fabrication.cli import main; main()", "stream",
+                             str(path), "--port", port], stderr=subprocess.PIPE, text=True, env=env,
+                            preexec_fn=hear_ctrl_c)

@@ -196,13 +196,14 @@ def test_ctrl_c_keeps_finished_outputs_and_leaves_no_partial_file(first_run, tmp
     root, _, out, _ = first_run
     mine = tmp_path / "out"
     env = _child_env()
+    # its own process group, which Ctrl-C in a terminal signals as a whole (client and workers)
     process = subprocess.Popen([sys.executable, "-m", "fabrication.cli", "batch", str(root / "in"), "-o", str(mine),
-                                "--to", "svg", "--jobs", "1"], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                               env=env, preexec_fn=_take_ctrl_c)
+                                "--to", "svg", "--jobs", "2"], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                               env=env, preexec_fn=_take_ctrl_c, start_new_session=True)
     deadline = time.monotonic() + 120
     while not list(mine.rglob("*.svg")) and time.monotonic() < deadline and process.poll() is None:
         time.sleep(0.05)
-    process.send_signal(signal.SIGINT)
+    os.killpg(process.pid, signal.SIGINT)
     _, stderr = process.communicate(timeout=120)
     assert process.returncode == 130, stderr
     assert b"interrupted" in stderr and b"Traceback" not in stderr

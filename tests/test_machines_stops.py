@@ -9,15 +9,13 @@ from __future__ import annotations
 import os
 import re
 import signal
-import subprocess
-import sys
 import threading
 import time
 
 import pytest
 from click.testing import CliRunner
 
-from emulator_fixtures import emulator  # noqa: F401 - pytest fixture
+from emulator_fixtures import emulator, stream_in_child  # noqa: F401 - emulator: a pytest fixture
 from fabrication.cli import main
 from fabrication.cli.stream_cmd import run_stream
 from machines.emulator import Faults
@@ -25,7 +23,7 @@ from machines.gcode_program import program_from_text
 from machines.ports import open_port
 from machines.streamer import GrblStreamer, StreamInterrupted
 from onestroke.errors import MachineError
-from test_machines_stream import hear_ctrl_c, job_text, last_acked
+from test_machines_stream import job_text, last_acked
 
 
 # long moves: the planner holds seconds of motion, so only a feed hold stops the machine
@@ -68,10 +66,7 @@ def test_ctrl_c_with_a_lost_feed_hold_resets_within_a_second(tmp_path, emulator)
     emu = emulator(time_scale=2.0, faults=Faults(drop_hold=1))
     path = tmp_path / "job.gcode"
     path.write_text(LONG_MOVES)
-    env = {**os.environ, "PYTHONUNBUFFERED": "1"}
-    process = subprocess.Popen([sys.executable, "-c", "from fabrication.cli import main; main()", "stream",
-                                str(path), "--port", emu.device], stderr=subprocess.PIPE, text=True, env=env,
-                               preexec_fn=hear_ctrl_c)
+    process = stream_in_child(path, emu.device)
     assert emu.wait_until(lambda: len(emu.executed) >= 25, timeout=60)
     assert emu.beam_on  # burning when interrupted
     sent = time.monotonic()

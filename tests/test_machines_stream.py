@@ -2,7 +2,6 @@
 and every fault path through the `onestroke stream` command (beam off, one line, exit code)."""
 
 import math
-import os
 import re
 import signal
 import subprocess
@@ -13,20 +12,13 @@ import time
 import pytest
 from click.testing import CliRunner
 
-from emulator_fixtures import emulator  # noqa: F401 - pytest fixture
+from emulator_fixtures import emulator, hear_ctrl_c, stream_in_child  # noqa: F401 - emulator: a pytest fixture
 from fabrication.cli import main
 from machines.emulator import Faults
 from machines.gcode_program import program_from_text
 from machines.ports import open_port
 from machines.streamer import DRAIN_LINE, GrblStreamer, StreamOptions
 from onestroke.errors import MachineError
-
-
-def hear_ctrl_c():
-    """In a child about to exec: take Ctrl-C (SIGINT) again. A shell starts background
-    jobs with SIGINT ignored, and a child inherits that, so a test suite run in the
-    background would otherwise send its Ctrl-C to a process that cannot hear it."""
-    signal.signal(signal.SIGINT, signal.SIG_DFL)
 
 
 def job_text(n, *, step=0.5, feed=3000, seed=0):
@@ -242,10 +234,7 @@ def test_ctrl_c_halts_safely(tmp_path, emulator):
     emu = emulator(time_scale=5.0)
     path = tmp_path / "job.gcode"
     path.write_text(job_text(3000))
-    env = {**os.environ, "PYTHONUNBUFFERED": "1"}
-    process = subprocess.Popen([sys.executable, "-c", "from fabrication.cli import main; main()", "stream",
-                                str(path), "--port", emu.device], stderr=subprocess.PIPE, text=True, env=env,
-                               preexec_fn=hear_ctrl_c)
+    process = stream_in_child(path, emu.device)
     assert emu.wait_until(lambda: len(emu.executed) >= 400, timeout=30)
     assert emu.beam_on  # burning when interrupted
     process.send_signal(signal.SIGINT)

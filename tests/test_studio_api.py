@@ -163,3 +163,12 @@ def test_an_svg_drawing_opens_and_exports(drawing, tmp_path):
         assert state["report"]["strokes"] == 1 and state["graph"]["junctions"] == []
         assert svg_client.get("/api/image").headers["content-type"].startswith("image/svg+xml")
         assert svg_client.post("/api/export/svg", json={}).content.startswith(b"<?xml")
+
+
+def test_multi_stroke_mode_and_a_bad_threshold(client):
+    edits = client.get("/api/state").json()["edits"]
+    multi = client.post("/api/state", json={"edits": dict(edits, multi=True)}).json()
+    assert multi["settings"]["multi"] is True and multi["report"]["strokes"] >= 1
+    assert multi["edits"]["multi"] is True
+    answer = client.post("/api/state", json={"edits": dict(edits, threshold=1.5)})
+    assert answer.status_code == 400 and "threshold" in answer.json()["error"]

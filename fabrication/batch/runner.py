@@ -9,7 +9,10 @@ finished output, leaves no partial file and picks up where it stopped.
 
 from __future__ import annotations
 
+import contextlib
 import os
+import signal
+import threading
 import time
 from collections.abc import Callable, Iterator
 from pathlib import Path
@@ -35,16 +38,32 @@ def _in_process(todo: Todo, job: BatchJob) -> Iterator[tuple[BatchItem, FileResu
         yield item, process_file(item.name, job, path=str(item.source), extensions=needed)
 
 
+@contextlib.contextmanager
+def _interrupts_ignored() -> Iterator[None]:
+    """SIGINT ignored in this block (in the main thread; elsewhere signals cannot be set)."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    previous = signal.signal(signal.SIGINT, signal.SIG_IGN)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, previous)
+
+
 def _process_pool(todo: Todo, job: BatchJob, workers: int) -> Iterator[tuple[BatchItem, FileResult]]:
     import multiprocessing
     from concurrent.futures import ProcessPoolExecutor, as_completed
 
-    # spawn: fresh interpreters (no locks or threads of this process copied into them)
-    pool = ProcessPoolExecutor(max_workers=workers, mp_context=multiprocessing.get_context("spawn"),
-                               initializer=warm_up, initargs=(job,))
-    try:
+    # spawn: fresh interpreters (no locks or threads of this process copied into them),
+    # started with Ctrl-C ignored (kept across exec): a worker interrupted while it imports
+    # would print a traceback; the client alone handles Ctrl-C
+    with _interrupts_ignored():
+        pool = ProcessPoolExecutor(max_workers=workers, mp_context=multiprocessing.get_context("spawn"),
+                                   initializer=warm_up, initargs=(job,))
         futures = {pool.submit(process_file, item.name, job, path=str(item.source), extensions=needed): item
                    for item, needed in todo}
+    try:
         for future in as_completed(futures):
             item = futures[future]
             try:
@@ -52,8 +71,12 @@ def _process_pool(todo: Todo, job: BatchJob, workers: int) -> Iterator[tuple[Bat
             except Exception as error:  # a worker died (out of memory, killed): this file failed
                 result = FileResult(name=item.name, error=f"worker failed: {type(error).__name__}: {error}")
             yield item, result
+    except BaseException:  # Ctrl-C, or the caller stopped early: no worker holds anything to keep
+        # (a private attribute; Python 3.14 has ProcessPoolExecutor.terminate_workers for this)
+        for process in list((getattr(pool, "_processes", None) or {}).values()):
+            process.terminate()
+        raise
     finally:
-        # on Ctrl-C: no new file starts; the ones running finish and are dropped
         pool.shutdown(wait=True, cancel_futures=True)
 
 
@@ -73,25 +96,22 @@ def _dask(todo: Todo, job: BatchJob, address: str, workers_seen: list) -> Iterat
         pending: dict = {}
         running = as_completed()
 
-        def hand_out() -> tuple[BatchItem, FileResult] | None:
-            item, needed = next(queue)
-            try:
-                data = item.source.read_bytes()
-            except OSError as error:
-                return item, FileResult(name=item.name, error=f"cannot read {item.name!r}: {error.strerror}")
-            future = client.submit(process_file, item.name, job, data=data, extensions=needed, pure=False)
-            pending[future] = item
-            running.add(future)
-            return None
+        def hand_out() -> Iterator[tuple[BatchItem, FileResult]]:
+            """Submit the next file that can be read; yield the ones that cannot."""
+            for item, needed in queue:
+                try:
+                    data = item.source.read_bytes()
+                except OSError as error:
+                    yield item, FileResult(name=item.name, error=f"cannot read {item.name!r}: {error.strerror}")
+                    continue
+                future = client.submit(process_file, item.name, job, data=data, extensions=needed, pure=False)
+                pending[future] = item
+                running.add(future)
+                return
 
         try:
             for _ in range(max(1, workers_seen[-1]) * DASK_AHEAD):
-                try:
-                    failed = hand_out()
-                except StopIteration:
-                    break
-                if failed:
-                    yield failed
+                yield from hand_out()
             for future in running:
                 item = pending.pop(future)
                 try:
@@ -99,12 +119,7 @@ def _dask(todo: Todo, job: BatchJob, address: str, workers_seen: list) -> Iterat
                 except Exception as error:  # the worker was lost
                     result = FileResult(name=item.name, error=f"worker failed: {type(error).__name__}: {error}")
                 yield item, result
-                try:
-                    failed = hand_out()
-                except StopIteration:
-                    continue
-                if failed:
-                    yield failed
+                yield from hand_out()
         finally:
             client.cancel(list(pending))
 
@@ -148,6 +163,7 @@ def run_batch(items: list[BatchItem], job: BatchJob, out_dir: str | os.PathLike,
     workers = 0
     workers_seen: list[int] = []
     last_save = time.monotonic()
+    results = None
     try:
         if scheduler:
             results = _dask(todo, job, scheduler, workers_seen)
@@ -163,6 +179,8 @@ def run_batch(items: list[BatchItem], job: BatchJob, out_dir: str | os.PathLike,
                 manifest.save()
                 last_save = time.monotonic()
     finally:
+        if results is not None:
+            results.close()  # stops the workers now if this ends early (Ctrl-C)
         for item, _ in todo:
             records.setdefault(item.name, FileRecord(input=item.name, status="not run"))
         manifest.save()

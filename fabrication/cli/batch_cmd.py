@@ -123,6 +123,8 @@ def batch(inputs: tuple[str, ...], out_dir: str, to: str, jobs: int | None, sche
                               embroidery={**placement, **embroidery}, laser={**placement, **laser})
     if scheduler is not None and "://" not in scheduler:
         raise InputError(f"--scheduler {scheduler!r} is not an address; e.g. tcp://10.0.0.5:8786")
+    if scheduler is not None and jobs is not None:
+        warnings += (f"--jobs {jobs} has no effect with --scheduler: the cluster's workers run the drawings",)
     if os.path.exists(out_dir) and not os.path.isdir(out_dir):
         raise InputError(f"output folder {out_dir!r} is a file")
     items = find_inputs(inputs, out_dir, tuple(t.extension for t in job.targets), INPUT_EXTENSIONS)

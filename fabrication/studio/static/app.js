@@ -319,9 +319,18 @@ function play() {
 
 // ---------------------------------------------------------------- wiring
 function settingsEdit(change) {
+  clearTimeout(previewTimer);
   const edits = JSON.parse(JSON.stringify(currentEdits()));
   Object.assign(edits, change);
   apply(edits);
+}
+
+// While a slider is dragged, the value it rests on is vectorized already (not yet a step
+// in the history): on release the answer comes from the cache.
+let previewTimer = null;
+function preview(change) {
+  clearTimeout(previewTimer);
+  previewTimer = setTimeout(() => apply(Object.assign(JSON.parse(JSON.stringify(currentEdits())), change), false), 350);
 }
 
 function setup() {
@@ -340,10 +349,13 @@ function setup() {
     const pts = s.strokes[0].points;
     apply(withEdit({ kind: "reverse", at: pts[Math.floor(pts.length / 2)].slice(0, 2) }, false));
   };
-  $("threshold").oninput = () => { $("threshold-value").textContent = Number($("threshold").value).toFixed(2); };
+  $("threshold").oninput = () => {
+    $("threshold-value").textContent = Number($("threshold").value).toFixed(2);
+    preview({ threshold: Number($("threshold").value) });
+  };
   $("threshold").onchange = () => settingsEdit({ threshold: Number($("threshold").value) });
   $("auto-threshold").onchange = () => settingsEdit({ threshold: $("auto-threshold").checked ? null : Number($("threshold").value) });
-  $("blur").oninput = () => { $("blur-value").textContent = $("blur").value; };
+  $("blur").oninput = () => { $("blur-value").textContent = $("blur").value; preview({ blur: Number($("blur").value) }); };
   $("blur").onchange = () => settingsEdit({ blur: Number($("blur").value) });
   $("multi").onchange = () => settingsEdit({ multi: $("multi").checked });
   $("play").onclick = play;
