@@ -1,7 +1,7 @@
 """Batch throughput: drawings per second on 1 and 2 worker processes and on a Dask
 LocalCluster, and the start-up time a batch saves against one process per drawing.
 
-Run from the repository root: python benchmarks/batch.py [--count 20] [--runs 3]
+Run from the repository root: python benchmarks/batch.py [--count 19] [--runs 3]
 Every figure is the wall time of a whole `onestroke` command (a fresh process, as a user
 runs it) on the drawings of benchmarks/batch_drawings.py (360 px), median over --runs, each
 run into an empty output folder. The cluster (2 worker processes, 1 thread each) is started
@@ -58,7 +58,7 @@ def _one_process_each(drawings: list[Path], work: Path, runs: int) -> float:
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--count", type=int, default=20, help="drawings (at most 19 distinct ones)")
+    parser.add_argument("--count", type=int, default=19, help="drawings (at most 19 distinct ones)")
     parser.add_argument("--runs", type=int, default=3)
     args = parser.parse_args()
     from distributed import LocalCluster

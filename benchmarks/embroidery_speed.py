@@ -78,6 +78,25 @@ def main() -> None:
                   f"{statistics.median(write_times):7.3f} {statistics.median(totals):8.3f} "
                   f"{statistics.median(cpus):6.3f} {min(totals):7.3f} "
                   f"{statistics.median(stats_times):8.3f} {png:6.2f}")
+    merge_scaling()
+
+
+def merge_scaling() -> None:
+    """Short-stitch merging on rows that nearly all merge (what a 0.0001 mm stitch length
+    used to make): the time must grow in proportion to the rows, not their square."""
+    from fabrication.embroidery.needles import BODY, LOCK
+    from fabrication.embroidery.plan import STITCH, _merge_short
+
+    print(f"\n{'rows':>9} {'merge s':>8} {'us/row':>7}   (every stitch 0.1 grid unit, minimum 3 units)")
+    for n in (10_000, 100_000, 1_000_000):
+        units = np.column_stack([np.arange(n) // 10, np.zeros(n, dtype=np.int64)])
+        kinds = np.full(n, STITCH, dtype=np.uint8)
+        roles = np.full(n, BODY, dtype=np.uint8)
+        roles[-4:] = LOCK
+        t0 = time.perf_counter()
+        keep = _merge_short(units, kinds, roles, 3.0 - 1e-9)
+        elapsed = time.perf_counter() - t0
+        print(f"{n:9d} {elapsed:8.3f} {elapsed / n * 1e6:7.2f}   ({int(keep.sum())} rows kept)")
 
 
 if __name__ == "__main__":

@@ -1,4 +1,5 @@
-"""Make examples/readme.png: the bundled drawing, its vectorized curve and its stitches.
+"""Make examples/readme.png: the bundled drawing, its vectorized curve and its stitches
+(zigzag, the embroider command's realistic preview).
 
     python docs/make_readme_image.py
 
@@ -42,11 +43,12 @@ def main() -> None:
         work = Path(folder)
         onestroke("vectorize", str(SOURCE), "-o", str(work / "loops.svg"))
         onestroke("preview", str(work / "loops.svg"), "-o", str(work / "curve.png"))
-        onestroke("embroider", str(SOURCE), "-o", str(work / "loops.pes"), "--style", "triple",
-                  "--size", "95mm", "--hoop", "100x50",
-                  "--preview", str(work / "stitches.png"))
+        # The realistic preview: thread in its colour on fabric, as it will look sewn.
+        onestroke("embroider", str(SOURCE), "-o", str(work / "loops.pes"), "--style", "zigzag",
+                  "--size", "95mm", "--hoop", "100x100", "--color", "#1d4e89",
+                  "--preview", str(work / "stitches.png"), "--preview-width", "1400")
         panels = [trimmed(SOURCE), trimmed(work / "curve.png"), trimmed(work / "stitches.png")]
-    labels = ["drawing (PNG)", "one curve, start blue -> end red", "triple stitch, .pes"]
+    labels = ["drawing (PNG)", "one curve, start blue -> end red", "zigzag, .pes (preview)"]
     gap = 16
     width = sum(p.width for p in panels) + gap * (len(panels) + 1)
     sheet = Image.new("RGB", (width, PANEL_HEIGHT + 2 * gap + 20), "white")

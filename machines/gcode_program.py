@@ -8,11 +8,13 @@ sender's job check and ETA, the time estimate (`machines.job_time`) and the prev
 from __future__ import annotations
 
 import os
+import re
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
 import numpy as np
 
+from machines.gcode_batch import PlainRun, read_plain_run, split_plain
 from machines.gcode_interpreter import GcodeError, GcodeInterpreter, GcodeState, MachineConfig
 from machines.grbl_codes import describe_error
 from machines.grbl_protocol import MAX_LINE_CHARS, clean_line
@@ -38,8 +40,21 @@ class Program:
         return len(self.lines)
 
 
+# printable ASCII without '(', ')', '/', ';' (clean_line's _PLAIN), lines split by '\n' only
+_CLEAN_TEXT = re.compile(r"[!-'*-.0-:<-~\n]*\Z")
+
+
 def program_from_text(text: str, *, source: str = "<text>") -> Program:
     """Clean every line; InputError naming the first line GRBL would refuse as too long."""
+    if _CLEAN_TEXT.match(text):  # the usual case (files onestroke writes): nothing to strip
+        raw_lines = text.upper().split("\n")
+        if raw_lines[-1] == "":
+            raw_lines.pop()  # what splitlines() does with a final line end
+        if max(map(len, raw_lines), default=0) <= MAX_LINE_CHARS:
+            numbered = zip(range(1, len(raw_lines) + 1), raw_lines)
+            if "" in raw_lines or "%" in raw_lines:
+                numbered = ((number, clean) for number, clean in numbered if clean and clean != "%")
+            return Program(source, tuple(numbered), len(raw_lines))
     lines = []
     raw_lines = text.splitlines()
     for number, raw in enumerate(raw_lines, start=1):
@@ -154,6 +169,62 @@ def _box(points) -> tuple[tuple[float, float], tuple[float, float]] | None:
     return (tuple(arr.min(axis=0).tolist()), tuple(arr.max(axis=0).tolist()))
 
 
+class _Columns:
+    """Segments and moves in program order: rows from the interpreter, runs from `read_plain_run`."""
+
+    def __init__(self) -> None:
+        self.seg: list[tuple] = []  # (start, end, feed, rapid, stop_before, move, index, burn)
+        self.mv: list[tuple] = []  # (kind, start, end, centre, feed, power, laser_on, line)
+        self.seg_chunks: list[tuple] = []
+        self.mv_chunks: list[tuple] = []
+        self.moves_done = 0
+
+    def n_moves(self) -> int:
+        return self.moves_done + len(self.mv)
+
+    def _flush(self) -> None:
+        if self.seg:
+            cols = list(zip(*self.seg))
+            self.seg_chunks.append((np.array(cols[0], dtype=float).reshape(-1, 3),
+                                    np.array(cols[1], dtype=float).reshape(-1, 3),
+                                    *(np.array(c, dtype=t) for c, t in zip(cols[2:], (float, bool, bool, int, int, bool)))))
+            self.seg = []
+        if self.mv:
+            cols = list(zip(*self.mv))
+            self.mv_chunks.append((np.array(cols[0], dtype=np.int8),
+                                   *(np.array(c, dtype=float).reshape(-1, 2) for c in cols[1:4]),
+                                   *(np.array(c, dtype=t) for c, t in zip(cols[4:], (float, float, bool, int)))))
+            self.moves_done += len(self.mv)
+            self.mv = []
+
+    def add_run(self, run: PlainRun, index: int, file_line: np.ndarray, stop_before: bool, spindle: str) -> None:
+        """A plain run starting at program line `index`, file lines `file_line` (0-based):
+        each line is one move and one segment."""
+        self._flush()
+        n = run.n
+        line = np.arange(index, index + n)
+        stops = np.zeros(n, dtype=bool)
+        stops[0] = stop_before
+        lit = (spindle != "M5") & (run.s > 0)
+        burn = lit & ~run.rapid
+        move = np.arange(self.moves_done, self.moves_done + n)
+        self.seg_chunks.append((run.start, run.end, run.feed, run.rapid, stops, move, line, burn))
+        self.mv_chunks.append((run.rapid.astype(np.int8) ^ 1, run.start[:, :2], run.end[:, :2],
+                               np.full((n, 2), np.nan), run.feed, run.s, burn, file_line))
+        self.moves_done += n
+
+    def arrays(self) -> tuple[tuple, GcodeMoves]:
+        """(segment columns, `GcodeMoves`); move lines are 0-based source line numbers."""
+        self._flush()
+        empty_seg = (np.zeros((0, 3)), np.zeros((0, 3)), np.zeros(0), np.zeros(0, dtype=bool),
+                     np.zeros(0, dtype=bool), np.zeros(0, dtype=int), np.zeros(0, dtype=int), np.zeros(0, dtype=bool))
+        seg = tuple(np.concatenate(c) for c in zip(*self.seg_chunks)) if self.seg_chunks else empty_seg
+        empty_mv = (np.zeros(0, dtype=np.int8), np.zeros((0, 2)), np.zeros((0, 2)), np.zeros((0, 2)),
+                    np.zeros(0), np.zeros(0), np.zeros(0, dtype=bool), np.zeros(0, dtype=int))
+        mv = list(np.concatenate(c) for c in zip(*self.mv_chunks)) if self.mv_chunks else list(empty_mv)
+        return seg, GcodeMoves(*mv)
+
+
 def analyze_program(program: Program, *, settings: Mapping[int, float] | None = None,
                     start: Sequence[float] = (0.0, 0.0, 0.0),
                     offsets: Mapping[str, Sequence[float]] | None = None,
@@ -175,17 +246,32 @@ def analyze_program(program: Program, *, settings: Mapping[int, float] | None = 
     if offsets and "G92" in offsets:
         state.g92 = [float(v) for v in offsets["G92"]]
     interp = GcodeInterpreter(config, state)
-    seg_start, seg_end, seg_feed, seg_rapid, seg_stop, seg_move, seg_index = [], [], [], [], [], [], []
-    mv_kind, mv_start, mv_end, mv_centre, mv_feed, mv_power, mv_on, mv_line = [], [], [], [], [], [], [], []
-    points: list = [(float(start[0]), float(start[1]))]
-    burn: list = []
+    cols = _Columns()
     dwell = np.zeros(len(program))
     syncs = np.zeros(len(program), dtype=bool)
-    max_s, uses_laser = 0.0, False
+    max_s = 0.0
     errors, codes = [], []
     position = tuple(float(v) for v in state.position)
     pending_stop = True
-    for index, (number, text) in enumerate(program.lines):
+    texts = [text for _, text in program.lines]
+    file_line = np.array([number - 1 for number, _ in program.lines], dtype=int)
+    rows = split_plain(texts)
+    # index of the next line that is not plain (plain runs are read in bulk)
+    other = np.flatnonzero([bool(r[5]) for r in rows]) if rows is not None else np.arange(len(texts))
+    index = 0
+    while index < len(texts):
+        if rows is not None and not rows[index][5]:
+            run_end = int(other[np.searchsorted(other, index)]) if len(other) and other[-1] >= index else len(texts)
+            run = read_plain_run(rows[index:run_end], interp)
+            if run is not None:
+                cols.add_run(run, index, file_line[index:index + run.n], pending_stop, interp.state.spindle)
+                max_s = max(max_s, float(run.s.max()))
+                pending_stop = False
+                position = tuple(interp.state.position)
+                index += run.n
+                continue
+        number, text = program.lines[index]
+        index += 1
         if text.startswith("$"):
             if not allow_settings:
                 errors.append((number, f"{text}: {SETTINGS_REFUSED}"))
@@ -198,55 +284,35 @@ def analyze_program(program: Program, *, settings: Mapping[int, float] | None = 
             codes.append(error.code)
             continue
         motion = interp.motion
-        move_index = len(mv_kind)
+        move_index = cols.n_moves()
         for action in actions:
             kind = action[0]
             if kind == "move":
                 _, target, feed, rapid, mode, s = action
-                seg_start.append(position)
-                seg_end.append(target)
-                seg_feed.append(np.nan if feed is None else feed)
-                seg_rapid.append(rapid)
-                seg_stop.append(pending_stop)
-                seg_move.append(move_index)
-                seg_index.append(index)
+                cols.seg.append((position, target, np.nan if feed is None else feed, rapid, pending_stop,
+                                 move_index, index - 1, mode != "M5" and s > 0 and not rapid))
                 pending_stop = False
-                if mode != "M5" and s > 0 and not rapid:
-                    burn += [position[:2], target[:2]]
-                    uses_laser = True
                 position = target
-                points.append(target[:2])
                 max_s = max(max_s, s)
             elif kind in ("sync", "end", "pause"):
                 pending_stop = True
-                syncs[index] = True
+                syncs[index - 1] = True
             elif kind == "dwell":
-                dwell[index] += float(action[1])
+                dwell[index - 1] += float(action[1])
                 pending_stop = True
             elif kind == "spindle":
                 max_s = max(max_s, action[2])
         if motion is not None:
             st = interp.state
             on = st.spindle != "M5" and st.s > 0 and motion.kind != 0
-            mv_kind.append(motion.kind)
-            mv_start.append(motion.start[:2])
-            mv_end.append(motion.end[:2])
-            mv_centre.append(motion.centre[:2] if motion.centre else (np.nan, np.nan))
-            mv_feed.append(np.nan if motion.kind == 0 else st.feed)
-            mv_power.append(st.s)
-            mv_on.append(on)
-            mv_line.append(number - 1)
-    moves = GcodeMoves(np.array(mv_kind, dtype=np.int8), np.array(mv_start, dtype=float).reshape(-1, 2),
-                       np.array(mv_end, dtype=float).reshape(-1, 2), np.array(mv_centre, dtype=float).reshape(-1, 2),
-                       np.array(mv_feed, dtype=float), np.array(mv_power, dtype=float),
-                       np.array(mv_on, dtype=bool), np.array(mv_line, dtype=int))
-    starts = np.array(seg_start, dtype=float).reshape(-1, 3)
-    ends = np.array(seg_end, dtype=float).reshape(-1, 3)
-    feeds, rapids = np.array(seg_feed, dtype=float), np.array(seg_rapid, dtype=bool)
-    stops = np.array(seg_stop, dtype=bool)
+            cols.mv.append((motion.kind, motion.start[:2], motion.end[:2],
+                            motion.centre[:2] if motion.centre else (np.nan, np.nan),
+                            np.nan if motion.kind == 0 else st.feed, st.s, on, number - 1))
+    (starts, ends, feeds, rapids, stops, seg_move, seg_index, seg_burn), moves = cols.arrays()
     seconds = plan_times(starts, ends, feeds, rapids, stops, kin)
-    segments = Segments(starts, ends, feeds, rapids, stops, np.array(seg_move, dtype=int),
-                        np.array(seg_index, dtype=int), seconds)
+    segments = Segments(starts, ends, feeds, rapids, stops, seg_move, seg_index, seconds)
     per_line = np.bincount(segments.index, weights=seconds, minlength=len(program)) + dwell
-    return ProgramStats(_box(points) if len(points) > 1 else None, _box(burn), max_s, uses_laser,
+    points = np.vstack([np.asarray(start, dtype=float)[:2], ends[:, :2]])
+    burn = np.vstack([starts[seg_burn, :2], ends[seg_burn, :2]])
+    return ProgramStats(_box(points) if len(points) > 1 else None, _box(burn), max_s, bool(seg_burn.any()),
                         np.cumsum(per_line), tuple(errors), tuple(codes), moves, segments, dwell, syncs)

@@ -83,46 +83,50 @@ def link_schedule(program: Program, stats: ProgramStats, *, baud: int, rx_buffer
     byte_time = BITS_PER_BYTE / float(baud)
     ok_time = latency + OK_BYTES * byte_time
     seg = stats.segments
-    blocks_of = [[] for _ in range(len(program))]
-    for b, index in enumerate(seg.index.tolist()):
-        if seg.seconds[b] > 0:
-            blocks_of[index].append(b)
-    duration = seg.seconds.tolist()
+    n = len(program)
+    sizes = np.fromiter((len(text) + 1 for _, text in program.lines), dtype=np.int64, count=n)
+    total = np.concatenate([[0], np.cumsum(sizes)])
+    # character counting: line i goes out once every line before `head[i]` is answered,
+    # the first one from which the unanswered bytes plus line i fit the RX buffer (the
+    # answers come in order, so waiting for the newest of them is waiting for all)
+    head = np.minimum(np.searchsorted(total, total[1:] - rx_buffer, side="left"), np.arange(n)).tolist()
+    wire = (sizes * byte_time).tolist()
+    moving = np.flatnonzero(seg.seconds > 0)
+    lines_of = seg.index[moving]
+    first = np.searchsorted(lines_of, np.arange(n), side="left").tolist()
+    last = np.searchsorted(lines_of, np.arange(n), side="right").tolist()
+    duration = seg.seconds[moving].tolist()
     syncs, dwell = stats.syncs.tolist(), stats.dwell.tolist()
-    block_end = np.zeros(len(seg))
-    ack = np.zeros(len(program))
-    inflight: list[tuple[float, int]] = []  # (ack time, bytes) of lines sent, oldest first
-    head = 0
-    used = 0
+    ends = [0.0] * len(moving)  # end time of each block, in order
+    ack = [0.0] * n
     wire_free = 0.0  # when the host's last byte has arrived at the controller
     parser_free = 0.0
-    ends: list[float] = []  # end time of each block queued so far, in order
     last_end = 0.0
-    for i, (_, text) in enumerate(program.lines):
-        size = len(text) + 1
-        send = 0.0
-        # character counting: wait for the oldest answers until this line fits
-        while used + size > rx_buffer and head < len(inflight):
-            send = max(send, inflight[head][0])
-            used -= inflight[head][1]
-            head += 1
-        arrived = max(send + latency, wire_free) + size * byte_time
+    for i in range(n):
+        h = head[i]
+        send = ack[h - 1] if h else 0.0
+        # (comparisons instead of max(): the same values, this loop runs once per line)
+        arrived = send + latency
+        if arrived < wire_free:
+            arrived = wire_free
+        arrived += wire[i]
         wire_free = arrived
-        done = max(arrived, parser_free) + parse_time
+        done = (arrived if arrived >= parser_free else parser_free) + parse_time
         if syncs[i]:  # M3/M4/M5, M8/M9, G4, S without motion: the planner drains first
             done = max(done, last_end) + dwell[i]
             last_end = done
-        for b in blocks_of[i]:
-            if len(ends) >= planner_blocks:  # a free planner block: the one 15 back has run
-                done = max(done, ends[-planner_blocks])
-            last_end = max(last_end, done) + duration[b]
-            ends.append(last_end)
-            block_end[b] = last_end
+        for b in range(first[i], last[i]):
+            if b >= planner_blocks:  # a free planner block: the one 15 back has run
+                free = ends[b - planner_blocks]
+                if free > done:
+                    done = free
+            last_end = (last_end if last_end >= done else done) + duration[b]
+            ends[b] = last_end
         parser_free = done
         ack[i] = done + ok_time
-        inflight.append((ack[i], size))
-        used += size
-    return ack, block_end
+    block_end = np.zeros(len(seg))
+    block_end[moving] = ends
+    return np.array(ack), block_end
 
 
 def estimate_program_time(program: Program, profile: LaserProfile, *, stats: ProgramStats | None = None,
@@ -149,7 +153,7 @@ def estimate_program_time(program: Program, profile: LaserProfile, *, stats: Pro
         link_total, total = 0.0, planner
         line_done = stats.line_seconds
     line_seconds = np.zeros(n_lines)
-    numbers = np.array([n - 1 for n, _ in program.lines], dtype=int)
+    numbers = np.fromiter((n - 1 for n, _ in program.lines), dtype=int, count=len(program))
     if len(numbers):
         line_seconds[numbers] = line_done
         line_seconds = np.maximum.accumulate(line_seconds)

@@ -9,8 +9,9 @@ from onestroke.errors import (
     InputError,
     MachineError,
     OnestrokeError,
+    OutputError,
     VectorizeError,
 )
 
-__all__ = ["OnestrokeError", "InputError", "VectorizeError", "FabricationError", "MachineError"]
+__all__ = ["OnestrokeError", "InputError", "VectorizeError", "FabricationError", "MachineError", "OutputError"]
 __version__ = "0.1.0"

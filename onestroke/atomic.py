@@ -3,13 +3,14 @@
 from __future__ import annotations
 
 import contextlib
+import errno
 import os
 import tempfile
 from collections.abc import Iterator
 from pathlib import Path
 from typing import IO
 
-from onestroke.errors import InputError
+from onestroke.errors import InputError, OutputError
 
 
 def check_writable(path: str | os.PathLike) -> Path:
@@ -31,11 +32,26 @@ def check_writable(path: str | os.PathLike) -> Path:
     return path
 
 
+def _os_reason(error: OSError) -> str:
+    reasons = {errno.ENOSPC: "the disk is full", errno.EDQUOT: "the disk quota is exceeded",
+               errno.EROFS: "the file system is read-only", errno.EACCES: "permission denied",
+               errno.EPERM: "operation not permitted", errno.EFBIG: "the file is too large for this system",
+               errno.ENOENT: "the folder cannot hold files", errno.EIO: "input/output error"}
+    return reasons.get(error.errno) or error.strerror or type(error).__name__
+
+
 @contextlib.contextmanager
 def atomic_open(path: str | os.PathLike, mode: str = "wb") -> Iterator[IO]:
-    """Open a temporary file beside `path`; rename it over `path` only if the block succeeds."""
+    """Open a temporary file beside `path`; rename it over `path` only if the block succeeds.
+
+    Any OSError of the file system (disk full, read-only, permission, /proc) becomes an
+    `OutputError` naming `path`; the temporary file is removed either way.
+    """
     path = check_writable(path)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".part", dir=path.parent or ".")
+    try:
+        fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".part", dir=path.parent or ".")
+    except OSError as error:
+        raise OutputError(f"cannot write {str(path)!r}: {_os_reason(error)}") from None
     try:
         with os.fdopen(fd, mode, **({} if "b" in mode else {"encoding": "utf-8", "newline": "\n"})) as handle:
             yield handle
@@ -43,9 +59,11 @@ def atomic_open(path: str | os.PathLike, mode: str = "wb") -> Iterator[IO]:
             os.fsync(handle.fileno())
         os.chmod(tmp, 0o644)
         os.replace(tmp, path)
-    except BaseException:
-        with contextlib.suppress(FileNotFoundError):
+    except BaseException as error:
+        with contextlib.suppress(OSError):
             os.unlink(tmp)
+        if isinstance(error, OSError):
+            raise OutputError(f"cannot write {str(path)!r}: {_os_reason(error)}") from None
         raise
 
 

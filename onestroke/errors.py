@@ -28,3 +28,7 @@ class FabricationError(OnestrokeError):
 
 class MachineError(OnestrokeError):
     """Talking to a machine failed: port, protocol, alarm or error reply."""
+
+
+class OutputError(OnestrokeError):
+    """A file could not be written: disk full, read-only, permission, a special folder."""

@@ -121,6 +121,11 @@ def test_strokes_of_one_colour_are_sewn_together(svg):
     assert (listed.kinds == COLOR).sum() == 1
 
 
+def test_more_colours_than_strokes_are_warned_about(svg, tmp_path):
+    result = _run("embroider", svg, "-o", tmp_path / "d.pes", "--color", "red,green,blue,black,white")
+    assert "5 colours for 4 stroke(s)" in result.stderr
+
+
 def test_every_pyembroidery_chart_picks_a_numbered_thread():
     for chart in THREAD_CHARTS:
         thread = nearest_thread((200, 30, 40), chart)

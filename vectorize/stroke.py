@@ -13,6 +13,11 @@ from onestroke.errors import InputError
 # length is below 1e-5 of the segment length for the gentle segments spline fitting makes.
 _TABLE_SAMPLES = 48
 
+# Largest coordinate a stroke may hold (px before placement, mm after): ten million units
+# keeps squared lengths and arc-length sums far from overflow and every number written out
+# short. Readers refuse or clamp beyond it, naming the element.
+MAX_COORDINATE = 1e7
+
 
 def _bezier_points(control: np.ndarray, t: np.ndarray) -> np.ndarray:
     """Evaluate cubic segments. control (K, 4, 2), t (M,) in [0, 1] -> (K, M, 2)."""
@@ -42,6 +47,9 @@ class Stroke:
             raise InputError(f"stroke control points must have shape (K, 4, 2), got {control.shape}")
         if not np.all(np.isfinite(control)):
             raise InputError("stroke control points must be finite numbers")
+        if np.abs(control).max() > MAX_COORDINATE:
+            raise InputError(f"stroke coordinate {np.abs(control).max():.3g} is beyond the limit of "
+                             f"{MAX_COORDINATE:.0e} (px or mm)")
         control.setflags(write=False)
         object.__setattr__(self, "control", control)
         if self.color is not None:

@@ -6,11 +6,19 @@ A line drawing stored as SVG comes in one of two forms:
 - an outline: the ink shape's contour, filled and not stroked (common on stock sites).
   It has no centre line yet; `read_svg` returns its polygons and the vectorizer finds
   the centre-line curve from a rasterization of them.
+
+Files from the wild spell the SVG namespace in many ways (https, a trailing slash, none at
+all) or wrap the drawing in XHTML; those are normalised to the standard namespace before
+svgelements reads them. A coordinate that is not finite or lies beyond
+`stroke.MAX_COORDINATE` (1e7 px, 260 m at 96 dpi) is refused, naming the element.
 """
 
 from __future__ import annotations
 
+import io
 import os
+import re
+import xml.etree.ElementTree as ET
 from dataclasses import dataclass
 
 import numpy as np
@@ -18,7 +26,12 @@ import svgelements as se
 
 from onestroke.errors import InputError
 from vectorize.drawing import Drawing
-from vectorize.stroke import Stroke
+from vectorize.stroke import MAX_COORDINATE, Stroke
+
+SVG_NS = "http://www.w3.org/2000/svg"
+MAX_SVG_BYTES = 200_000_000  # a 200 MB SVG is far past any drawing; refuse before parsing
+# Namespaces a human meant as SVG's: http or https, www or not, with or without a final slash.
+_SVG_LIKE = re.compile(r"^(https?://)?(www\.)?w3\.org/2000/svg/?$", re.IGNORECASE)
 
 
 @dataclass(frozen=True)
@@ -89,6 +102,60 @@ def _has_paint(value) -> bool:
         and getattr(value, "opacity", 1.0) != 0
 
 
+def _local(tag) -> str:
+    return tag.rsplit("}", 1)[-1] if isinstance(tag, str) else ""
+
+
+def _namespace(tag) -> str | None:
+    return tag[1:].split("}", 1)[0] if isinstance(tag, str) and tag.startswith("{") else None
+
+
+def _svg_source(path: str):
+    """The file itself if its root is a standard <svg>; else the first <svg> element (inside
+    XHTML or any wrapper), its SVG-like namespaces made the standard one, as bytes."""
+    try:
+        if os.path.getsize(path) > MAX_SVG_BYTES:
+            raise InputError(f"SVG {path!r} is over {MAX_SVG_BYTES // 1_000_000} MB; too large to read")
+        root = ET.parse(path).getroot()
+    except ET.ParseError as error:
+        raise InputError(f"cannot read SVG {path!r}: not well-formed XML ({error})") from None
+    if root.tag == f"{{{SVG_NS}}}svg":
+        return path
+    svg = next((element for element in root.iter() if _local(element.tag) == "svg"), None)
+    if svg is None:
+        raise InputError(f"{path!r} holds no <svg> element (its root is <{_local(root.tag)}>)")
+    for element in svg.iter():
+        namespace = _namespace(element.tag)
+        if namespace is None or _SVG_LIKE.match(namespace) or namespace == "http://www.w3.org/1999/xhtml":
+            element.tag = f"{{{SVG_NS}}}{_local(element.tag)}"
+    return io.BytesIO(ET.tostring(svg))
+
+
+def _element_name(element) -> str:
+    """`<circle id="c1">` or `<path>`: how a message names an element."""
+    tag = type(element).__name__.lower().replace("simpleline", "line")
+    ident = getattr(element, "id", None)
+    return f"<{tag} id={ident!r}>" if ident else f"<{tag}>"
+
+
+def _check_coordinates(control: np.ndarray, element, path: str) -> None:
+    if not np.all(np.isfinite(control)):
+        raise InputError(f"SVG {path!r}: {_element_name(element)} has a coordinate that is not a finite number")
+    largest = float(np.abs(control).max())
+    if largest > MAX_COORDINATE:
+        raise InputError(f"SVG {path!r}: {_element_name(element)} reaches a coordinate of {largest:.3g} px, "
+                         f"beyond the limit of {MAX_COORDINATE:.0e} px")
+
+
+def _canvas_side(value) -> float:
+    """A viewport side in px, or 0 when missing, not finite or beyond the coordinate limit."""
+    try:
+        side = float(value) if value else 0.0
+    except (TypeError, ValueError):
+        return 0.0
+    return side if np.isfinite(side) and 0 < side <= MAX_COORDINATE else 0.0
+
+
 def _rgb(paint) -> tuple[int, int, int] | None:
     """RGB 0-255 of an svgelements paint (the stroke colour), None when it has none."""
     try:
@@ -99,38 +166,54 @@ def _rgb(paint) -> tuple[int, int, int] | None:
 
 def read_svg(path: str | os.PathLike) -> SvgContent:
     """Parse an SVG file into strokes and outline rings (px at 96 dpi, transforms applied)."""
+    path = str(path)
     if not os.path.isfile(path):
-        raise InputError(f"input file {str(path)!r} does not exist")
+        raise InputError(f"input file {path!r} does not exist")
+    source = _svg_source(path)
     try:
-        svg = se.SVG.parse(str(path), reify=True)
+        svg = se.SVG.parse(source, reify=True)
     except Exception as error:  # svgelements raises many kinds on malformed XML
-        raise InputError(f"cannot read SVG {str(path)!r}: {str(error).splitlines()[0] if str(error) else type(error).__name__}") from None
+        raise InputError(f"cannot read SVG {path!r}: {str(error).splitlines()[0] if str(error) else type(error).__name__}") from None
+    if svg is None:
+        raise InputError(f"SVG {path!r}: its root <svg> is hidden (display:none), so nothing in it is drawn; "
+                         "remove that style to use the drawing")
     strokes: list[Stroke] = []
     rings: list[np.ndarray] = []
     widths: list[float] = []
-    for element in svg.elements():
+    try:
+        elements = list(svg.elements())
+    except (ValueError, ArithmeticError, AttributeError, TypeError) as error:
+        raise InputError(f"cannot read SVG {path!r}: {error}") from None
+    for element in elements:
         if not isinstance(element, se.Shape) or isinstance(element, se.Text):
             continue
         if element.values.get("visibility") == "hidden" or element.values.get("display") == "none":
             continue
+        try:
+            bbox = element.bbox()
+        except (ValueError, ArithmeticError, TypeError):
+            bbox = None
+        if bbox is not None:
+            _check_coordinates(np.asarray(bbox, dtype=float), element, path)
         path_obj = se.Path(element)
         stroked = _has_paint(element.stroke)
         filled = _has_paint(element.fill)
         color = _rgb(element.stroke) if stroked else None
         for control in _subpaths(path_obj):
+            _check_coordinates(control, element, path)
             if stroked or not filled:
                 # Unpainted shapes are treated as strokes: a line drawing has no other use.
                 strokes.append(Stroke(control, color))
                 width = element.stroke_width
-                widths.append(float(width) if width else 1.0)
+                widths.append(float(width) if width and np.isfinite(float(width)) else 1.0)
             else:
                 ring = Stroke(control).flatten(0.05)
                 if len(ring) >= 3:
                     rings.append(ring)
-    width = float(svg.width) if svg.width else 0.0
-    height = float(svg.height) if svg.height else 0.0
+    width = _canvas_side(svg.width)
+    height = _canvas_side(svg.height)
     if not strokes and not rings:
-        raise InputError(f"SVG {str(path)!r} holds no paths, lines or shapes to use")
+        raise InputError(f"SVG {path!r} holds no paths, lines or shapes to use")
     if not (width > 0 and height > 0):
         everything = np.vstack([s.flatten(0.5) for s in strokes] + rings)
         width, height = (float(v) + 1.0 for v in everything.max(axis=0))

@@ -30,6 +30,9 @@ PRUNE_SINGLE, PRUNE_MULTI = 0.95, 0.90
 # medial-axis branch points (a dense 2000 px scribble: ~500 crossings); noise has tens of
 # thousands, and simplifying those takes hours.
 MAX_OUTLINES, MAX_BRANCH_POINTS = 5000, 4000
+# Outline samples bound the Voronoi diagram's work: the example drawings have 4,500-18,000;
+# a 400 px square of noise has 367,000, which qhull takes minutes over.
+MAX_OUTLINE_SAMPLES = 150_000
 # Share of plausibility of the smoother touching pairing when the classifier says "touch".
 SMOOTHER_TOUCH = 0.85
 
@@ -188,12 +191,16 @@ def _order(graph: MedialGraph, ink, options: VectorizeOptions, ends: int, clock:
     return _Solution(graph, simple, junctions, verdicts, ordering, tried)
 
 
-def _refuse_noise(count: int, what: str, limit: int, threshold: float) -> None:
+def _refuse_noise(count: int, what: str, limit: int, threshold: float, given: bool) -> None:
     """Raise `InputError` when the ink has more `what` than any line drawing has: the
-    threshold cut through paper texture or noise (and the search would take hours)."""
+    threshold cut through paper texture or noise (and the search would take hours).
+    A threshold the user already chose is not suggested again (lowering it step by step
+    rarely helps); blur is what removes grain."""
     if count > limit:
+        hint = ("try --blur 2 (more for coarse grain) with that threshold, or clean the scan" if given
+                else f"try --blur 2 (more for coarse grain), or a --threshold well below {threshold:.2f}")
         raise InputError(f"the ink has {count} {what}: that is paper texture or noise, not a line "
-                         f"drawing; try a --threshold below {threshold:.2f}, or --blur 1")
+                         f"drawing; {hint}")
 
 
 def _front(image: np.ndarray, options: VectorizeOptions, clock: _Clock):
@@ -207,14 +214,18 @@ def _front(image: np.ndarray, options: VectorizeOptions, clock: _Clock):
     spacing = float(np.clip(w / 8.0, 0.3, 1.0))
     rings = outline_rings(ink.gray, ink.threshold, spacing)
     clock.lap("outline")
-    _refuse_noise(len(rings), "outlines (pieces and holes)", MAX_OUTLINES, ink.threshold)
+    _refuse_noise(len(rings), "outlines (pieces and holes)", MAX_OUTLINES, ink.threshold,
+                  options.threshold is not None)
+    _refuse_noise(sum(len(ring) for ring in rings), "outline samples", MAX_OUTLINE_SAMPLES, ink.threshold,
+                  options.threshold is not None)
     graph = medial_axis(rings, ink.gray, ink.threshold)
     clock.lap("medial axis")
     prune(graph, threshold=PRUNE_MULTI if options.multi else PRUNE_SINGLE, stroke_width=w)
     trim_free_ends(graph, stroke_width=w)
     clock.lap("pruning")
     branch_points = sum(1 for incident in graph.incident.values() if len(incident) >= 3)
-    _refuse_noise(branch_points, "branch points", MAX_BRANCH_POINTS, ink.threshold)
+    _refuse_noise(branch_points, "branch points", MAX_BRANCH_POINTS, ink.threshold,
+                  options.threshold is not None)
     bridged = dropped = 0
     if not options.multi:
         bridged = bridge_gaps(graph, stroke_width=w)

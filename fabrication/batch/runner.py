@@ -96,25 +96,22 @@ def _dask(todo: Todo, job: BatchJob, address: str, workers_seen: list) -> Iterat
         pending: dict = {}
         running = as_completed()
 
-        def hand_out() -> tuple[BatchItem, FileResult] | None:
-            item, needed = next(queue)
-            try:
-                data = item.source.read_bytes()
-            except OSError as error:
-                return item, FileResult(name=item.name, error=f"cannot read {item.name!r}: {error.strerror}")
-            future = client.submit(process_file, item.name, job, data=data, extensions=needed, pure=False)
-            pending[future] = item
-            running.add(future)
-            return None
+        def hand_out() -> Iterator[tuple[BatchItem, FileResult]]:
+            """Submit the next file that can be read; yield the ones that cannot."""
+            for item, needed in queue:
+                try:
+                    data = item.source.read_bytes()
+                except OSError as error:
+                    yield item, FileResult(name=item.name, error=f"cannot read {item.name!r}: {error.strerror}")
+                    continue
+                future = client.submit(process_file, item.name, job, data=data, extensions=needed, pure=False)
+                pending[future] = item
+                running.add(future)
+                return
 
         try:
             for _ in range(max(1, workers_seen[-1]) * DASK_AHEAD):
-                try:
-                    failed = hand_out()
-                except StopIteration:
-                    break
-                if failed:
-                    yield failed
+                yield from hand_out()
             for future in running:
                 item = pending.pop(future)
                 try:
@@ -122,12 +119,7 @@ def _dask(todo: Todo, job: BatchJob, address: str, workers_seen: list) -> Iterat
                 except Exception as error:  # the worker was lost
                     result = FileResult(name=item.name, error=f"worker failed: {type(error).__name__}: {error}")
                 yield item, result
-                try:
-                    failed = hand_out()
-                except StopIteration:
-                    continue
-                if failed:
-                    yield failed
+                yield from hand_out()
         finally:
             client.cancel(list(pending))
 

@@ -8,8 +8,9 @@ failure (a machine, the disk, memory), 130 for Ctrl-C; never a traceback.
 
 # Ctrl-C while Python imports click, numpy and the rest would print a traceback: until the
 # command runs, an interrupt just says so and exits (nothing has been written yet).
+# `_signal` is the built-in C module (`signal` itself spends ~10 ms building enums).
+import _signal
 import os
-import signal
 
 
 def _interrupted_early(signum, frame) -> None:
@@ -17,10 +18,11 @@ def _interrupted_early(signum, frame) -> None:
     os._exit(130)
 
 
-if signal.getsignal(signal.SIGINT) is signal.default_int_handler:  # keep SIG_IGN of background jobs
-    signal.signal(signal.SIGINT, _interrupted_early)
+if _signal.getsignal(_signal.SIGINT) is _signal.default_int_handler:  # keep SIG_IGN of background jobs
+    _signal.signal(_signal.SIGINT, _interrupted_early)
 
 import errno  # noqa: E402 - after the Ctrl-C handler on purpose
+import signal  # noqa: E402
 import sys  # noqa: E402
 import warnings  # noqa: E402
 

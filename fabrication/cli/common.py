@@ -14,6 +14,12 @@ def warn(message: str) -> None:
     console.print(f"[yellow]warning:[/yellow] {message}", soft_wrap=True)
 
 
+def step(description: str):
+    """A live status line (spinner, stage name) while a step runs, on a terminal only: in a
+    log or a pipe nothing but the final summary is printed."""
+    return console.status(description)
+
+
 def done(message: str) -> None:
     """Print a one-line summary of what a command made."""
     click.echo(message)

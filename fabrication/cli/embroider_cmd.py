@@ -7,7 +7,7 @@ import time
 
 import click
 
-from fabrication.cli.common import console, done, edits_option, warn
+from fabrication.cli.common import console, done, edits_option, step, warn
 from fabrication.cli.options import (Integer, Length, Number, drawing_input_options, input_argument,
                                      output_option, placement_options)
 from onestroke.errors import InputError
@@ -108,6 +108,11 @@ def embroider(source: str, output: str, style: str, size: float | None, width: f
 
     started = time.perf_counter()
     # Every option is checked before anything is read or written.
+    check_distinct(inputs=[("input", source), ("--edits file", edits)],
+                   outputs=[("output", output), ("--preview", preview_path)])
+    if stitch_length is not None and stitch_length < min_stitch:
+        raise InputError(f"--stitch-length {stitch_length:g} mm is shorter than --min-stitch {min_stitch:g} mm, "
+                         "so every stitch would be merged away; lengthen it or lower --min-stitch")
     settings = embroidery_settings(
         output=output, style=style, size=size, width=width, height=height, rotate=rotate, hoop=hoop, fit=fit,
         stitch_length=stitch_length, tolerance=tolerance, stitch_width=stitch_width, spacing=spacing,
@@ -115,11 +120,6 @@ def embroider(source: str, output: str, style: str, size: float | None, width: f
         min_stroke=min_stroke, min_stitch=min_stitch, max_stitch=max_stitch, trim_distance=trim_distance,
         lock_form=lock_form, color=color, thread_chart=thread_chart, start=start, name=design_name,
         source=source, date=source_date(), pes_version=pes_version, spm=spm)
-    check_distinct(inputs=[("input", source), ("--edits file", edits)],
-                   outputs=[("output", output), ("--preview", preview_path)])
-    if stitch_length is not None and stitch_length < min_stitch:
-        raise InputError(f"--stitch-length {stitch_length:g} mm is shorter than --min-stitch {min_stitch:g} mm, "
-                         "so every stitch would be merged away; lengthen it or lower --min-stitch")
     if preview_path is not None:
         check_preview_path(preview_path)
         preview_options = PreviewOptions(width=preview_width, style=preview_style,
@@ -137,19 +137,20 @@ def embroider(source: str, output: str, style: str, size: float | None, width: f
     else:
         from fabrication.cli.common import read_drawing
 
-        drawing = read_drawing(source, multi=multi, threshold=threshold, blur=blur, classifier=classifier,
-                               edits=edits)
-    result = embroider_drawing(drawing, job)
-    write_embroidery(result.plan, output, pes_version=pes_version)
+        with step(f"reading {os.path.basename(source)}"):
+            drawing = read_drawing(source, multi=multi, threshold=threshold, blur=blur,
+                                   classifier=classifier, edits=edits)
+    with step("planning the stitches"):
+        result = embroider_drawing(drawing, job)
+    with step(f"writing {os.path.basename(output)}"):
+        write_embroidery(result.plan, output, pes_version=pes_version)
     if preview_path is not None:
-        render_stitch_preview(result.plan, preview_path, hoop=the_hoop, stats=result.stats,
-                              options=preview_options)
+        with step("drawing the preview"):
+            render_stitch_preview(result.plan, preview_path, hoop=the_hoop, stats=result.stats,
+                                  options=preview_options)
 
     for message in result.warnings:
         warn(message)
-    if color is not None and len(job.plan.colors) > len(result.drawing.strokes):
-        warn(f"--color lists {len(job.plan.colors)} colours for {len(result.drawing.strokes)} "
-             "stroke(s); the extra colours are unused")
     stats = result.stats
     for line in stats.lines():
         console.print(line, soft_wrap=True)

@@ -10,7 +10,7 @@ import os
 
 import click
 
-from fabrication.cli.common import console, done, warn
+from fabrication.cli.common import console, done, step, warn
 from fabrication.cli.options import Integer, Number, input_argument, output_option
 from onestroke.errors import InputError
 from onestroke.paths import check_distinct
@@ -52,7 +52,8 @@ def preview(source: str, output: str, width_px: int, hoop: str | None, spm: floa
     if suffix in GCODE_SUFFIXES:
         from fabrication.laser.preview import render_gcode_preview
 
-        job = render_gcode_preview(source, output)
+        with step(f"drawing {os.path.basename(source)}"):
+            job = render_gcode_preview(source, output)
         minutes, seconds = divmod(int(round(job.total_seconds)), 60)
         done(f"wrote {output}: laser job about {minutes} min {seconds:02d} s")
         return
@@ -73,8 +74,10 @@ def preview(source: str, output: str, width_px: int, hoop: str | None, spm: floa
         else:
             from fabrication.cli.common import read_drawing
 
-            drawing = read_drawing(source)
-        render_drawing_preview(drawing, output, options)
+            with step(f"reading {os.path.basename(source)}"):
+                drawing = read_drawing(source)
+        with step("drawing the preview"):
+            render_drawing_preview(drawing, output, options)
         done(f"wrote {output}: {len(drawing.strokes)} stroke(s), length {drawing.length:.1f} {drawing.unit}")
         return
 
@@ -85,10 +88,12 @@ def preview(source: str, output: str, width_px: int, hoop: str | None, spm: floa
 
     profile = load_embroidery_profile()
     the_hoop = profile.hoop(hoop) if hoop is not None else None
-    read = read_embroidery(source)
+    with step(f"reading {os.path.basename(source)}"):
+        read = read_embroidery(source)
     stats = embroidery_stats(read.plan, stitches_per_minute=spm or profile.stitches_per_minute,
                              trim_seconds=profile.trim_seconds, color_changes=read.color_changes)
-    render_stitch_preview(read.plan, output, hoop=the_hoop, stats=stats, options=options)
+    with step("drawing the preview"):
+        render_stitch_preview(read.plan, output, hoop=the_hoop, stats=stats, options=options)
     for message in stats.warnings:
         warn(message)
     for line in stats.lines():
@@ -107,8 +112,9 @@ def _player_page(source: str, output: str, hoop: str | None, spm: float | None) 
     if hoop is not None:
         field = profile.hoop(hoop)
         frame = (-field.width / 2, -field.height / 2, field.width / 2, field.height / 2)
-    data = player_data_for_file(source, stitches_per_minute=spm or profile.stitches_per_minute,
-                                trim_seconds=profile.trim_seconds, hoop=frame)
+    with step(f"reading {os.path.basename(source)}"):
+        data = player_data_for_file(source, stitches_per_minute=spm or profile.stitches_per_minute,
+                                    trim_seconds=profile.trim_seconds, hoop=frame)
     for message in data.warnings:
         warn(message)
     write_player_html(data, output, source=source)

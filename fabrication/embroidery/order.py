@@ -148,7 +148,8 @@ def sewing_order(drawing: Drawing, *, colors: tuple[RGB, ...] = (), default: RGB
         position = strokes[members[chosen][-1]].end
     threads = tuple(nearest_thread(c, thread_chart) if thread_chart else Thread(color=c) for c in blocks)
     block_of = {c: k for k, c in enumerate(blocks)}
-    # Strokes sewn with the chart's thread are drawn in the thread's colour from here on.
-    sewn = tuple(Stroke(strokes[i].control, threads[block_of[rgb[i]]].color) for i in order)
+    # The same stroke objects (their cached arc-length tables with them); threads are
+    # looked up through `block`.
+    sewn = tuple(strokes[i] for i in order)
     return SewingOrder(drawing=drawing.with_strokes(sewn), source=tuple(source[i] for i in order),
                        threads=threads, block=tuple(block_of[rgb[i]] for i in order))

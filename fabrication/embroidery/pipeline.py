@@ -83,6 +83,9 @@ def embroider(drawing: Drawing, job: EmbroideryJob = EmbroideryJob()) -> Embroid
     plan = plan_embroidery(hooped, job.plan)
     check_plan_in_hoop(plan, job.hoop)
     warnings.extend(plan.dropped)
+    if len(job.plan.colors) > len(drawing.strokes):
+        warnings.append(f"--color lists {len(job.plan.colors)} colours for {len(drawing.strokes)} "
+                        "stroke(s); the extra colours are unused")
     warnings.extend(_long_stitch_warnings(plan, style))
     plan = replace(plan, name=job.name, field=(job.hoop.width, job.hoop.height), date=job.date)
     stats = embroidery_stats(plan, stitches_per_minute=job.stitches_per_minute,

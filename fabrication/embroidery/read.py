@@ -47,8 +47,10 @@ def read_embroidery(path: str | os.PathLike) -> EmbroideryFile:
     try:
         pattern = pyembroidery.read(path)
     except Exception as error:  # pyembroidery raises anything on a corrupt file
-        raise InputError(f"cannot read {path!r}: not a valid {suffix} file "
-                         f"({type(error).__name__}: {error})") from None
+        # pyembroidery's exception text is its own internals (an index, a struct size): not
+        # worth showing; what the user needs is that the file is not what its name says.
+        raise InputError(f"cannot read {path!r}: it is not a valid {suffix} file (damaged, truncated or "
+                         "another format)") from None
     if pattern is None or not pattern.stitches:
         raise InputError(f"{path!r} holds no stitches pyembroidery can read")
     rows = np.asarray(pattern.stitches, dtype=float).reshape(-1, 3)

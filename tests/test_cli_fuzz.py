@@ -1,0 +1,38 @@
+"""Fuzzed inputs through every reading command: PNG bytes, SVG text, G-code text and option
+values (Hypothesis, derandomized, bounded to about a minute). Each command line must exit
+0, 1 or 2, show no traceback, leave no partial or half-written file and finish in time.
+The longer run of 2,000 inputs is `python benchmarks/fuzz.py`.
+"""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+import pytest
+from hypothesis import HealthCheck, given, settings
+
+ROOT = Path(__file__).resolve().parents[1]
+if str(ROOT) not in sys.path:
+    sys.path.insert(0, str(ROOT))
+
+from benchmarks.fuzz_cases import fuzz_case, run_case  # noqa: E402
+
+TIME_BOUND = 60.0  # s per command line: generous for a loaded CI machine; a hang is minutes
+
+
+@pytest.mark.parametrize("kind,examples", [("png", 15), ("svg", 30), ("gcode", 20), ("options", 25)])
+def test_fuzzed_command_lines(kind, examples, tmp_path_factory):
+    folder = tmp_path_factory.mktemp(f"fuzz-{kind}")
+
+    @settings(max_examples=examples, derandomize=True, deadline=None, database=None,
+              suppress_health_check=list(HealthCheck))
+    @given(fuzz_case(kind))
+    def check(case):
+        outcome = run_case(case, folder, time_bound=TIME_BOUND)
+        assert not outcome.hung, (case, "ran past the time bound")
+        assert outcome.traceback is None, (case, outcome.traceback)
+        assert outcome.exit_code in (0, 1, 2), (case, outcome.exit_code)
+        assert outcome.leftovers == (), (case, outcome.leftovers)
+
+    check()

@@ -1,0 +1,221 @@
+"""Issue 14, item by item: a table of command lines with the exit code and a fragment of the
+one-line message each must give. Every row failed before the change (a silent overwrite, a
+traceback, a run away, a misleading message) and passes after it.
+
+Runs through click's CliRunner (faithful here: the same group, the same error mapping);
+only Ctrl-C and file-size limits need a real process.
+"""
+
+from __future__ import annotations
+
+import os
+import signal
+import subprocess
+import sys
+import time
+
+import numpy as np
+import pytest
+from click.testing import CliRunner
+from PIL import Image
+
+from fabrication.cli import main
+from vectorize.drawing import Drawing
+from vectorize.stroke import Stroke
+from vectorize.svg_write import write_drawing
+
+PATH = '<path d="M 20 120 C 40 20, 80 20, 100 75 S 160 130, 180 30" fill="none" stroke="black" stroke-width="3"/>'
+
+
+def svg(body: str = PATH, root: str = 'xmlns="http://www.w3.org/2000/svg"', wrap: str | None = None) -> str:
+    text = f'<svg {root} width="200" height="150">{body}</svg>'
+    return wrap.format(text) if wrap else text
+
+
+FILES = {
+    "d.svg": svg(),
+    "https.svg": svg(root='xmlns="https://www.w3.org/2000/svg"'),
+    "slash.svg": svg(root='xmlns="http://www.w3.org/2000/svg/"'),
+    "xhtml.svg": svg(wrap='<html xmlns="http://www.w3.org/1999/xhtml"><body>{}</body></html>'),
+    "hidden.svg": svg(root='xmlns="http://www.w3.org/2000/svg" style="display:none"'),
+    "huge-circle.svg": svg('<circle id="sun" cx="50" cy="50" r="1e300" fill="black"/>'),
+    "e30.svg": svg('<path d="M1e30 0 L 2e30 5e29 L 3e30 0" stroke="black" fill="none"/>'),
+    "job.gcode": "G21\nG90\nM4 S0\nG0 X5 Y5\nG1 X30 Y5 S600 F1500\nG1 X30 Y30\nM5\n",
+}
+
+
+@pytest.fixture(scope="module")
+def folder(tmp_path_factory):
+    base = tmp_path_factory.mktemp("refusals")
+    for name, text in FILES.items():
+        (base / name).write_text(text, encoding="utf-8")
+    (base / "latin1.gcode").write_bytes(b"; Tiefe 2\xb0 (Latin-1 degree sign)\n" + FILES["job.gcode"].encode())
+    (base / "garbage.pes").write_bytes(np.random.default_rng(4).integers(0, 256, 3000, dtype=np.uint8).tobytes())
+    noise = (np.random.default_rng(0).random((400, 400)) * 255).astype(np.uint8)
+    Image.fromarray(noise).save(base / "noise.png")
+    (base / "far.json").write_text(
+        '{"format": "onestroke-drawing", "width": 10, "height": 10, "unit": "px", '
+        '"strokes": [[[[0, 0], [1, 1], [2, 2], [1e300, 5e299]]]]}', encoding="utf-8")
+    os.symlink(base / "d.svg", base / "link.svg")
+    os.link(base / "d.svg", base / "hard.svg")
+    (base / "dir.pes").mkdir()
+    os.symlink(base / "x.gcode", base / "x.frame.gcode")  # laser -o x.gcode --frame writes it: the same file
+    return base
+
+
+# (item, arguments, exit code, fragment of stderr); {in} is the input folder, {out} a fresh one.
+TABLE = [
+    # 1. an output never replaces an input or another output
+    ("1", ["vectorize", "{in}/d.svg", "-o", "{in}/d.svg"], 2, "same file as the input"),
+    ("1", ["vectorize", "{in}/d.svg", "-o", "{in}/link.svg"], 2, "same file as the input"),
+    ("1", ["vectorize", "{in}/d.svg", "-o", "{in}/hard.svg"], 2, "same file as the input"),
+    ("1", ["embroider", "{in}/d.svg", "-o", "{out}/d.pes", "--preview", "{in}/d.svg"], 2, "--preview"),
+    ("1", ["preview", "{in}/d.svg", "-o", "{in}/d.svg"], 2, "same file as the input"),
+    ("1", ["laser", "{in}/d.svg", "-o", "{in}/x.gcode", "--frame"], 2, "frame file"),
+    # 2. SVG spellings read, absurd coordinates refused naming the element
+    ("2", ["vectorize", "{in}/https.svg", "-o", "{out}/a.svg"], 0, ""),
+    ("2", ["vectorize", "{in}/slash.svg", "-o", "{out}/a.svg"], 0, ""),
+    ("2", ["vectorize", "{in}/xhtml.svg", "-o", "{out}/a.svg"], 0, ""),
+    ("2", ["vectorize", "{in}/hidden.svg", "-o", "{out}/a.svg"], 2, "hidden"),
+    ("2", ["vectorize", "{in}/huge-circle.svg", "-o", "{out}/a.svg"], 2, "<circle id='sun'>"),
+    ("2", ["vectorize", "{in}/e30.svg", "-o", "{out}/a.svg"], 2, "beyond the limit"),
+    ("2", ["preview", "{in}/far.json", "-o", "{out}/a.png"], 2, "beyond the limit"),
+    # 3. options that would run away are refused before any work
+    ("3", ["embroider", "{in}/d.svg", "-o", "{out}/a.pes", "--stitch-length", "0.0001mm"], 2, "--stitch-length"),
+    ("3", ["embroider", "{in}/d.svg", "-o", "{out}/a.pes", "--stitch-length", "0.2mm"], 2, "--min-stitch"),
+    ("3", ["laser", "{in}/d.svg", "-o", "{out}/a.gcode", "--passes", "1000000"], 2, "--passes"),
+    ("3", ["laser", "{in}/d.svg", "-o", "{out}/a.gcode", "--blur", "1e9"], 2, "--blur"),
+    ("3", ["vectorize", "{in}/d.svg", "-o", "{out}/a.svg", "--blur", "1e9"], 2, "--blur"),
+    ("3", ["laser", "{in}/d.svg", "-o", "{out}/a.gcode", "--feed", "0.0001mm/min"], 2, "--feed"),
+    ("3", ["laser", "{in}/noise.png", "-o", "{out}/a.gcode"], 2, "--blur"),
+    # 4. OS errors: one line
+    ("4", ["vectorize", "{in}/d.svg", "-o", "/proc/onestroke-test.svg"], 1, "cannot write"),
+    ("4", ["vectorize", "{in}/d.svg", "-o", "/sys/onestroke-test.svg"], 1, "cannot write"),
+    # 5. messages name the real problem and an option the command has
+    ("5", ["embroider", "{in}/dir.pes", "-o", "{out}/a.pes"], 2, "is a directory"),
+    ("5", ["preview", "{in}/dir.pes", "-o", "{out}/a.png"], 2, "is a directory"),
+    ("5", ["vectorize", "{in}/d.svg", "-o", "/etc/hostname/x.svg"], 2, "is a file, not a folder"),
+    ("5", ["embroider", "{in}/d.svg", "-o", "{out}/a.pes", "--rotate", "nan"], 2, "--rotate nan is not a finite"),
+    ("5", ["embroider", "{in}/d.svg", "-o", "{out}/a.pes", "--hoop", "9" * 1000], 2, " ... "),
+    ("5", ["vectorize", "{in}/noise.png", "-o", "{out}/a.svg", "--threshold", "0.4"], 2, "with that threshold"),
+    ("5", ["preview", "{in}/garbage.pes", "-o", "{out}/a.png"], 2, "not a valid .pes file (damaged"),
+    ("5", ["stream", "{in}/job.gcode", "--port", ""], 2, "--port is empty"),
+    ("5", ["stream", "{in}/job.gcode", "--port", "sim://foo"], 2, "sim://?speed"),
+    ("5", ["stream", "{in}/job.gcode", "--port", "sim://", "--check", "--frame"], 2, "cannot be combined"),
+    ("5", ["laser", "{in}/d.svg", "-o", "{out}/a.gcode", "--port", "sim://", "--baud", "0"], 2, "--baud 0"),
+    ("5", ["preview", "{in}/latin1.gcode", "-o", "{out}/a.png"], 0, ""),
+    ("5", ["vectorize", "{in}/d.svg", "-o", "{out}/a.svg", "--classifier", "x"], 2, "vectorize --help'"),
+]
+
+
+@pytest.mark.parametrize("item,args,code,fragment", TABLE,
+                         ids=[f"{i}:{' '.join(a[:1] + a[3:])[:60]}" for i, a, _, _ in TABLE])
+def test_invocation(folder, tmp_path, item, args, code, fragment):
+    argv = [a.replace("{in}", str(folder)).replace("{out}", str(tmp_path)) for a in args]
+    before = {p.name: p.lstat().st_mtime_ns for p in folder.iterdir()}
+    result = CliRunner().invoke(main, argv)
+    assert result.exit_code == code, (result.exit_code, result.output)
+    assert "Traceback" not in result.output and "internal error" not in result.stderr
+    if code:
+        lines = result.stderr.strip().splitlines()
+        assert len(lines) == 1 and lines[0].startswith("error: "), result.stderr
+        assert fragment in lines[0] and len(lines[0]) <= 520, lines[0]
+        assert list(tmp_path.iterdir()) == []  # nothing written, not even a partial file
+    assert {p.name: p.lstat().st_mtime_ns for p in folder.iterdir()} == before  # inputs untouched
+
+
+def test_laser_blur_exists_and_threshold_hint_does_not_chase_itself(folder, tmp_path):
+    """`laser` on noise suggests --blur: laser has it. A threshold the user gave is not
+    suggested again, lower (0.40 -> 0.35 -> 0.30 ...)."""
+    result = CliRunner().invoke(main, ["laser", str(folder / "noise.png"), "-o", str(tmp_path / "a.gcode"),
+                                       "--threshold", "0.35"])
+    assert result.exit_code == 2 and "--blur" in result.stderr and "--threshold" not in result.stderr
+    assert "--blur" in CliRunner().invoke(main, ["laser", "--help"]).output
+
+
+def test_disk_full_is_one_line_and_leaves_nothing(folder, tmp_path, monkeypatch):
+    """ENOSPC as the kernel reports it when the data reaches the disk (fsync)."""
+    import errno
+
+    def full(fd):
+        raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
+
+    monkeypatch.setattr(os, "fsync", full)
+    result = CliRunner().invoke(main, ["vectorize", str(folder / "d.svg"), "-o", str(tmp_path / "a.svg")])
+    assert result.exit_code == 1 and result.stderr.strip() == \
+        f"error: cannot write {str(tmp_path / 'a.svg')!r}: the disk is full"
+    assert list(tmp_path.iterdir()) == []
+
+
+def _child(*args, **kwargs):
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join(sys.path)}
+    # "ready" once the interpreter itself is up: Ctrl-C before that is Python's, not ours.
+    code = "import sys; print('ready', flush=True); from fabrication.cli import main; main()"
+    return subprocess.Popen([sys.executable, "-c", code, *args],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, env=env, text=True, **kwargs)
+
+
+def test_file_size_limit_is_one_line_exit_1(folder, tmp_path):
+    """A real EFBIG from the kernel (RLIMIT_FSIZE, SIGXFSZ ignored) while writing."""
+    import resource
+
+    def limit():
+        signal.signal(signal.SIGXFSZ, signal.SIG_IGN)
+        resource.setrlimit(resource.RLIMIT_FSIZE, (100, 100))
+
+    child = _child("vectorize", str(folder / "d.svg"), "-o", str(tmp_path / "a.svg"), preexec_fn=limit)
+    out, err = child.communicate(timeout=120)
+    assert child.returncode == 1 and err.startswith("error: cannot write") and "Traceback" not in err, err
+    assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize("delay", [0.05, 0.15, 0.5])
+def test_ctrl_c_while_importing_is_one_line(folder, tmp_path, delay):
+    """Ctrl-C at once (click, rich being imported), a little later (numpy, scipy, the
+    vectorizer) and during the work: "interrupted", exit 130, no traceback, no file."""
+    def take_sigint():  # background test runs start children with SIGINT ignored
+        signal.signal(signal.SIGINT, signal.SIG_DFL)
+
+    child = _child("vectorize", str(folder / "noise.png"), "-o", str(tmp_path / "a.svg"), preexec_fn=take_sigint)
+    assert child.stdout.readline().strip() == "ready"
+    time.sleep(delay)
+    child.send_signal(signal.SIGINT)
+    out, err = child.communicate(timeout=120)
+    assert "Traceback" not in err, err
+    assert (child.returncode, err.strip()) == (130, "interrupted"), (child.returncode, err)
+    assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.slow
+def test_a_169_megapixel_scan_is_read_downscaled(tmp_path):
+    """A 13,000 px square scan (169 Mpx, past Pillow's bomb guard) just works, downscaled."""
+    from PIL import ImageDraw
+
+    image = Image.new("L", (13000, 13000), 255)
+    ImageDraw.Draw(image).ellipse([2000, 2000, 11000, 11000], outline=0, width=60)
+    image.save(tmp_path / "scan.png", compress_level=1)
+    del image
+    result = CliRunner().invoke(main, ["vectorize", str(tmp_path / "scan.png"), "-o", str(tmp_path / "scan.svg")])
+    assert result.exit_code == 0, result.output
+    assert "downscaled" in result.stderr and (tmp_path / "scan.svg").stat().st_size > 0
+
+
+def test_readme_zigzag_example_runs(tmp_path):
+    """The README's zigzag example, as written, on the shipped example drawing."""
+    import re
+    import shlex
+    from pathlib import Path
+
+    readme = (Path(__file__).parents[1] / "README.md").read_text(encoding="utf-8")
+    line = next(l for l in readme.splitlines() if l.startswith("onestroke embroider") and "--style zigzag" in l)
+    args = shlex.split(line.split("#")[0])[1:]
+    args[1] = str(Path(__file__).parents[1] / "examples" / "loops.png")
+    args = [str(tmp_path / a) if re.fullmatch(r"[\w.-]+\.(jef|pes|png)", a) else a for a in args]
+    result = CliRunner().invoke(main, args)
+    assert result.exit_code == 0, result.output
+
+
+def test_drawing_with_far_stroke_is_refused_in_the_library():
+    with pytest.raises(ValueError, match="beyond the limit"):
+        Drawing((Stroke.from_polyline(np.array([[0.0, 0.0], [2e7, 0.0]])),), 10, 10, "px")
+    write_drawing  # noqa: B018 - imported for the fixture JSON's format name
