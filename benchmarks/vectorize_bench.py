@@ -289,7 +289,8 @@ def junction_check(classifiers: list[str]) -> None:
     """Each classifier on crops centred at the ground-truth crossings, touches and
     near-touches of the generated sets, with branch directions measured on the ground truth
     3 widths out: how well it does when the pipeline's junction is exactly right."""
-    from vectorize.intersections import Junction, make_classifier
+    from vectorize.classifiers import make_classifier
+    from vectorize.intersections import Junction
 
     labels = {}
     for name, gt in TASKS:

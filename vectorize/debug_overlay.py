@@ -11,7 +11,7 @@ import numpy as np
 from PIL import Image, ImageDraw
 
 from onestroke.atomic import atomic_open
-from vectorize.pipeline import VectorizeResult
+from vectorize.options import VectorizeResult
 
 DEGREE_COLORS = {1: (0, 160, 0), 2: (120, 120, 120), 3: (230, 120, 0), 4: (200, 0, 200)}
 

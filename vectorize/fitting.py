@@ -8,16 +8,20 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.interpolate import splev, splprep
 
+from vectorize.ink_guard import InkGuard, curve_excess, keep_in_ink
 from vectorize.stroke import Stroke
 
 
 @dataclass(frozen=True)
 class TracedPoint:
-    """A point of a traversed stroke with what the filter needs to know about it."""
+    """A point of a traversed stroke with what the filter needs to know about it: keep it
+    for the fit; split the fit there; a corner (split, and the joint goes where the two
+    sides' tangents meet)."""
 
     xy: np.ndarray
     keep: bool
     split: bool
+    corner: bool = False
 
 
 def _dedupe(points: np.ndarray, min_step: float) -> np.ndarray:
@@ -118,9 +122,7 @@ def sharp_corners(xy: np.ndarray, stroke_width: float, *, closed: bool) -> np.nd
     narrow = _turn(xy, arc, 0.5 * stroke_width, closed)
     candidate = (wide > np.radians(40.0)) & (narrow > 0.6 * wide)
     corners: list[int] = []
-    for i in np.argsort(-wide):
-        if not candidate[i]:
-            break
+    for i in np.flatnonzero(candidate)[np.argsort(-wide[candidate], kind="stable")]:
         if all(abs(arc[i] - arc[j]) > 2.0 * stroke_width for j in corners):
             corners.append(int(i))
     return np.array(sorted(corners), dtype=int)
@@ -145,22 +147,34 @@ def _corner_point(before: np.ndarray, after: np.ndarray, fallback: np.ndarray, l
     return point
 
 
-def fit_stroke(traced: list[TracedPoint], *, closed: bool, sigma: float, stroke_width: float) -> Stroke:
-    """Filter, split at sharp features (Y-feet tips, corners) and fit one traversed stroke."""
+def _open_fit(points: np.ndarray, sigma: float) -> np.ndarray:
+    return fit_piece(points, closed=False, sigma=sigma, anchor=True)
+
+
+def fit_stroke(traced: list[TracedPoint], *, closed: bool, sigma: float, stroke_width: float,
+               guard: InkGuard | None = None) -> Stroke:
+    """Filter, split at sharp features (Y-feet tips, cusps, corners) and fit one traversed
+    stroke; with `guard`, every piece is brought back inside the ink where it strays
+    (`vectorize.ink_guard`)."""
     xy = np.array([p.xy for p in traced])
     keep = np.array([p.keep for p in traced])
     split = np.array([p.split for p in traced])
     corner = np.zeros(len(xy), dtype=bool)
     found = sharp_corners(xy, stroke_width, closed=closed)
     corner[found[keep[found] & ~split[found]]] = True
+    corner |= np.array([p.corner for p in traced], dtype=bool)
     split |= corner
     split_at = np.flatnonzero(split)
-    if closed and split_at.size:
-        # Start a closed stroke at its first sharp feature: then it is a chain of open pieces.
-        shift = int(split_at[0])
+    if closed and split_at.size and len(xy) > 3:
+        # Where a closed line starts cannot be read from the ink; start at its top-left
+        # sharp feature, as a pen usually does: then it is a chain of open pieces.
+        if np.allclose(xy[0], xy[-1]):
+            xy, keep, split, corner = xy[:-1], keep[:-1], split[:-1], corner[:-1]
+            split_at = np.flatnonzero(split)
+        shift = int(split_at[np.argmin(xy[split_at].sum(axis=1))])
         xy, keep, split, corner = (np.roll(a, -shift, axis=0) for a in (xy, keep, split, corner))
         xy = np.vstack([xy, xy[:1]])
-        keep, split, corner = np.append(keep, True), np.append(split, True), np.append(corner, corner[0])
+        keep, split, corner = np.append(keep, keep[0]), np.append(split, split[0]), np.append(corner, corner[0])
         closed = False
     # Around a corner the axis is off the centre line for about a stroke width: leave it out.
     arc = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(xy, axis=0), axis=1))])
@@ -185,6 +199,12 @@ def fit_stroke(traced: list[TracedPoint], *, closed: bool, sigma: float, stroke_
         else:
             control = fit_piece(piece, closed=closed and len(cuts) == 2, sigma=sigma,
                                 anchor=not (corner[lo] or corner[hi]))
+            if guard is not None:
+                # Measured against every traced point of the piece, the uncertain ones too.
+                whole = xy[lo:hi + 1]
+                if closed and len(cuts) == 2:
+                    whole = np.vstack([whole, whole[:1]])
+                control = keep_in_ink(whole, control, guard, _open_fit, sigma)
         previous = piece
         pieces.append(np.array(control))  # writable: the joints move its ends
     # Join the pieces: at corners where their sides meet, elsewhere where they end.
@@ -195,14 +215,27 @@ def fit_stroke(traced: list[TracedPoint], *, closed: bool, sigma: float, stroke_
         before, after = pieces[k], pieces[m]
         if corner[at]:
             point = _corner_point(before, after, xy[at], 2.0 * stroke_width)
+            if guard is not None and guard.excess(point)[0] > 0.0:
+                point = xy[at]
         else:
             point = (before[-1, 3] + after[0, 0]) / 2.0
-        if not corner[at]:
+        if not corner[at] or np.array_equal(point, xy[at]):
             # Elsewhere move the inner handles along, keeping both end tangents; at a
             # corner the point lies on the tangents already.
             before[-1, 2] += point - before[-1, 3]
             after[0, 1] += point - after[0, 0]
         before[-1, 3] = point
         after[0, 0] = point
+    if guard is not None:
+        # Moving the ends to the joints can swing a piece out (a corner cut across the paper):
+        # refit those between their joints on all of their traced points.
+        for k, (lo, hi) in enumerate(zip(cuts[:-1], cuts[1:])):
+            if curve_excess(guard, pieces[k])[0] <= 0.0:
+                continue
+            whole = xy[lo:hi + 1].copy()
+            if len(pieces) == 1 and closed:
+                continue  # a closed piece has no joints: it was checked when fitted
+            whole[0], whole[-1] = pieces[k][0, 0], pieces[k][-1, 3]
+            pieces[k] = keep_in_ink(whole, _open_fit(whole, sigma), guard, _open_fit, sigma)
     control = np.concatenate(pieces, axis=0)
     return Stroke(control)

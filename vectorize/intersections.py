@@ -4,19 +4,18 @@ A degree-4 node joins four branches. The pen either crossed (each branch continu
 one opposite it) or the two curves touched and turned back (two branches pair up on each
 side). A classifier gives the probability of a crossing; when it says "touching", the
 pairing with the smaller tangent discontinuity is taken (paper, Section 3.3.1). Any
-classifier that follows `IntersectionClassifier` plugs in without touching the traversal.
+classifier that follows `IntersectionClassifier` plugs in without touching the traversal
+(`vectorize.classifiers.make_classifier` builds the named ones).
 """
 
 from __future__ import annotations
 
-import functools
 from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Protocol
 
 import numpy as np
 
-from onestroke.errors import InputError
 
 # A configuration pairs the four branch slots 0..3 into two passes through the node.
 Pairing = tuple[tuple[int, int], tuple[int, int]]
@@ -130,19 +129,3 @@ class GeometricClassifier:
             p = float(1.0 / (1.0 + np.exp(4.0 * (straight - touch))))
             verdicts.append(JunctionVerdict(p_crossing=p, confidence=max(p, 1.0 - p)))
         return verdicts
-
-
-@functools.lru_cache(maxsize=None)
-def make_classifier(name: str) -> IntersectionClassifier:
-    """The classifier called `name`: "cnn" (shipped ONNX model) or "geometric".
-
-    Cached: loading and hash-checking the model and starting onnxruntime cost more than
-    classifying a drawing, and the classifiers hold no state that a run changes.
-    """
-    if name == "geometric":
-        return GeometricClassifier()
-    if name == "cnn":
-        from vectorize.cnn_classifier import CnnClassifier
-
-        return CnnClassifier()
-    raise InputError(f"unknown classifier {name!r}; use 'cnn' or 'geometric'")

@@ -10,99 +10,14 @@ from __future__ import annotations
 
 import os
 import time
-from dataclasses import dataclass, field
 
 import numpy as np
 
 from onestroke.errors import InputError
-from vectorize.drawing import Drawing
+from vectorize.options import InputFrame, VectorizeOptions, VectorizeReport, VectorizeResult
 
-
-@dataclass(frozen=True, kw_only=True)
-class VectorizeOptions:
-    """Options of the vectorizer.
-
-    multi: multi-stroke mode (paper 4.5) instead of one single line.
-    threshold: gray level in [0, 1] below which a pixel is ink (None: Li's method).
-    blur: Gaussian sigma in px applied before thresholding (0: none).
-    classifier: "cnn" (shipped model) or "geometric" (tangent continuity).
-    max_size: longest side of the working image in px; larger inputs are downscaled.
-    seed: seed of every random choice (retry search ties), for reproducible output.
-    """
-
-    multi: bool = False
-    threshold: float | None = None
-    blur: float = 0.0
-    classifier: str = "cnn"
-    max_size: int = 1000
-    seed: int = 0
-    keep_stages: bool = False
-
-    def __post_init__(self) -> None:
-        if self.threshold is not None and not 0.0 < self.threshold < 1.0:
-            raise InputError(f"threshold {self.threshold!r} must lie strictly between 0 and 1")
-        if self.blur < 0:
-            raise InputError(f"blur sigma {self.blur!r} must be >= 0")
-        if self.classifier not in ("cnn", "geometric"):
-            raise InputError(f"unknown classifier {self.classifier!r}; use 'cnn' or 'geometric'")
-        if self.max_size < 64:
-            raise InputError(f"max_size {self.max_size!r} must be at least 64 px")
-
-
-@dataclass(frozen=True)
-class VectorizeReport:
-    """What happened: counts, warnings and time, for the CLI and the benchmark.
-
-    strokes: strokes produced; intersections: degree-4 nodes classified; y_junctions: sharp
-    out-and-back features kept; dropped_components: ink pieces left out (single-line mode);
-    gaps_bridged: pen gaps joined across (single-line mode, `gaps.py`);
-    high_degree_junctions: nodes where three or more strokes meet (not resolved);
-    scale: working px per input px (< 1 when downscaled); seconds: wall time per stage.
-    """
-
-    strokes: int = 0
-    intersections: int = 0
-    y_junctions: int = 0
-    dropped_components: int = 0
-    gaps_bridged: int = 0
-    high_degree_junctions: int = 0
-    retries: int = 0
-    scale: float = 1.0
-    stroke_width: float = 0.0
-    warnings: tuple[str, ...] = ()
-    seconds: dict = field(default_factory=dict)
-
-    @property
-    def total_seconds(self) -> float:
-        return float(sum(self.seconds.values()))
-
-
-@dataclass(frozen=True)
-class VectorizeResult:
-    """The drawing (px, in the input image's frame) and the report; `stages` for --debug;
-    `graph`: the junctions and branches the edits act on (`vectorize.refine.GraphView`),
-    when the run was given edits or a stage cache."""
-
-    drawing: Drawing
-    report: VectorizeReport
-    stages: dict | None = None
-    graph: object | None = None
-
-
-@dataclass(frozen=True)
-class InputFrame:
-    """How the pipeline's input image sits in the frame the output is written in.
-
-    scale: image px per output unit; offset: (2,) output position of the image's corner;
-    width/height: the output canvas; reduced_from: (W, H) of an original image that was
-    shrunk before the pipeline saw it (for the "downscaled" message), else None.
-    """
-
-    scale: float
-    offset: tuple[float, float]
-    width: float
-    height: float
-    reduced_from: tuple[int, int] | None = None
+__all__ = ["InputFrame", "VectorizeOptions", "VectorizeReport", "VectorizeResult", "vectorize_file",
+           "vectorize_image"]
 
 
 def vectorize_file(path: str | os.PathLike, options: VectorizeOptions = VectorizeOptions(), *,

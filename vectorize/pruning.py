@@ -93,7 +93,9 @@ def trim_free_ends(graph: MedialGraph, *, stroke_width: float) -> None:
         band = out.radii[(arc >= 0.6 * stroke_width) & (arc <= 1.4 * stroke_width)]
         if band.size < 3:
             continue
-        full = 0.85 * float(np.median(band))
+        # Not more than the drawing's own half width: where the ink widens inwards (the foot
+        # of a sharp V, both sides' inks merged) the end already is the cap's centre.
+        full = 0.85 * min(float(np.median(band)), 0.5 * stroke_width)
         first = int(np.argmax(out.radii >= full))
         if first == 0 or arc[first] > stroke_width or first >= len(out.points) - 2:
             continue

@@ -11,7 +11,7 @@ feature drawn out and back, kept and traversed twice.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -96,6 +96,7 @@ class Simplified:
     unresolved: tuple
     t_ends: tuple
     retraced: frozenset = frozenset()
+    through: dict = field(default_factory=dict)  # node where three passes cross -> slot pairs
 
 
 def _min_radius(branch: Branch) -> float:
@@ -135,14 +136,17 @@ def _merge(graph: MedialGraph, a: int, b: int, bid: int) -> int:
 
 
 def simplify(graph: MedialGraph, *, stroke_width: float, multi: bool, ends: int = 2,
-             may_merge=None, after_merging=None) -> Simplified:
+             may_merge=None, after_merging=None, through: dict | None = None) -> Simplified:
     """Merge crossing halves into degree-4 nodes in place and classify the other nodes.
 
     ends: free ends the single line is taken to have (2 open, 0 closed); free ends beyond
     those may be read as spikes drawn out and back. The user's edits hook in here
     (`vectorize.refine`): may_merge(branch) -> False keeps the two nodes it joins apart (a
     split); after_merging(graph) makes the user's own merges before the nodes are typed.
+    through: nodes already resolved as three passes crossing (`vectorize.clusters`) -> their
+    slot pairs; they are kept as they are.
     """
+    through = dict(through or {})
     reach = 2.5 * stroke_width
     merged = 0
 
@@ -259,7 +263,7 @@ def simplify(graph: MedialGraph, *, stroke_width: float, multi: bool, ends: int 
                 if not _v_spike(graph, node, reach):
                     retraced.add(node)  # a T: the spike runs back over itself
                 y_tips.add(graph.branches[node_slots[spike][0]].other(node))
-            elif _is_t_shape(dirs):
+            elif is_t_shape(dirs):
                 # A stroke ending on another line: an end of the drawing (paper 3.3, 4.5).
                 t_ends.append(node)
             else:
@@ -268,14 +272,14 @@ def simplify(graph: MedialGraph, *, stroke_width: float, multi: bool, ends: int 
                 unresolved.append(node)
                 if not multi:
                     t_ends.append(node)
-        elif degree >= 5:
+        elif degree >= 5 and node not in through:
             unresolved.append(node)
     crossings = tuple(sorted(graph.nodes_of_degree(4)))
     return Simplified(y_feet, frozenset(y_tips), crossings, merged, tuple(unresolved), tuple(t_ends),
-                      frozenset(retraced))
+                      frozenset(retraced), through)
 
 
-def _is_t_shape(dirs: np.ndarray) -> bool:
+def is_t_shape(dirs: np.ndarray) -> bool:
     """Largest angle between branches near 180 degrees and the other two alike (paper 4.5)."""
     pairs = [(0, 1), (0, 2), (1, 2)]
     angles = sorted(float(np.degrees(np.arccos(np.clip(np.dot(dirs[i], dirs[j]), -1, 1)))) for i, j in pairs)

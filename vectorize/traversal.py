@@ -2,14 +2,12 @@
 
 The walk starts at an end of the drawing and follows branches; at a degree-4 node it
 leaves by the branch the chosen pairing assigns, at a Y-junction it goes down the foot
-and back, at other nodes it goes as straight as it can. When a single-line drawing comes
-out as several strokes, some degree-4 decision was wrong: a best-first search over the
-alternatives, cheapest (least confident) first, looks for a one-stroke ordering.
+and back, at other nodes it goes as straight as it can. This is the multi-stroke mode's
+walk; a single line is routed by `vectorize.route_inspection`.
 """
 
 from __future__ import annotations
 
-import heapq
 from dataclasses import dataclass
 
 import numpy as np
@@ -17,10 +15,6 @@ import numpy as np
 from vectorize.graph import MedialGraph
 from vectorize.intersections import Pairing
 from vectorize.simplify import Simplified, Slot, directions, slots
-
-# Bound of the retry search: traversals tried before giving up on one stroke.
-MAX_TRAVERSALS = 400
-
 
 @dataclass(frozen=True)
 class Pass:
@@ -153,45 +147,16 @@ class Walker:
 
 
 def order_strokes(graph: MedialGraph, simple: Simplified, ranked: dict[int, tuple[Pairing, ...]],
-                  costs: dict[int, tuple[float, ...]], *, stroke_width: float, search: bool) -> tuple[Ordering, int]:
-    """Traverse with the preferred pairings; if that gives several strokes and `search`,
-    try alternatives best-first by total cost. Returns the ordering and traversals tried.
+                  costs: dict[int, tuple[float, ...]], *, stroke_width: float) -> tuple[Ordering, int]:
+    """Traverse with the preferred pairings (multi-stroke mode; single-line drawings are
+    routed by `vectorize.route_inspection`). Returns the ordering and traversals tried (1).
 
-    ranked[node]: the three pairings of a degree-4 node, preferred first; costs[node]: the
-    cost of choosing each (0 for the first, higher for less plausible ones).
+    ranked[node]: the pairings of a degree-4 node, preferred first; costs[node]: the cost of
+    choosing each (unused here, kept for a common signature with the single-line search).
     """
     walker = Walker(graph, simple, stroke_width)
     nodes = sorted(ranked)
-
-    def run(ranks: tuple[int, ...]) -> tuple[list, list]:
-        return walker.traverse({n: ranked[n][r] for n, r in zip(nodes, ranks)})
-
-    start = tuple(0 for _ in nodes)
-    best_ranks, (best_strokes, best_closed) = start, run(start)
-    tried = 1
-    if search and len(best_strokes) > 1 and nodes:
-        best_key = (len(best_strokes), 0.0)
-        heap = [(0.0, start, 0)]
-        seen = {start}
-        while heap and tried < MAX_TRAVERSALS:
-            cost, ranks, last = heapq.heappop(heap)
-            if ranks != start:
-                strokes, closed = run(ranks)
-                tried += 1
-                key = (len(strokes), cost)
-                if key < best_key:
-                    best_key, best_ranks, best_strokes, best_closed = key, ranks, strokes, closed
-                if len(strokes) == 1:
-                    break
-            # Children change one decision at or after the last changed one: each
-            # assignment is generated once, in order of increasing total cost.
-            for j in range(last, len(nodes)):
-                if ranks[j] + 1 < len(ranked[nodes[j]]):
-                    child = ranks[:j] + (ranks[j] + 1,) + ranks[j + 1:]
-                    if child not in seen:
-                        seen.add(child)
-                        delta = costs[nodes[j]][ranks[j] + 1] - costs[nodes[j]][ranks[j]]
-                        heapq.heappush(heap, (cost + delta, child, j))
-    ordering = Ordering(tuple(tuple(s) for s in best_strokes), tuple(best_closed),
-                        tuple(ranked[n][r] for n, r in zip(nodes, best_ranks)))
-    return ordering, tried
+    choice = {n: ranked[n][0] for n in nodes}
+    strokes, closed = walker.traverse(choice)
+    ordering = Ordering(tuple(tuple(p) for p in strokes), tuple(closed), tuple(choice[n] for n in nodes))
+    return ordering, 1

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import time
+from dataclasses import replace
 from typing import NamedTuple
 
 import numpy as np
@@ -14,13 +15,17 @@ from vectorize.edits import Edits
 from vectorize.fitting import TracedPoint, fit_stroke
 from vectorize.gaps import bridge_gaps, keep_largest_piece
 from vectorize.graph import MedialGraph
-from vectorize.intersections import Junction, JunctionVerdict, make_classifier, ranked_pairings
+from vectorize.ink_guard import InkGuard
+from vectorize.classifiers import make_classifier
+from vectorize.clusters import merge_triple_points, straightest_pairs
+from vectorize.intersections import Junction, JunctionVerdict, ranked_pairings
 from vectorize.medial_axis import medial_axis
 from vectorize.outline import outline_rings
-from vectorize.pipeline import InputFrame, VectorizeOptions, VectorizeReport, VectorizeResult
+from vectorize.options import InputFrame, VectorizeOptions, VectorizeReport, VectorizeResult
 from vectorize.pruning import prune, trim_free_ends
 from vectorize.refine import Refinement, StageCache
-from vectorize.simplify import Simplified, directions, simplify, slots
+from vectorize.route_inspection import connect_pairings, plan_routes
+from vectorize.simplify import Simplified, is_t_shape, directions, simplify, slots
 from vectorize.stroke import Stroke
 from vectorize.traversal import Ordering, order_strokes
 
@@ -112,6 +117,10 @@ def _trace(graph: MedialGraph, simple: Simplified, ordering: Ordering, junctions
         reach = max(reach, graph.spans.get(node, 0.0) + 0.5 * stroke_width)
         reach = float(np.clip(reach, graph.radii[node], 12.0 * stroke_width))
         zones.append((graph.positions[node], reach, verdicts[node].is_crossing))
+    for node in simple.through:
+        # Three passes cross: their inks overlap about as far as the cluster reached.
+        reach = float(np.clip(graph.spans.get(node, 0.0) + stroke_width, graph.radii[node], 12.0 * stroke_width))
+        zones.append((graph.positions[node], reach, True))
     result = []
     for passes, closed in zip(ordering.strokes, ordering.closed):
         traced: list[TracedPoint] = []
@@ -122,20 +131,24 @@ def _trace(graph: MedialGraph, simple: Simplified, ordering: Ordering, junctions
             far_node = branch.b if step.start == "a" else branch.a
             points = points if index == 0 else points[1:]
             on_foot = step.branch in foot_branches
+            # The pen turns back on itself: a cusp (the fit splits there, never loops).
+            turns_back = (index + 1 < len(passes) and passes[index + 1].branch == step.branch
+                          and passes[index + 1].start != step.start)
             for k, xy in enumerate(points):
                 last = k == len(points) - 1
-                tip = last and far_node in simple.y_tips
+                tip = last and (far_node in simple.y_tips or turns_back)
                 keep = (not on_foot) or tip
                 traced.append(TracedPoint(xy, keep, tip))
         xy = np.array([t.xy for t in traced])
         for base in sharp_points:
             for i in np.flatnonzero(np.all(xy == base, axis=1)):
-                traced[i] = TracedPoint(traced[i].xy, traced[i].keep, True)
+                traced[i] = TracedPoint(traced[i].xy, traced[i].keep, True, traced[i].corner)
         for center, reach, crossing in zones:
             dist = np.linalg.norm(xy - center, axis=1)
             for i in np.flatnonzero(dist < reach):
                 at_node = dist[i] < 1e-6
-                traced[i] = TracedPoint(traced[i].xy, crossing and at_node and traced[i].keep, traced[i].split)
+                traced[i] = TracedPoint(traced[i].xy, crossing and at_node and traced[i].keep, traced[i].split,
+                                        traced[i].corner)
         result.append((traced, closed))
     return result
 
@@ -170,7 +183,11 @@ def _order(graph: MedialGraph, ink, options: VectorizeOptions, ends: int, clock:
         graph, simple, junctions, verdicts = cached
     else:
         hooks = refine.simplify_hooks() if refine is not None else {}
-        simple = simplify(graph, stroke_width=w, multi=options.multi, ends=ends, **hooks)
+        through = merge_triple_points(graph, stroke_width=w, may_merge=hooks.get("may_merge"))
+        simple = simplify(graph, stroke_width=w, multi=options.multi, ends=ends, through=through, **hooks)
+        # Paired after simplification: merging crossings next to a triple point renumbers its slots.
+        simple = replace(simple, through={n: straightest_pairs(directions(graph, n, 2.5 * w))[0]
+                                          for n in simple.through})
         clock.lap("simplification")
         junction_list = _junctions(graph, simple.crossings, w)
         junctions = dict(zip(simple.crossings, junction_list))
@@ -186,9 +203,48 @@ def _order(graph: MedialGraph, ink, options: VectorizeOptions, ends: int, clock:
     costs = {n: _pairing_costs(verdicts[n]) for n in simple.crossings}
     if refine is not None:
         refine.fix_pairings(junctions, ranked, costs)
-    ordering, tried = order_strokes(graph, simple, ranked, costs, stroke_width=w, search=not options.multi)
+    if options.multi:
+        ordering, tried = order_strokes(graph, simple, ranked, costs, stroke_width=w)
+    else:
+        ordering, tried = _single_route(graph, simple, ranked, costs, w)
     clock.lap("traversal")
     return _Solution(graph, simple, junctions, verdicts, ordering, tried)
+
+
+# Cost (in stroke widths) of the pen starting or ending at a junction that is not a line
+# ending on another line: a whole spike of up to this length is retraced rather.
+JUNCTION_END = 20.0
+
+
+def _junction_end_cost(graph: MedialGraph, node: int, dirs: np.ndarray, w: float) -> float:
+    """How poor a place `node` is for the pen to start or end (px).
+
+    Plausible only where a line comes in and stops on another (a T whose stem is not a
+    free branch: the tail of a 6 closing its loop). A junction where a stub or spike
+    leaves a line is not: the pen would have drawn the stub first from its far end.
+    """
+    if len(dirs) == 3 and is_t_shape(dirs):
+        cos = [(float(np.dot(dirs[i], dirs[j])), k) for i, j, k in ((0, 1, 2), (0, 2, 1), (1, 2, 0))]
+        stem = min(cos)[1]
+        if graph.degree(graph.branches[slots(graph, node)[stem][0]].other(node)) != 1:
+            return 0.1 * w
+    return JUNCTION_END * w
+
+
+def _single_route(graph: MedialGraph, simple: Simplified, ranked: dict, costs: dict,
+                  w: float) -> tuple[Ordering, int]:
+    """Single-line mode: one stroke over the whole (connected) graph, retracing the least."""
+    pairing, tried = connect_pairings(graph, ranked, costs, fixed=simple.through)
+    dirs = {n: directions(graph, n, 2.5 * w) for n in graph.incident if graph.degree(n) >= 3}
+    # The tip of a sharp corner's spur is not where a pen starts; a junction is a poorer
+    # place than a free end, all else equal.
+    v_tips = {graph.branches[slots(graph, n)[f][0]].other(n) for n, f in simple.y_feet.items()
+              if n not in simple.retraced}
+    end_cost = {n: 3.0 * w for n in v_tips}
+    end_cost.update({n: _junction_end_cost(graph, n, dirs[n], w) for n in dirs})
+    routes = plan_routes(graph, {**simple.through, **pairing}, stroke_width=w, directions=dirs, end_cost=end_cost)
+    choice = tuple(pairing.get(n, ranked[n][0]) for n in simple.crossings)
+    return Ordering(tuple(r.passes for r in routes), tuple(r.closed for r in routes), choice), tried
 
 
 def _refuse_noise(count: int, what: str, limit: int, threshold: float, given: bool) -> None:
@@ -279,11 +335,12 @@ def run_pipeline(image: np.ndarray, options: VectorizeOptions, *,
     # Smoothing allowance: the medial axis wobbles by ~0.07 px per px of stroke width (pixel
     # grid, anti-aliasing); fitting tighter follows that wobble, looser cuts corners.
     sigma = float(np.clip(0.065 * w, 0.15, 0.8))
+    guard = InkGuard(graph, ink.gray, ink.threshold) if solved is None else None
     strokes = list(solved[1]) if solved is not None else []
     for traced, closed in _trace(graph, simple, ordering, junctions, verdicts, w) if solved is None else ():
         if len(traced) < 2:
             continue
-        strokes.append(_orient(fit_stroke(traced, closed=closed, sigma=sigma, stroke_width=w), closed))
+        strokes.append(_orient(fit_stroke(traced, closed=closed, sigma=sigma, stroke_width=w, guard=guard), closed))
     if refine is not None and solved is None:
         refine.keep_solved(best, strokes)
     strokes = [s for s in strokes if s.length > 0.5 * w or len(strokes) == 1]

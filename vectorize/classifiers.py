@@ -1,0 +1,34 @@
+"""The crossing classifiers by name: the factory beside the pipeline that calls it.
+
+`vectorize.intersections` holds the junction types and the geometric rule, and
+`vectorize.cnn_classifier` the network; this module imports both, so neither imports the
+other back.
+"""
+
+from __future__ import annotations
+
+import functools
+
+from onestroke.errors import InputError
+from vectorize.intersections import GeometricClassifier, IntersectionClassifier
+
+
+def make_classifier(name: str | IntersectionClassifier) -> IntersectionClassifier:
+    """The classifier called `name`: "cnn" (shipped ONNX model) or "geometric"; a classifier
+    object (`VectorizeOptions.classifier` may hold one) is returned as it is."""
+    if not isinstance(name, str):
+        return name
+    return _named(name)
+
+
+@functools.lru_cache(maxsize=None)
+def _named(name: str) -> IntersectionClassifier:
+    """Cached: loading and hash-checking the model and starting onnxruntime cost more than
+    classifying a drawing, and the classifiers hold no state that a run changes."""
+    if name == "geometric":
+        return GeometricClassifier()
+    if name == "cnn":
+        from vectorize.cnn_classifier import CnnClassifier
+
+        return CnnClassifier()
+    raise InputError(f"unknown classifier {name!r}; use 'cnn' or 'geometric'")

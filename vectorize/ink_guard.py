@@ -1,0 +1,108 @@
+"""The curve never leaves the ink: measure a fitted piece against the medial balls, refit it
+closer, split it, or in the end follow the centre line itself.
+
+The ink is the union of its medial balls (each centre-line point with its radius), so a
+point p lies within the ink grown by `margin` px exactly when |p - q| - r(q) <= margin for
+some centre-line point q. A smooth spline fitted through two passes of a retraced stem, or
+pulled across a sharp turn, can swing outside; the ladder below brings it back, each rung
+tighter than the one before: refit with every point and little smoothing; split at the
+worst point and fit the halves; the centre line as a polyline.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+import numpy as np
+from scipy.ndimage import map_coordinates
+from scipy.spatial import cKDTree
+
+from vectorize.graph import MedialGraph
+from vectorize.stroke import Stroke
+
+# Nearest centre-line points looked at per sample: a ball further down the list than this
+# is smaller than a nearer one's (they are 0.25-1 px apart along the line).
+NEIGHBOURS = 8
+SPLIT_DEPTH = 4
+
+
+class InkGuard:
+    """How far points lie outside the ink grown by `margin` px (<= 0: inside).
+
+    graph: the centre line with radii; gray, level: the working image and its ink
+    threshold. Pruning leaves the tips of sharp corners uncovered by medial balls, so a
+    point the balls miss is looked up in the image itself (with its `margin` around it).
+    """
+
+    def __init__(self, graph: MedialGraph, gray: np.ndarray, level: float, *, margin: float = 1.0) -> None:
+        self.gray, self.level = gray, level
+        points = [b.points for b in graph.branches.values()]
+        radii = [b.radii for b in graph.branches.values()]
+        if graph.positions:
+            points.append(np.array(list(graph.positions.values())))
+            radii.append(np.array(list(graph.radii.values())))
+        self.points = np.vstack(points) if points else np.zeros((1, 2))
+        self.radii = np.concatenate(radii) if radii else np.zeros(1)
+        self.tree = cKDTree(self.points)
+        self.margin = margin
+
+    def excess(self, xy: np.ndarray) -> np.ndarray:
+        """(N, 2) points -> (N,) px beyond the grown ink (negative inside)."""
+        xy = np.asarray(xy, dtype=float).reshape(-1, 2)
+        k = min(NEIGHBOURS, len(self.points))
+        dist, index = self.tree.query(xy, k=k)
+        dist, index = dist.reshape(len(xy), k), index.reshape(len(xy), k)
+        excess = (dist - self.radii[index]).min(axis=1) - self.margin
+        out = np.flatnonzero(excess > 0.0)
+        if out.size:
+            angles = np.linspace(0.0, 2.0 * np.pi, 8, endpoint=False)
+            ring = np.vstack([[0.0, 0.0], self.margin * np.column_stack([np.cos(angles), np.sin(angles)])])
+            probe = (xy[out, None, :] + ring[None]).reshape(-1, 2)
+            h, w = self.gray.shape
+            values = map_coordinates(self.gray, [np.clip(probe[:, 1], 0, h - 1), np.clip(probe[:, 0], 0, w - 1)],
+                                     order=1, mode="nearest").reshape(len(out), len(ring))
+            excess[out[(values < self.level).any(axis=1)]] = 0.0
+        return excess
+
+    def stroke_excess(self, stroke: Stroke) -> float:
+        """Largest excess along a stroke (px), sampled within 0.2 px of the curve."""
+        return float(self.excess(stroke.flatten(0.2)).max())
+
+
+def curve_excess(guard: InkGuard, control: np.ndarray) -> tuple[float, np.ndarray]:
+    """Largest excess of a piece and where it is."""
+    pts = Stroke(control).flatten(0.2)
+    ex = guard.excess(pts)
+    k = int(np.argmax(ex))
+    return float(ex[k]), pts[k]
+
+
+def keep_in_ink(points: np.ndarray, control: np.ndarray, guard: InkGuard,
+                fit: Callable[[np.ndarray, float], np.ndarray], sigma: float,
+                depth: int = 0) -> np.ndarray:
+    """A fit of `points` (N, 2), the piece's whole traced centre line, that stays in the ink.
+
+    control: (K, 4, 2) the first fit; fit(points, sigma) -> control fits an open piece
+    anchored at its ends. Returns control points (K', 4, 2) whose curve lies within the
+    guard's margin of the ink wherever the centre line itself does.
+    """
+    worst, at = curve_excess(guard, control)
+    if worst <= 0.0 or len(points) < 3:
+        return control
+    # The centre line itself may run outside (a bridged pen gap): then only do as well.
+    allowed = max(0.0, float(guard.excess(points).max()))
+    if worst <= allowed + 1e-6:
+        return control
+    tight = fit(points, 0.25 * sigma)
+    tight_worst, at = curve_excess(guard, tight)
+    if tight_worst <= allowed + 1e-6:
+        return tight
+    if depth < SPLIT_DEPTH and len(points) >= 8:
+        # Split at the traced point nearest the worst place, away from the piece's ends.
+        k = int(np.argmin(np.linalg.norm(points - at, axis=1)))
+        k = min(max(k, 2), len(points) - 3)
+        left, right = points[:k + 1], points[k:]
+        first = keep_in_ink(left, fit(left, sigma), guard, fit, sigma, depth + 1)
+        second = keep_in_ink(right, fit(right, sigma), guard, fit, sigma, depth + 1)
+        return np.concatenate([first, second], axis=0)
+    return Stroke.from_polyline(points).control

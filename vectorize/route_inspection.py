@@ -1,0 +1,471 @@
+"""One connected drawing, one stroke: route inspection (Chinese postman) on the branch graph.
+
+A single line visits every branch of its ink once, except where the pen went out and back
+(a retraced stem, a crossbar drawn out and back, a sharp spike): those branches are drawn
+twice. When the graph has more than two odd-degree nodes, no walk uses every branch once;
+the cheapest set of branches to draw twice is a minimum-weight matching of the odd nodes
+over shortest-path distances (Edmonds and Johnson's route inspection), leaving two of them
+unmatched for the pen to start and end at. Every decided junction (a crossing or a touch at
+a degree-4 node, or a cluster where three passes cross) is a set of through-paths here, so
+retraced paths go through it the way the pairing says and the walk never turns there.
+
+The walk itself is Fleury's rule (never cross a bridge of what is left while there is
+another way) with the smoothest exit first: at a junction the pen goes as straight as the
+drawing still allows, and a stub drawn out and back is taken when the pen passes it.
+"""
+
+from __future__ import annotations
+
+import functools
+import heapq
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.sparse import coo_matrix
+from scipy.sparse.csgraph import connected_components, dijkstra
+
+from vectorize.graph import MedialGraph
+from vectorize.simplify import slots
+from vectorize.traversal import Pass
+
+# The exact matching (bitmask dynamic programme) runs up to this many odd nodes: its states
+# grow as 2^n. Above it the matching is greedy (cheapest pair first) and then improved by
+# swapping partners between two pairs until no swap helps: within a few per cent of the
+# optimum on metric distances, not exact.
+EXACT_ODD_NODES = 14
+
+
+def _back(p: Pass) -> Pass:
+    return Pass(p.branch, "b" if p.start == "a" else "a")
+
+
+@dataclass(frozen=True)
+class Chain:
+    """Branches joined through decided junctions: from (u, u_slot) to (v, v_slot).
+
+    u, v: graph nodes where the chain ends (nodes that are not decided); slots index
+    `slots(graph, node)`. A chain through decided junctions only has u = v = -1.
+    """
+
+    passes: tuple[Pass, ...]
+    u: int
+    u_slot: int
+    v: int
+    v_slot: int
+    length: float
+
+
+@dataclass(frozen=True)
+class Route:
+    """The single stroke: its branch passes in drawing order, whether it is closed, and the
+    retraced length (px) the matching added."""
+
+    passes: tuple[Pass, ...]
+    closed: bool
+    retraced: float
+
+
+def _partners(pairings: dict[int, tuple[tuple[int, int], ...]]) -> dict[int, dict[int, int]]:
+    result = {}
+    for node, pairs in pairings.items():
+        result[node] = {}
+        for a, b in pairs:
+            result[node][a], result[node][b] = b, a
+    return result
+
+
+def chains(graph: MedialGraph, pairings: dict) -> list[Chain]:
+    """Cut the graph into chains between undecided nodes (pairings: node -> slot pairs)."""
+    partner = _partners(pairings)
+    node_slots = {n: slots(graph, n) for n in graph.incident}
+    index = {n: {s: i for i, s in enumerate(sl)} for n, sl in node_slots.items()}
+    seen_branch: set[int] = set()
+    result = []
+
+    def follow(node: int, slot: int) -> tuple[list[Pass], int, int, float]:
+        passes, length = [], 0.0
+        while True:
+            bid, end = node_slots[node][slot]
+            seen_branch.add(bid)
+            passes.append(Pass(bid, end))
+            branch = graph.branches[bid]
+            length += branch.length
+            far = branch.b if end == "a" else branch.a
+            far_slot = index[far][(bid, "b" if end == "a" else "a")]
+            if far not in partner:
+                return passes, far, far_slot, length
+            node, slot = far, partner[far][far_slot]
+            if node_slots[node][slot][0] in seen_branch and (node, slot) == start:
+                return passes, -1, -1, length  # back where a closed chain began
+
+    done: set[tuple[int, int]] = set()
+    for node in sorted(graph.incident):
+        if node in partner:
+            continue
+        for slot in range(len(node_slots[node])):
+            if (node, slot) in done:
+                continue
+            start = (node, slot)
+            passes, far, far_slot, length = follow(node, slot)
+            done.add((node, slot))
+            done.add((far, far_slot))
+            result.append(Chain(tuple(passes), node, slot, far, far_slot, length))
+    for node in sorted(partner):
+        for slot in range(len(node_slots[node])):
+            if node_slots[node][slot][0] in seen_branch:
+                continue
+            start = (node, slot)
+            passes, _, _, length = follow(node, slot)
+            result.append(Chain(tuple(passes), -1, -1, -1, -1, length))
+    return result
+
+
+def pieces(graph: MedialGraph, pairings: dict) -> int:
+    """How many separate lines the graph falls into when decided junctions are through-paths."""
+    partner = _partners(pairings)
+    ids: dict[tuple[int, int], int] = {}
+
+    def vertex(node: int, slot: int) -> int:
+        if node in partner:
+            key = (node, min(slot, partner[node][slot]))
+        else:
+            key = (node, -1)
+        return ids.setdefault(key, len(ids))
+
+    rows, cols = [], []
+    for node in graph.incident:
+        for slot, (bid, end) in enumerate(slots(graph, node)):
+            if end == "a":
+                branch = graph.branches[bid]
+                far_slot = slots(graph, branch.b).index((bid, "b"))
+                rows.append(vertex(node, slot))
+                cols.append(vertex(branch.b, far_slot))
+    if not ids:
+        return 0
+    links = coo_matrix((np.ones(len(rows)), (rows, cols)), shape=(len(ids), len(ids)))
+    return int(connected_components(links, directed=False)[0])
+
+
+def match_odd(dist: np.ndarray, end_cost: np.ndarray) -> tuple[list[tuple[int, int]], list[int]]:
+    """Pairs of odd nodes to join by retraced paths, and the (0 or 2) left for the ends.
+
+    dist: (M, M) path costs between the M odd nodes (M even); end_cost: (M,) cost of the
+    pen starting or ending at each. Minimises the sum of the pairs' costs plus the ends'.
+    Exact for M <= EXACT_ODD_NODES (bitmask dynamic programme), greedy with pair swaps above.
+    """
+    m = len(dist)
+    if m == 0:
+        return [], []
+    if m <= EXACT_ODD_NODES:
+        return _match_exact(dist, end_cost)
+    return _match_greedy(dist, end_cost)
+
+
+def _match_exact(dist: np.ndarray, end_cost: np.ndarray) -> tuple[list[tuple[int, int]], list[int]]:
+    m = len(dist)
+    full = (1 << m) - 1
+    d = dist.tolist()
+    e = end_cost.tolist()
+
+    @functools.lru_cache(maxsize=None)
+    def best(mask: int, ends_left: int) -> tuple[float, tuple]:
+        if mask == full:
+            return 0.0, ()
+        i = (~mask & (mask + 1)).bit_length() - 1  # lowest node not yet placed
+        options = []
+        if ends_left:
+            cost, plan = best(mask | (1 << i), ends_left - 1)
+            options.append((cost + e[i], ((i, -1),) + plan))
+        for j in range(i + 1, m):
+            if not mask >> j & 1 and d[i][j] < np.inf:
+                cost, plan = best(mask | (1 << i) | (1 << j), ends_left)
+                options.append((cost + d[i][j], ((i, j),) + plan))
+        return min(options, key=lambda o: o[0]) if options else (np.inf, ())
+
+    _, plan = best(0, 2)
+    best.cache_clear()
+    pairs = [(i, j) for i, j in plan if j >= 0]
+    ends = [i for i, j in plan if j < 0]
+    return pairs, ends
+
+
+def _match_greedy(dist: np.ndarray, end_cost: np.ndarray) -> tuple[list[tuple[int, int]], list[int]]:
+    m = len(dist)
+    # The two ends: the pair of nodes whose removal leaves the cheapest greedy matching is
+    # too costly to search; take the two with the largest distance to their nearest other
+    # odd node, net of their end cost (the ones a retrace would reach furthest for).
+    nearest = np.where(np.eye(m, dtype=bool), np.inf, dist).min(axis=1) - end_cost
+    ends = [int(i) for i in np.argsort(-nearest, kind="stable")[:2]]
+    free = [i for i in range(m) if i not in ends]
+    order = sorted((dist[i, j], i, j) for a, i in enumerate(free) for j in free[a + 1:])
+    placed: set[int] = set()
+    pairs = []
+    for _, i, j in order:
+        if i not in placed and j not in placed:
+            pairs.append((i, j))
+            placed |= {i, j}
+    improved = True
+    while improved:
+        improved = False
+        for a in range(len(pairs)):
+            for b in range(a + 1, len(pairs)):
+                (i, j), (k, l) = pairs[a], pairs[b]
+                now = dist[i, j] + dist[k, l]
+                for x, y in (((i, k), (j, l)), ((i, l), (j, k))):
+                    if dist[x] + dist[y] < now - 1e-9:
+                        pairs[a], pairs[b] = x, y
+                        now = dist[x] + dist[y]
+                        improved = True
+    return pairs, ends
+
+
+class _Multigraph:
+    """Chains (and their retraced copies) as edges between undecided nodes."""
+
+    def __init__(self, chain_list: list[Chain]) -> None:
+        self.chains = chain_list
+        self.edges: list[int] = []  # edge -> chain index
+        self.at: dict[int, list[tuple[int, str]]] = {}  # node -> [(edge, end "u"/"v")]
+        self.used: list[bool] = []
+
+    def add(self, chain_index: int) -> None:
+        edge = len(self.edges)
+        self.edges.append(chain_index)
+        self.used.append(False)
+        c = self.chains[chain_index]
+        self.at.setdefault(c.u, []).append((edge, "u"))
+        self.at.setdefault(c.v, []).append((edge, "v"))
+
+    def far(self, edge: int, end: str) -> tuple[int, int]:
+        c = self.chains[self.edges[edge]]
+        return (c.v, c.v_slot) if end == "u" else (c.u, c.u_slot)
+
+    def slot(self, edge: int, end: str) -> int:
+        c = self.chains[self.edges[edge]]
+        return c.u_slot if end == "u" else c.v_slot
+
+    def free_at(self, node: int) -> list[tuple[int, str]]:
+        return [(e, end) for e, end in self.at.get(node, []) if not self.used[e]]
+
+    def reaches(self, start: int, goal: int, skip: int) -> bool:
+        """Whether `goal` can be reached from `start` over unused edges other than `skip`."""
+        if start == goal:
+            return True
+        seen, stack = {start}, [start]
+        while stack:
+            node = stack.pop()
+            for e, end in self.at.get(node, []):
+                if self.used[e] or e == skip:
+                    continue
+                nxt = self.far(e, end)[0]
+                if nxt == goal:
+                    return True
+                if nxt not in seen:
+                    seen.add(nxt)
+                    stack.append(nxt)
+        return False
+
+
+def _fleury(multi: _Multigraph, start: int, first_slot: int | None, turn) -> list[tuple[int, str]]:
+    """An Euler walk from `start`: (edge, end it leaves from) in order; smoothest exit first."""
+    walk: list[tuple[int, str]] = []
+    node, entry = start, first_slot
+    total = len(multi.edges)
+    while len(walk) < total:
+        options = multi.free_at(node)
+        if not options:
+            break
+        options.sort(key=lambda o: (turn(node, entry, multi.slot(*o)), o[0]))
+        choice = options[0]
+        if len(options) > 1:
+            for e, end in options:
+                far = multi.far(e, end)[0]
+                # Not a bridge: the far node is reachable without it, or it is the last way on.
+                if far == node or multi.reaches(node, far, e):
+                    choice = (e, end)
+                    break
+        e, end = choice
+        multi.used[e] = True
+        walk.append(choice)
+        node, entry = multi.far(e, end)
+    return walk
+
+
+def plan_routes(graph: MedialGraph, pairings: dict, *, stroke_width: float, directions: dict,
+                end_cost: dict[int, float] | None = None) -> list[Route]:
+    """One stroke per piece of the graph over all its branches, retracing as little as it can.
+
+    pairings: node -> slot pairs of its through-paths (decided junctions); directions: node
+    -> (D, 2) unit tangents per slot, leaving the node (for junctions of degree >= 3);
+    end_cost: px added when the pen starts or ends at a node (default 0): makes some nodes,
+    such as the tip of a sharp corner's spur, poor places to start. A graph that is one
+    piece under the pairings (see `connect_pairings`) gives exactly one route.
+    """
+    chain_list = chains(graph, pairings)
+    nodes = sorted({c.u for c in chain_list if c.u >= 0} | {c.v for c in chain_list if c.v >= 0})
+    where = {n: i for i, n in enumerate(nodes)}
+    open_chains = [c for c in chain_list if c.u >= 0]
+    links = coo_matrix((np.ones(len(open_chains)), ([where[c.u] for c in open_chains], [where[c.v] for c in open_chains])),
+                       shape=(len(nodes), len(nodes)))
+    _, label = connected_components(links, directed=False)
+    groups: dict[int, list[Chain]] = {}
+    for c in open_chains:
+        groups.setdefault(int(label[where[c.u]]), []).append(c)
+    routes = [_route(graph, group, stroke_width, directions, end_cost or {}) for _, group in sorted(groups.items())]
+    routes += [Route(c.passes, True, 0.0) for c in chain_list if c.u < 0]
+    return routes
+
+
+def _route(graph: MedialGraph, chain_list: list[Chain], stroke_width: float, directions: dict,
+           end_cost: dict[int, float]) -> Route:
+    """The route over one connected piece of chains (none of them closed on its own)."""
+    nodes = sorted({c.u for c in chain_list if c.u >= 0} | {c.v for c in chain_list if c.v >= 0})
+    where = {n: i for i, n in enumerate(nodes)}
+    degree = np.zeros(len(nodes), dtype=int)
+    for c in chain_list:
+        if c.u >= 0:
+            degree[where[c.u]] += 1
+            degree[where[c.v]] += 1
+
+    def turn(node: int, entry: int | None, out: int) -> float:
+        """Bending of a pass into the node by slot `entry` and out by `out`: 0 straight, 2 back."""
+        if entry is None or node not in directions:
+            return 0.0
+        d = directions[node]
+        return 1.0 + float(np.dot(d[entry], d[out]))
+
+    def leave_penalty(node: int, slot: int) -> float:
+        # Tie-break by smoothness: at a three-way junction, retracing one branch leaves the
+        # other two to be walked through; prefer the retrace that leaves them straightest.
+        if node not in directions or len(directions[node]) != 3:
+            return 0.0
+        a, b = (i for i in range(3) if i != slot)
+        return 0.25 * stroke_width * turn(node, a, b)
+
+    # Shortest paths between odd nodes over the cheapest chain between each pair of nodes.
+    best_chain: dict[tuple[int, int], int] = {}
+    for k, c in enumerate(chain_list):
+        if c.u < 0 or c.u == c.v:
+            continue
+        key = (min(where[c.u], where[c.v]), max(where[c.u], where[c.v]))
+        if key not in best_chain or c.length < chain_list[best_chain[key]].length:
+            best_chain[key] = k
+    odd = [i for i in range(len(nodes)) if degree[i] % 2]
+    pairs_out: list[tuple[int, int]] = []
+    ends: list[int] = []
+    paths: list[list[int]] = []
+    if odd:
+        keys = list(best_chain)
+        weights = [max(chain_list[best_chain[k]].length, 1e-6) for k in keys]
+        rows = [k[0] for k in keys]
+        cols = [k[1] for k in keys]
+        matrix = coo_matrix((weights, (rows, cols)), shape=(len(nodes), len(nodes))).tocsr()
+        dist, pred = dijkstra(matrix, directed=False, indices=odd, return_predecessors=True)
+
+        def path(a: int, b: int) -> list[int]:
+            """Chain indices along the shortest path from odd node a to node b."""
+            row = odd.index(a)
+            seq = [b]
+            while seq[-1] != a:
+                seq.append(int(pred[row, seq[-1]]))
+            seq.reverse()
+            return [best_chain[(min(x, y), max(x, y))] for x, y in zip(seq[:-1], seq[1:])]
+
+        def end_slot(chain_index: int, node_index: int) -> int:
+            c = chain_list[chain_index]
+            return c.u_slot if where[c.u] == node_index else c.v_slot
+
+        m = len(odd)
+        cost = np.full((m, m), np.inf)
+        for i in range(m):
+            for j in range(i + 1, m):
+                dij = dist[i, odd[j]]
+                if np.isfinite(dij):
+                    p = path(odd[i], odd[j])
+                    dij += leave_penalty(nodes[odd[i]], end_slot(p[0], odd[i]))
+                    dij += leave_penalty(nodes[odd[j]], end_slot(p[-1], odd[j]))
+                cost[i, j] = cost[j, i] = dij
+        ends_cost = np.array([end_cost.get(nodes[i], 0.0) for i in odd])
+        pairs_out, ends = match_odd(cost, ends_cost)
+        paths = [path(odd[i], odd[j]) for i, j in pairs_out]
+    multi = _Multigraph(chain_list)
+    for k, c in enumerate(chain_list):
+        if c.u >= 0:
+            multi.add(k)
+    retraced = 0.0
+    for p in paths:
+        for k in p:
+            multi.add(k)
+            retraced += chain_list[k].length
+    if ends:
+        # Start at the free end if one of the two is one: the walk then reaches every
+        # junction along a branch and can go on as straight as the drawing allows.
+        start = min((nodes[odd[i]] for i in ends), key=lambda n: (len(multi.at[n]), n))
+    else:
+        # A closed walk: begin at the top-left node (any node would do).
+        start = min(nodes, key=lambda n: (float(graph.positions[n].sum()), n))
+    walk = _fleury(multi, start, None, turn)
+    passes: list[Pass] = []
+    for e, end in walk:
+        chain = chain_list[multi.edges[e]]
+        seq = chain.passes if end == "u" else tuple(_back(p) for p in reversed(chain.passes))
+        passes.extend(seq)
+    return Route(tuple(passes), not ends, retraced)
+
+
+def connect_pairings(graph: MedialGraph, ranked: dict, costs: dict, *, fixed: dict | None = None,
+                     max_tries: int = 400) -> tuple[dict, int]:
+    """Pairings for the decided junctions under which the drawing stays one piece.
+
+    ranked[node]: its pairings, preferred first; costs[node]: the cost of each. A pairing
+    that turns a touch into a crossing (or back) can cut the line into separate loops; the
+    search tries assignments best-first by total cost until the graph is one piece. If none
+    within `max_tries` is, junctions are left undecided, least sure first, until it is:
+    there the walk may turn any way. Returns node -> pairing (undecided nodes left out) and
+    the number of assignments tried. fixed: node -> slot pairs decided elsewhere (three
+    passes through a point), part of every assignment and never changed.
+    """
+    nodes = sorted(ranked)
+    fixed = fixed or {}
+
+    def assign(ranks: tuple[int, ...]) -> dict:
+        return {**fixed, **{n: ranked[n][r] for n, r in zip(nodes, ranks)}}
+
+    start = tuple(0 for _ in nodes)
+    best_key, best_ranks = (pieces(graph, assign(start)), 0.0), start
+    tried = 1
+    heap = [(0.0, start, 0)]
+    seen = {start}
+    while best_key[0] > 1 and heap and tried < max_tries:
+        cost, ranks, last = heapq.heappop(heap)
+        if ranks != start:
+            key = (pieces(graph, assign(ranks)), cost)
+            tried += 1
+            if key < best_key:
+                best_key, best_ranks = key, ranks
+                if key[0] == 1:
+                    break
+        # Children change one decision at or after the last changed one: each assignment
+        # is generated once, in order of increasing total cost.
+        for j in range(last, len(nodes)):
+            if ranks[j] + 1 < len(ranked[nodes[j]]):
+                child = ranks[:j] + (ranks[j] + 1,) + ranks[j + 1:]
+                if child not in seen:
+                    seen.add(child)
+                    delta = costs[nodes[j]][ranks[j] + 1] - costs[nodes[j]][ranks[j]]
+                    heapq.heappush(heap, (cost + delta, child, j))
+    pairing = assign(best_ranks)
+    count = best_key[0]
+    for n in fixed:
+        del pairing[n]
+    if count > 1:
+        # Least sure first: the node whose second choice costs least.
+        # A pairing the user fixed (its only choice) stays, even if the line then falls apart.
+        for node in sorted((n for n in nodes if len(ranked[n]) > 1), key=lambda n: (costs[n][1], n)):
+            trial = {n: p for n, p in pairing.items() if n != node}
+            now = pieces(graph, {**fixed, **trial})
+            if now < count:
+                pairing, count = trial, now
+            if count <= 1:
+                break
+    return pairing, tried
