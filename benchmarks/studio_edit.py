@@ -16,6 +16,7 @@ simplification on; threshold/blur/multi -> everything from binarization.
 
 from __future__ import annotations
 
+import argparse
 import os
 import sys
 import time
@@ -92,7 +93,9 @@ def bench(path: Path) -> dict[str, float]:
 
 
 def main() -> None:
-    paths = [Path(p) for p in (sys.argv[1:] or DEFAULT)]
+    parser = argparse.ArgumentParser(description="Median answer time of each studio edit kind.")
+    parser.add_argument("drawings", nargs="*", type=Path, help="raster drawings (default: three 1000 px examples)")
+    paths = parser.parse_args().drawings or [Path(p) for p in DEFAULT]
     print(f"load: {os.getloadavg()[0]:.2f} (1 min), {os.cpu_count()} cores; median of {REPEATS} per edit kind, seconds")
     kinds = ("first", "pairing", "start", "reverse", "split", "merge", "threshold", "blur", "multi")
     print(f"{'drawing':40s} " + " ".join(f"{k:>9s}" for k in kinds))

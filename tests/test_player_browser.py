@@ -7,18 +7,11 @@ from __future__ import annotations
 import re
 from pathlib import Path
 
-import pytest
 from click.testing import CliRunner
 
+from conftest import ARTIFACTS
 from fabrication.cli import main
 from player_fixtures import BLUE, RED, write_pattern
-
-sync_api = pytest.importorskip("playwright.sync_api")
-
-CHROMIUM = "/usr/bin/chromium"
-ARGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-background-networking",
-        "--disable-component-update", "--disable-sync", "--no-first-run"]
-ARTIFACTS = Path(__file__).resolve().parents[1] / "test-artifacts"
 
 # pixels of the canvas within `tol` of an RGB colour, counted in the page
 _COUNT = """([r, g, b, tol]) => {
@@ -38,16 +31,6 @@ def _number(text: str) -> int:
 def _seconds(text: str) -> float:
     minutes, seconds = text.split("/")[0].strip().split(":")[-2:]
     return int(minutes) * 60 + float(seconds)
-
-
-@pytest.fixture(scope="module")
-def browser():
-    if not Path(CHROMIUM).exists():
-        pytest.fail(f"{CHROMIUM} is missing: apt-get install -y chromium")
-    with sync_api.sync_playwright() as p:
-        browser = p.chromium.launch(executable_path=CHROMIUM, args=ARGS)
-        yield browser
-        browser.close()
 
 
 def _open(browser, path: Path):
@@ -72,7 +55,6 @@ def _open(browser, path: Path):
 
 
 def test_embroidery_player_plays_scrubs_and_draws_thread(browser, tmp_path):
-    ARTIFACTS.mkdir(exist_ok=True)
     source, out = tmp_path / "two.vp3", tmp_path / "two.html"
     write_pattern(source)
     assert CliRunner().invoke(main, ["preview", str(source), "-o", str(out)]).exit_code == 0

@@ -12,15 +12,12 @@ from pathlib import Path
 import pytest
 from click.testing import CliRunner
 
+from conftest import ARTIFACTS
 from fabrication.cli import main
 from fabrication.studio.server import StudioServer
 from fabrication.studio.session import StudioSession
 
 ROOT = Path(__file__).resolve().parents[1]
-ARTIFACTS = ROOT / "test-artifacts"
-CHROMIUM = "/usr/bin/chromium"
-ARGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-background-networking",
-        "--disable-component-update", "--disable-sync", "--no-first-run"]
 
 pytestmark = pytest.mark.slow
 
@@ -36,22 +33,17 @@ def studio(tmp_path_factory):
 
 
 @pytest.fixture(scope="module")
-def page(studio):
-    from playwright.sync_api import sync_playwright
-
-    ARTIFACTS.mkdir(exist_ok=True)
-    with sync_playwright() as playwright:
-        browser = playwright.chromium.launch(executable_path=CHROMIUM, args=ARGS)
-        context = browser.new_context(viewport={"width": 1280, "height": 760}, accept_downloads=True)
-        page = context.new_page()
-        page.set_default_timeout(20000)
-        errors = []
-        page.on("pageerror", lambda error: errors.append(str(error)))
-        page.goto(studio[0].url)
-        page.wait_for_function("window.studio.state !== null && document.body.classList.contains('busy') === false")
-        yield page
-        assert not errors, errors
-        browser.close()
+def page(studio, browser):
+    context = browser.new_context(viewport={"width": 1280, "height": 760}, accept_downloads=True)
+    page = context.new_page()
+    page.set_default_timeout(20000)
+    errors = []
+    page.on("pageerror", lambda error: errors.append(str(error)))
+    page.goto(studio[0].url)
+    page.wait_for_function("window.studio.state !== null && document.body.classList.contains('busy') === false")
+    yield page
+    context.close()
+    assert not errors, errors
 
 
 def coloured_pixels(page) -> int:

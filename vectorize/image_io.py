@@ -9,6 +9,7 @@ import numpy as np
 from PIL import Image, UnidentifiedImageError
 
 from onestroke.errors import InputError
+from vectorize.options import InputFrame
 
 # Largest image read (decoded pixels): a 1200 dpi A4 scan is 139 Mpx; beyond this a file is
 # refused before decoding. Pillow's own decompression-bomb guard is raised to this limit.
@@ -23,7 +24,6 @@ def load_image(path: str | os.PathLike, *, max_size: int | None = None):
     anything else box-averaged by Pillow on 8-bit data, so that a huge scan never needs
     gigabytes as floats. Images over `MAX_PIXELS` are refused.
     """
-    from vectorize.pipeline import InputFrame
 
     path = str(path)
     if not os.path.isfile(path):
