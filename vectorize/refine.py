@@ -96,11 +96,15 @@ class GraphView:
         return {"junctions": [vars(j) for j in self.junctions], "branches": [vars(b) for b in self.branches]}
 
 
+def _pairings(directions: np.ndarray) -> tuple:
+    """The node's three pairings in the order of `PAIRINGS`: crossing, then the touchings."""
+    return (crossing_pairing(directions),) + touching_pairings(directions)
+
+
 def pairing_kind(directions: np.ndarray, pairing) -> str:
     """Which of `PAIRINGS` this pairing of a degree-4 node's slots is."""
-    options = (crossing_pairing(directions),) + touching_pairings(directions)
     normal = tuple(sorted(tuple(sorted(p)) for p in pairing))
-    for kind, option in zip(PAIRINGS, options):
+    for kind, option in zip(PAIRINGS, _pairings(directions)):
         if tuple(option) == normal:
             return kind
     return PAIRINGS[0]
@@ -108,7 +112,7 @@ def pairing_kind(directions: np.ndarray, pairing) -> str:
 
 def pairing_of(directions: np.ndarray, kind: str):
     """The pairing of slots that `kind` names at a node with these branch directions."""
-    return ((crossing_pairing(directions),) + touching_pairings(directions))[PAIRINGS.index(kind)]
+    return _pairings(directions)[PAIRINGS.index(kind)]
 
 
 class Refinement:
