@@ -8,7 +8,7 @@ import click
 
 from fabrication.cli.common import console, done, warn
 from fabrication.cli.embroider_cmd import embroider, source_date
-from fabrication.cli.job_options import embroidery_settings, laser_settings
+from fabrication.job_options import embroidery_settings, laser_settings
 from fabrication.cli.laser_cmd import laser
 from fabrication.cli.options import Integer, drawing_input_options, placement_options
 from onestroke.errors import InputError

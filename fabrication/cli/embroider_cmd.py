@@ -100,7 +100,7 @@ def embroider(source: str, output: str, style: str, size: float | None, width: f
               preview_style: str, preview_hoop: bool, multi: bool, threshold: float | None, blur: float,
               classifier: str, edits: str | None) -> None:
     """Sew SOURCE (PNG/JPG/SVG/JSON drawing) along its curve into an embroidery file."""
-    from fabrication.cli.job_options import embroidery_settings
+    from fabrication.job_options import embroidery_settings
     from fabrication.embroidery.canvas import check_preview_path
     from fabrication.embroidery.export import write_embroidery
     from fabrication.embroidery.pipeline import embroider as embroider_drawing

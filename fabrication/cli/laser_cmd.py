@@ -64,7 +64,7 @@ def laser(source: str, output: str, size: float | None, width: float | None, hei
           classifier: str, port: str | None, baud: int, profile_path: str | None, edits: str | None) -> None:
     """Turn SOURCE (PNG/JPG/SVG) into G-code for a GRBL 1.1 laser in one continuous pass per stroke."""
     from fabrication.cli.common import read_drawing
-    from fabrication.cli.job_options import laser_settings
+    from fabrication.job_options import laser_settings
     from fabrication.laser.gcode_write import write_gcode
     from fabrication.laser.program import laser_program
     from fabrication.laser.raster_time import raster_time

@@ -16,9 +16,7 @@ from pathlib import Path
 
 import numpy as np
 
-# Imported here, in the importing (main) thread: the package installs a Ctrl-C handler when
-# imported, which Python allows only there, and the API calls run in worker threads.
-from fabrication.cli.job_options import embroidery_settings, laser_settings
+from fabrication.job_options import embroidery_settings, laser_settings
 from onestroke.atomic import atomic_write_text
 from onestroke.errors import InputError
 from vectorize import VectorizeOptions, vectorize_file

@@ -1,7 +1,7 @@
 """Command-line option values (strings such as "2.5mm") to the library's job dataclasses.
 
-Shared by `onestroke embroider`, `onestroke laser` and `onestroke batch`, so that one set of
-option values gives one job and the batch writes the same bytes as the single commands.
+Shared by `onestroke embroider`, `onestroke laser`, `onestroke batch` and the studio, so that
+one set of option values gives one job and each of them writes the same bytes.
 Nothing here prints: warnings come back as one-line messages for the caller to show.
 """
 
