@@ -2,9 +2,9 @@
 downscaled without holding the full image in memory).
 
 Generates seeded scans (a smooth closed pen line on slightly grey paper, the line about
-1.5 mm wide as at 1200 dpi) as 1-bit, gray and RGB PNG, an LZW TIFF and a JPEG, then runs
-`onestroke vectorize` on each in a child process and prints its peak RSS (the child's
-ru_maxrss), CPU seconds and exit code. The scans are written to --folder and deleted
+1.5 mm wide as at 1200 dpi) as 1-bit, gray and RGB PNG, a Group 4 (1-bit) and an LZW (gray)
+TIFF and a JPEG, then runs `onestroke vectorize` on each in a child process and prints its
+peak RSS (the child's VmHWM), CPU seconds (user + system) and exit code. The scans are written to --folder and deleted
 afterwards unless --keep; they are never committed.
 
     python benchmarks/large_scans.py                       # 139 and 300 Mpx, every kind
@@ -24,8 +24,9 @@ from pathlib import Path
 import numpy as np
 from PIL import Image, ImageDraw
 
-KINDS = ("png-1", "png-l", "png-rgb", "tiff-l", "jpeg-rgb")
+KINDS = ("png-1", "png-l", "png-rgb", "tiff-1", "tiff-l", "jpeg-rgb")
 ROOT = Path(__file__).resolve().parents[1]
+Image.MAX_IMAGE_PIXELS = None  # these scans are this large on purpose
 
 
 def scan_size(mpx: float) -> tuple[int, int]:
@@ -59,7 +60,7 @@ def write_scan(kind: str, mpx: float, folder: Path, seed: int) -> Path:
     if fmt == "png":
         image.save(path, compress_level=1)
     elif fmt == "tiff":
-        image.save(path, compression="tiff_lzw")
+        image.save(path, compression="group4" if mode == "1" else "tiff_lzw")
     else:
         image.save(path, quality=90)
     return path
@@ -105,7 +106,8 @@ def main() -> None:
             path = scan_path(folder, kind, mpx)
             if not (args.keep and path.exists()):
                 path = write_scan(kind, mpx, folder, args.seed)
-            w, h = scan_size(mpx)
+            with Image.open(path) as scan:
+                w, h = scan.size
             code, rss, cpu, message = run_vectorize(path, folder / "out.svg")
             print(f"{path.name:34} {f'{w}x{h}':>13} {path.stat().st_size / 1e6:8.1f} {code:4d} {rss:11.0f} "
                   f"{cpu:6.1f}  {message[:70]}", flush=True)

@@ -91,19 +91,15 @@ def reduce_png_stream(image: Image.Image, factor: int,
         decoder.setimage(canvas.im, (0, 0, w, h))
         inflater, wrapper = zlib.decompressobj(), zlib.compressobj(0)
         stream = _idat_data(image)
-        page = mmap.PAGESIZE
+        page, done = mmap.PAGESIZE, False
         for y0 in range(0, h, step):
             y1 = min(h, y0 + step)
-            filtered = _inflate(inflater, stream, (y1 - y0) * rowbytes)
-            stored = wrapper.compress(filtered) + wrapper.flush(zlib.Z_SYNC_FLUSH)
-            del filtered
-            status, error = decoder.decode(stored)
-            del stored
-            if error < 0 or (status < 0 and y1 < h):
-                raise OSError(f"PNG image data could not be decoded (decoder error {error})")
+            for filtered in _inflate(inflater, stream, (y1 - y0) * rowbytes):
+                done = done or _decode(decoder, wrapper.compress(filtered), last=y1 == h)
+            done = done or _decode(decoder, wrapper.flush(zlib.Z_SYNC_FLUSH), last=y1 == h)
             with memoryview(memory)[y0 * linesize:y1 * linesize] as rows:
                 band = Image.frombuffer(canvas_mode, (w, y1 - y0), rows, "raw", canvas_mode, 0, 1)
-                pieces.append(np.asarray(prepare(_as_png_mode(band, image)).reduce(factor)))
+                pieces.append(_reduce_band(band, image, factor, prepare))
                 del band
             start = y0 * linesize // page * page
             memory.madvise(mmap.MADV_DONTNEED, start, y1 * linesize - start)
@@ -117,36 +113,46 @@ def reduce_png_stream(image: Image.Image, factor: int,
     return np.concatenate(pieces, axis=0)
 
 
-def _as_png_mode(band: Image.Image, png: Image.Image) -> Image.Image:
-    """A canvas band as an image of the PNG's own mode (same pixels, as a full decode gives)."""
+def _decode(decoder, data: bytes, *, last: bool) -> bool:
+    """Feed stored deflate data to Pillow's decoder. True once it has written the image's
+    last row (status -1), which must be in the last band."""
+    if not data:
+        return False
+    status, error = decoder.decode(data)
+    if error < 0 or (status < 0 and not last):
+        raise OSError(f"the PNG image data could not be decoded (decoder error {error})")
+    return status < 0
+
+
+def _reduce_band(band: Image.Image, png: Image.Image, factor: int,
+                 prepare: Callable[[Image.Image], Image.Image]) -> np.ndarray:
+    """`prepare(<band in the PNG's mode>).reduce(factor)` for a canvas band, as an array."""
+    if png.mode in ("1", "RGB"):
+        # The canvas holds 0/255 gray for "1" and RGB plus a pad byte for "RGB"; prepare makes
+        # both RGB, copies or a subset of those channels: box-average first (a quarter of the
+        # pixels to convert), then convert. Same numbers: reduce works channel by channel.
+        return np.asarray(prepare(band.reduce(factor).convert("RGB")))
     if png.mode == "P":
         band.palette = png.palette.copy()
         band.palette.dirty = 1
         if "transparency" in png.info:
             band.info["transparency"] = png.info["transparency"]
-        return band
-    if png.mode == "1":
-        return band.convert("1", dither=Image.Dither.NONE)  # rows hold exactly 0 and 255
-    if png.mode == "LA":
-        return band.convert("LA")  # the canvas holds (L, L, L, A), Pillow's own LA storage
-    if png.mode == "RGB":
-        return band.convert("RGB")
-    return band
+    # "LA" bands are RGBA canvases holding (L, L, L, A): Pillow's own LA storage, and what
+    # converting LA to RGBA (prepare's first step for LA) gives.
+    return np.asarray(prepare(band).reduce(factor))
 
 
-def _inflate(inflater, stream: Iterator[bytes], size: int) -> bytes:
-    """The next `size` bytes of the inflated image data (filtered rows)."""
-    parts, got = [], 0
-    while got < size:
+def _inflate(inflater, stream: Iterator[bytes], size: int, piece: int = 1 << 20) -> Iterator[bytes]:
+    """The next `size` bytes of the inflated image data (filtered rows), in pieces."""
+    while size > 0:
         data = inflater.unconsumed_tail or next(stream, b"")
         if not data:
             raise OSError("the PNG image data ends early")
-        part = inflater.decompress(data, size - got)
+        part = inflater.decompress(data, min(size, piece))
         if not part and inflater.eof:
             raise OSError("the PNG image data ends early")
-        parts.append(part)
-        got += len(part)
-    return b"".join(parts)
+        size -= len(part)
+        yield part
 
 
 def _idat_data(image: Image.Image, block: int = 1 << 20) -> Iterator[bytes]:
