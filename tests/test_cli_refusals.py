@@ -13,6 +13,7 @@ import signal
 import subprocess
 import sys
 import time
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -53,6 +54,8 @@ def folder(tmp_path_factory):
     (base / "garbage.pes").write_bytes(np.random.default_rng(4).integers(0, 256, 3000, dtype=np.uint8).tobytes())
     noise = (np.random.default_rng(0).random((400, 400)) * 255).astype(np.uint8)
     Image.fromarray(noise).save(base / "noise.png")
+    Image.fromarray(noise).save(base / "2-medial-axis.png")  # the name of a --debug stage image
+    (base / "garbage.jef").write_bytes(np.random.default_rng(5).integers(0, 256, 3000, dtype=np.uint8).tobytes())
     (base / "far.json").write_text(
         '{"format": "onestroke-drawing", "width": 10, "height": 10, "unit": "px", '
         '"strokes": [[[[0, 0], [1, 1], [2, 2], [1e300, 5e299]]]]}', encoding="utf-8")
@@ -72,6 +75,8 @@ TABLE = [
     ("1", ["embroider", "{in}/d.svg", "-o", "{out}/d.pes", "--preview", "{in}/d.svg"], 2, "--preview"),
     ("1", ["preview", "{in}/d.svg", "-o", "{in}/d.svg"], 2, "same file as the input"),
     ("1", ["laser", "{in}/d.svg", "-o", "{in}/x.gcode", "--frame"], 2, "frame file"),
+    ("1", ["vectorize", "{in}/2-medial-axis.png", "-o", "{out}/a.svg", "--debug", "{in}"], 2, "--debug image"),
+    ("1", ["studio", "{in}/d.svg", "--edits", "{in}/d.svg", "--no-browser"], 2, "same file as the input"),
     # 2. SVG spellings read, absurd coordinates refused naming the element
     ("2", ["vectorize", "{in}/https.svg", "-o", "{out}/a.svg"], 0, ""),
     ("2", ["vectorize", "{in}/slash.svg", "-o", "{out}/a.svg"], 0, ""),
@@ -99,6 +104,7 @@ TABLE = [
     ("5", ["embroider", "{in}/d.svg", "-o", "{out}/a.pes", "--hoop", "9" * 1000], 2, " ... "),
     ("5", ["vectorize", "{in}/noise.png", "-o", "{out}/a.svg", "--threshold", "0.4"], 2, "with that threshold"),
     ("5", ["preview", "{in}/garbage.pes", "-o", "{out}/a.png"], 2, "not a valid .pes file (damaged"),
+    ("5", ["preview", "{in}/garbage.jef", "-o", "{out}/a.png"], 2, "not a valid .jef file (damaged"),
     ("5", ["stream", "{in}/job.gcode", "--port", ""], 2, "--port is empty"),
     ("5", ["stream", "{in}/job.gcode", "--port", "sim://foo"], 2, "sim://?speed"),
     ("5", ["stream", "{in}/job.gcode", "--port", "sim://", "--check", "--frame"], 2, "cannot be combined"),
@@ -215,6 +221,46 @@ def test_readme_zigzag_example_runs(tmp_path):
     args = [str(tmp_path / a) if re.fullmatch(r"[\w.-]+\.(jef|pes|png)", a) else a for a in args]
     result = CliRunner().invoke(main, args)
     assert result.exit_code == 0, result.output
+
+
+def test_readme_lists_every_command():
+    """Item 7: every command of the group (emulator included) is shown in the README."""
+    readme = (Path(__file__).parents[1] / "README.md").read_text(encoding="utf-8")
+    missing = [name for name in main.list_commands(None) if f"onestroke {name}" not in readme]
+    assert missing == []
+
+
+def test_readme_states_the_laser_default_size_and_it_holds(tmp_path):
+    """Item 7: without --size a raster is read at 96 px per inch (README); 800 px of ink
+    burn 800 / 96 * 25.4 = 211.7 mm wide."""
+    import re
+
+    readme = (Path(__file__).parents[1] / "README.md").read_text(encoding="utf-8")
+    assert "Without `--size`, `--width` or `--height` the design keeps the drawing's own size read at\n96 px per inch" \
+        in readme
+    image = np.full((300, 1000), 255, np.uint8)
+    image[145:155, 100:900] = 0
+    Image.fromarray(image).save(tmp_path / "bar.png")
+    result = CliRunner().invoke(main, ["laser", str(tmp_path / "bar.png"), "-o", str(tmp_path / "bar.gcode")])
+    assert result.exit_code == 0, result.output
+    xs = [float(x) for x in re.findall(r"X(-?[\d.]+)", (tmp_path / "bar.gcode").read_text())]
+    assert max(xs) - min(xs) == pytest.approx(800 / 96 * 25.4, abs=2.0)
+
+
+@pytest.mark.slow
+def test_train_classifier_default_out_is_beside_the_user_not_the_shipped_model(tmp_path):
+    """Item 7: `train-classifier` without --out writes ./crossing_cnn.onnx (+ .json, .md) in
+    the current folder; the shipped model is not touched."""
+    from vectorize.cnn_classifier import DEFAULT_MODEL
+
+    shipped = Path(DEFAULT_MODEL).read_bytes()
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join(sys.path)}
+    done = subprocess.run([sys.executable, "-m", "fabrication.cli", "train-classifier", "--samples", "100",
+                           "--epochs", "1", "--validation", "8", "--workers", "1"],
+                          cwd=tmp_path, capture_output=True, text=True, env=env, timeout=600)
+    assert done.returncode == 0, done.stderr[-500:]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["crossing_cnn.json", "crossing_cnn.md", "crossing_cnn.onnx"]
+    assert Path(DEFAULT_MODEL).read_bytes() == shipped
 
 
 def test_drawing_with_far_stroke_is_refused_in_the_library():
