@@ -247,22 +247,6 @@ def test_readme_states_the_laser_default_size_and_it_holds(tmp_path):
     assert max(xs) - min(xs) == pytest.approx(800 / 96 * 25.4, abs=2.0)
 
 
-@pytest.mark.slow
-def test_train_classifier_default_out_is_beside_the_user_not_the_shipped_model(tmp_path):
-    """Item 7: `train-classifier` without --out writes ./crossing_cnn.onnx (+ .json, .md) in
-    the current folder; the shipped model is not touched."""
-    from vectorize.cnn_classifier import DEFAULT_MODEL
-
-    shipped = Path(DEFAULT_MODEL).read_bytes()
-    env = {**os.environ, "PYTHONPATH": os.pathsep.join(sys.path)}
-    done = subprocess.run([sys.executable, "-m", "fabrication.cli", "train-classifier", "--samples", "100",
-                           "--epochs", "1", "--validation", "8", "--workers", "1"],
-                          cwd=tmp_path, capture_output=True, text=True, env=env, timeout=600)
-    assert done.returncode == 0, done.stderr[-500:]
-    assert sorted(p.name for p in tmp_path.iterdir()) == ["crossing_cnn.json", "crossing_cnn.md", "crossing_cnn.onnx"]
-    assert Path(DEFAULT_MODEL).read_bytes() == shipped
-
-
 def test_drawing_with_far_stroke_is_refused_in_the_library():
     with pytest.raises(ValueError, match="beyond the limit"):
         Drawing((Stroke.from_polyline(np.array([[0.0, 0.0], [2e7, 0.0]])),), 10, 10, "px")
