@@ -6,7 +6,6 @@ to test-artifacts/ (kept by CI as artifacts of the run)."""
 from __future__ import annotations
 
 import json
-import shutil
 from pathlib import Path
 
 import pytest
@@ -14,66 +13,9 @@ from click.testing import CliRunner
 
 from conftest import ARTIFACTS
 from fabrication.cli import main
-from fabrication.studio.server import StudioServer
-from fabrication.studio.session import StudioSession
-
-ROOT = Path(__file__).resolve().parents[1]
+from studio_fixtures import cli_bytes, click_at, coloured_pixels, page, settle, studio  # noqa: F401 - fixtures
 
 pytestmark = pytest.mark.slow
-
-
-@pytest.fixture(scope="module")
-def studio(tmp_path_factory):
-    folder = tmp_path_factory.mktemp("studio-browser")
-    drawing = folder / "loops.png"
-    shutil.copy(ROOT / "examples" / "loops.png", drawing)
-    server = StudioServer(StudioSession(drawing), port=0).start()
-    yield server, drawing
-    server.stop()
-
-
-@pytest.fixture(scope="module")
-def page(studio, browser):
-    context = browser.new_context(viewport={"width": 1280, "height": 760}, accept_downloads=True)
-    page = context.new_page()
-    page.set_default_timeout(20000)
-    errors = []
-    page.on("pageerror", lambda error: errors.append(str(error)))
-    page.goto(studio[0].url)
-    page.wait_for_function("window.studio.state !== null && document.body.classList.contains('busy') === false")
-    yield page
-    context.close()
-    assert not errors, errors
-
-
-def coloured_pixels(page) -> int:
-    """Strongly coloured pixels on the drawing canvas: the curve (the raster is drawn grey)."""
-    return page.evaluate("""() => {
-        const c = document.getElementById('canvas');
-        const d = c.getContext('2d').getImageData(0, 0, c.width, c.height).data;
-        let n = 0;
-        for (let i = 0; i < d.length; i += 4) {
-            const mx = Math.max(d[i], d[i + 1], d[i + 2]), mn = Math.min(d[i], d[i + 1], d[i + 2]);
-            if (mx - mn > 80) n++;
-        }
-        return n;
-    }""")
-
-
-def settle(page, edits_count=None) -> None:
-    condition = "!document.body.classList.contains('busy')"
-    if edits_count is not None:
-        condition += f" && window.studio.state.edits.edits.length === {edits_count}"
-    page.wait_for_function(condition)
-
-
-def cli_bytes(command: str, drawing: Path, edits: dict, tmp_path: Path, suffix: str, *flags) -> bytes:
-    (tmp_path / "edits.json").write_text(json.dumps(edits))
-    out = tmp_path / f"cli{suffix}"
-    run = CliRunner().invoke(main, [command, str(drawing), "--edits", str(tmp_path / "edits.json"),
-                                    "-o", str(out), *flags])
-    assert run.exit_code == 0, run.output
-    return out.read_bytes()
 
 
 def test_page_refine_play_and_export(page, studio, tmp_path):
@@ -156,11 +98,6 @@ def test_page_refine_play_and_export(page, studio, tmp_path):
     run = CliRunner().invoke(main, ["vectorize", str(drawing), "--edits", str(saved), "-o", str(tmp_path / "r.svg")])
     assert run.exit_code == 0, run.output
     assert svg == (tmp_path / "r.svg").read_bytes()
-
-
-def click_at(page, at) -> None:
-    x, y = page.evaluate(f"window.studio.toScreen({at[0]}, {at[1]})")
-    page.mouse.click(x, y)
 
 
 def test_page_split_merge_blur_start_reverse_load(page, studio):

@@ -192,6 +192,14 @@ def create_app(session: StudioSession, *, token: str, hosts: set[str]) -> Guard:
         session.sender = LaserSender(content.decode(), port=port, baud=baud, name=name).start()
         return JSONResponse(session.sender.status())
 
+    async def ports(request: Request):
+        from machines.ports import list_ports
+
+        found = await run_in_threadpool(list_ports, probe=False)
+        return JSONResponse({"ports": [{"device": "sim://", "description": "GRBL emulator (dry run)"}] +
+                             [{"device": p.device, "description": p.description, "problem": p.problem}
+                              for p in found]})
+
     async def control(request: Request):
         action = request.path_params["action"]
         if session.sender is None or action not in ("pause", "resume", "abort"):
@@ -211,5 +219,6 @@ def create_app(session: StudioSession, *, token: str, hosts: set[str]) -> Guard:
         Route("/api/edits", api(save_edits), methods=["POST"]),
         Route("/api/send", api(send), methods=["GET", "POST"]),
         Route("/api/send/{action}", api(control), methods=["POST"]),
+        Route("/api/ports", api(ports), methods=["GET"]),
     ]
     return Guard(Starlette(routes=routes), token=token, hosts=hosts)
