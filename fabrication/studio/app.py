@@ -22,7 +22,7 @@ from starlette.requests import Request
 from starlette.responses import JSONResponse, PlainTextResponse, Response
 from starlette.routing import Route
 
-from fabrication.studio.session import StudioSession
+from fabrication.studio.session import StudioSession, Superseded
 from onestroke.errors import InputError, OnestrokeError
 from vectorize.edits import Edits, edits_from_dict
 
@@ -154,8 +154,15 @@ def create_app(session: StudioSession, *, token: str, hosts: set[str]) -> Guard:
         return Response(buffer.getvalue(), media_type="image/png")
 
     async def state(request: Request):
-        edits = session.saved_edits() if request.method == "GET" else (await payload(request))[0]
-        return JSONResponse(await run_in_threadpool(session.state, edits))
+        if request.method == "GET":
+            return JSONResponse(await run_in_threadpool(session.state, session.saved_edits()))
+        edits, _, data = await payload(request)
+        superseded = session.ticket(str(data["page"])) if data.get("page") else None
+        try:
+            return JSONResponse(await run_in_threadpool(session.state, edits, superseded=superseded))
+        except Superseded:
+            # The page sent a newer state request meanwhile and ignores this answer.
+            return JSONResponse({"superseded": True})
 
     async def embroidery(request: Request):
         edits, options, _ = await payload(request)
