@@ -130,6 +130,29 @@ def test_invocation(folder, tmp_path, item, args, code, fragment):
     assert {p.name: p.lstat().st_mtime_ns for p in folder.iterdir()} == before  # inputs untouched
 
 
+SHARED = [("--size", "0.01mm", "--size '0.01mm' must be from 0.1 mm to 10000 mm"),
+          ("--blur", "30", "--blur 30 must be from 0 px to 25 px"),
+          ("--threshold", "2", "--threshold 2 must be above 0 to below 1"),
+          ("--rotate", "400", "--rotate 400 must be from -360 degrees to 360 degrees")]
+COMMANDS = {"vectorize": ["-o", "{out}/a.svg"], "embroider": ["-o", "{out}/a.pes"],
+            "laser": ["-o", "{out}/a.gcode"], "batch": ["-o", "{out}/b", "--to", "svg,pes,gcode"]}
+
+
+@pytest.mark.parametrize("option,value,message", SHARED, ids=[o for o, _, _ in SHARED])
+def test_shared_options_are_spelled_and_checked_the_same_on_every_command(folder, tmp_path, option, value, message):
+    """What to build: one declaration per option group, so every command that takes an
+    option refuses the same bad value with the same line, before any work."""
+    lines = {}
+    for command, rest in COMMANDS.items():
+        if option not in CliRunner().invoke(main, [command, "--help"]).output:
+            continue
+        argv = [command, str(folder / "d.svg"), *[a.replace("{out}", str(tmp_path)) for a in rest], option, value]
+        result = CliRunner().invoke(main, argv)
+        lines[command] = (result.exit_code, result.stderr.strip())
+    assert len(lines) >= 3 and set(lines.values()) == {(2, f"error: {message}")}, lines
+    assert list(tmp_path.iterdir()) == []
+
+
 def test_laser_blur_exists_and_threshold_hint_does_not_chase_itself(folder, tmp_path):
     """`laser` on noise suggests --blur: laser has it. A threshold the user gave is not
     suggested again, lower (0.40 -> 0.35 -> 0.30 ...)."""
