@@ -83,7 +83,11 @@ def reduce_png_stream(image: Image.Image, factor: int,
     rowbytes = 1 + (_PNG_BITS[rawmode] * w + 7) // 8  # the filter byte, then the packed row
     step = band_rows(w, 4, factor)  # a band's widest copy is RGB(A) at four bytes a pixel
     flags = mmap.MAP_PRIVATE | getattr(mmap, "MAP_NORESERVE", 0)
-    memory = mmap.mmap(-1, linesize * h, flags=flags)
+    try:
+        memory = mmap.mmap(-1, linesize * h, flags=flags)
+    except OSError as error:  # address space refused (a strict overcommit policy): memory, not the file
+        raise MemoryError(f"cannot reserve {linesize * h / 1e6:.0f} MB of address space to decode "
+                          f"the image in bands ({error.strerror})") from None
     canvas = Image.frombuffer(canvas_mode, (w, h), memory, "raw", canvas_mode, 0, 1)
     decoder = Image._getdecoder(image.mode, "zip", rawmode, image.decoderconfig)
     pieces = []
@@ -97,10 +101,10 @@ def reduce_png_stream(image: Image.Image, factor: int,
             for filtered in _inflate(inflater, stream, (y1 - y0) * rowbytes):
                 done = done or _decode(decoder, wrapper.compress(filtered), last=y1 == h)
             done = done or _decode(decoder, wrapper.flush(zlib.Z_SYNC_FLUSH), last=y1 == h)
-            with memoryview(memory)[y0 * linesize:y1 * linesize] as rows:
-                band = Image.frombuffer(canvas_mode, (w, y1 - y0), rows, "raw", canvas_mode, 0, 1)
-                pieces.append(_reduce_band(band, image, factor, prepare))
-                del band
+            rows = memoryview(memory)[y0 * linesize:y1 * linesize]
+            band = Image.frombuffer(canvas_mode, (w, y1 - y0), rows, "raw", canvas_mode, 0, 1)
+            pieces.append(_reduce_band(band, image, factor, prepare))
+            del band, rows
             start = y0 * linesize // page * page
             memory.madvise(mmap.MADV_DONTNEED, start, y1 * linesize - start)
     finally:
