@@ -115,7 +115,8 @@ def merge_triple_points(graph: MedialGraph, *, stroke_width: float, may_merge=No
         if len(members) != 4:
             continue
         inside = set(members)
-        inner = [b for b in short if graph.branches[b].a in inside]
+        # (Branches of clusters merged before are gone: their ids are no longer in the graph.)
+        inner = [b for b in short if b in graph.branches and graph.branches[b].a in inside]
         # A tree of four junctions: six feet leave it.
         if len(inner) != 3 or (may_merge is not None and not all(may_merge(graph.branches[b]) for b in inner)):
             continue

@@ -9,8 +9,8 @@ run with onnxruntime, looks at the ink around the node with one candidate pass d
 along it. A pairing's score adds, over its three passes, the image's log-odds and the
 continuation cost (1 + cos between the feet, 0 = straight), each weighted as fitted on
 generated triple points (the model's metadata, "combine"): a conditional-logit model over
-the 15 pairings. An unsure image (p near 0.5) adds nothing and continuation decides; with
-no model, continuation decides alone.
+the 15 pairings. Where that model is unsure (its best pairing's posterior under one half)
+continuation decides, as it does alone when no model is installed.
 """
 
 from __future__ import annotations
@@ -25,6 +25,8 @@ from vectorize.clusters import Pairs, matchings
 from vectorize.pass_crop import PassCropSpec, crop_passes, mirror_copies
 
 DEFAULT_MODEL = Path(__file__).parent / "models" / "pass_cnn.onnx"
+# Below this posterior probability of its best pairing the combined model is unsure.
+UNSURE = 0.5
 PAIRS = tuple(combinations(range(6), 2))  # the 15 candidate passes of a six-foot node
 PAIRINGS = tuple(matchings(list(range(6))))  # the 15 ways to pair six feet
 # Each pairing's passes as indices into PAIRS: (15, 3).
@@ -102,4 +104,11 @@ def pair_feet(gray: np.ndarray, centers: np.ndarray, feet: list[np.ndarray], str
     if scorer is None:
         return [best_pairing(-continuation_cost(f))[0] for f in feet]
     p = scorer.pass_probabilities(gray, centers, feet, stroke_width)
-    return [best_pairing(scorer.pass_scores(p[i], f))[0] for i, f in enumerate(feet)]
+    result = []
+    for i, f in enumerate(feet):
+        pick, totals = best_pairing(scorer.pass_scores(p[i], f))
+        # The model's own posterior of its pick (softmax over the 15 pairings): below one
+        # half it is unsure, and continuation decides alone.
+        posterior = 1.0 / float(np.sum(np.exp(totals - totals.max())))
+        result.append(pick if posterior >= UNSURE else best_pairing(-continuation_cost(f))[0])
+    return result

@@ -43,9 +43,9 @@ class CrossingNet(nn.Module):
 
 
 def pass_net() -> CrossingNet:
-    """The pass scorer (about 45k parameters): does the candidate pass drawn in the crop go
+    """The pass scorer (about 24k parameters): does the candidate pass drawn in the crop go
     straight through the ink of a triple point? (N, 4, 32, 32) -> logits (N,)."""
-    return CrossingNet(channels=(16, 32, 48, 64), inputs=4)
+    return CrossingNet(channels=(12, 24, 32, 48), inputs=4)
 
 
 class Probability(nn.Module):

@@ -38,8 +38,8 @@ def _synthetic(model_path: str | os.PathLike, scenes: int, seed: int, workers: i
 
 
 def fit_combination(model_path: str | os.PathLike, *, scenes: int, seed: int, workers: int = 1) -> dict:
-    """Weights of image log-odds and continuation cost that maximise the likelihood of the
-    true pairing among the 15 (conditional logit) on `scenes` fresh scenes."""
+    """Weights of image log-odds (>= 0) and continuation cost (<= 0) that maximise the
+    likelihood of the true pairing among the 15 (conditional logit) on `scenes` fresh scenes."""
     logit, cost = _synthetic(model_path, scenes, seed, workers)
     features = np.stack([logit[:, PAIRING_INDEX].sum(axis=2), cost[:, PAIRING_INDEX].sum(axis=2)], axis=-1)
 
@@ -48,7 +48,8 @@ def fit_combination(model_path: str | os.PathLike, *, scenes: int, seed: int, wo
         # A little ridge keeps the weights finite where the scenes are all told apart.
         return float(np.mean(logsumexp(totals, axis=1) - totals[:, 0]) + RIDGE * weights @ weights)
 
-    found = minimize(loss, np.array([1.0, -4.0]), method="Nelder-Mead", options={"xatol": 1e-4, "fatol": 1e-7})
+    # Signs fixed: the image's log-odds never count against a pass, nor does straightness.
+    found = minimize(loss, np.array([1.0, -1.0]), method="L-BFGS-B", bounds=[(0.0, None), (None, 0.0)])
     return {"image": round(float(found.x[0]), 4), "continuation": round(float(found.x[1]), 4),
             "scenes": scenes, "seed": seed}
 

@@ -85,9 +85,12 @@ score best, adding the image's log-odds and the continuation cost (`vectorize.pa
 - Parameters: {meta['parameters']:,}; file size {meta['bytes']:,} bytes; sha256 `{meta['sha256']}`.
 - Training data: {t['train_scenes']:,} synthetic scenes ({t['train_crops']:,} candidate passes,
   `vectorize.training.triple_synth`, seed {meta['seed']}), {t['epochs']} epochs, batch {t['batch']},
-  AdamW with a one-cycle learning rate up to {t['lr']}, random mirroring; {t['train_seconds']:.0f} s on {t['cpu']}.
+  AdamW with a one-cycle learning rate up to {t['lr']}, random mirroring; {t['train_seconds']:.0f} s on {t['cpu']}{
+  ' (' + t['note'] + ')' if t.get('note') else ''}.
 - Combination (fitted on {c['scenes']} scenes of seed {c['seed']}): score of a pass =
-  {c['image']:.3f} x image log-odds {c['continuation']:+.3f} x (1 + cos between its feet).
+  {c['image']:.3f} x image log-odds {c['continuation']:+.3f} x (1 + cos between its feet) (signs
+  fixed: image >= 0, continuation <= 0). Where the best pairing's posterior is under one
+  half, continuation alone decides.
 - Command: `{meta['command']}`
 
 ## Validation
@@ -103,8 +106,8 @@ cluster merge) find in {v['pipeline_scenes']} scenes ({v['pipeline_nodes']} node
 """
 
 
-def train_and_export_pass(*, seed: int = 0, scenes: int = 1500, epochs: int = 6, batch: int = 128,
-                          lr: float = 4e-3, calibration: int = 300, validation: int = 300, workers: int = 1,
+def train_and_export_pass(*, seed: int = 0, scenes: int = 1000, epochs: int = 4, batch: int = 128,
+                          lr: float = 4e-3, calibration: int = 200, validation: int = 200, workers: int = 1,
                           out: Path = DEFAULT_OUT, log: Callable[[str], None] = lambda line: None) -> dict:
     """Train, export `out` (.onnx), fit the combination weights on `calibration` scenes,
     measure pairing accuracy on `validation` scenes; writes .json and .md beside `out` and
@@ -115,8 +118,6 @@ def train_and_export_pass(*, seed: int = 0, scenes: int = 1500, epochs: int = 6,
     net, facts = train_pass(seed=seed, scenes=scenes, epochs=epochs, batch=batch, lr=lr, workers=workers, log=log)
     facts["cpu"] = f"{os.cpu_count()} CPU cores"
     data = export_onnx(net, out, spec, channels=4, output="p_pass")
-    combine = fit_combination(out, scenes=calibration, seed=seed + CALIBRATION_SEED_OFFSET, workers=workers)
-    log(f"combination fitted: {combine}")
     command = "onestroke train-pass-scorer " + " ".join(
         f"--{k} {v}" for k, v in (("seed", seed), ("scenes", scenes), ("epochs", epochs), ("batch", batch),
                                   ("lr", lr), ("calibration", calibration), ("validation", validation)))
@@ -128,8 +129,19 @@ def train_and_export_pass(*, seed: int = 0, scenes: int = 1500, epochs: int = 6,
         "bytes": len(data),
         "sha256": hashlib.sha256(data).hexdigest(),
         "training": facts,
-        "combine": combine,
     }
+    return calibrate_and_validate(out, meta, calibration=calibration, validation=validation, workers=workers,
+                                  log=log)
+
+
+def calibrate_and_validate(out: Path, meta: dict, *, calibration: int, validation: int, workers: int,
+                           log: Callable[[str], None] = lambda line: None) -> dict:
+    """For an exported model `out` and its metadata so far: fit the combination weights,
+    measure the pairing accuracy, write the .json and .md; returns the full metadata."""
+    seed = meta["seed"]
+    meta = dict(meta, combine=fit_combination(out, scenes=calibration, seed=seed + CALIBRATION_SEED_OFFSET,
+                                              workers=workers))
+    log(f"combination fitted: {meta['combine']}")
     # The metadata must exist before validation loads the model the way the vectorizer does.
     atomic_write_text(out.with_suffix(".json"), json.dumps(meta, indent=2) + "\n")
     meta["validation"] = evaluate_pairing(out, scenes=validation, seed=seed + VALIDATION_SEED_OFFSET,
