@@ -25,6 +25,7 @@ import numpy as np
 import svgelements as se
 
 from onestroke.errors import InputError
+from onestroke.progress import ProgressCallback, Stage, counted
 from vectorize.drawing import Drawing
 from vectorize.stroke import MAX_COORDINATE, Stroke
 
@@ -170,14 +171,37 @@ def _rgb(paint) -> tuple[int, int, int] | None:
         return None
 
 
-def read_svg(path: str | os.PathLike) -> SvgContent:
-    """Parse an SVG file into strokes and outline rings (px at 96 dpi, transforms applied)."""
+class _CountingReader:
+    """A binary file that reports how much of it was read (svgelements parses as it reads)."""
+
+    def __init__(self, handle, report: Stage) -> None:
+        self.handle, self.report = handle, report
+
+    def read(self, size: int = -1) -> bytes:
+        data = self.handle.read(size)
+        self.report.advance(len(data))
+        return data
+
+
+def read_svg(path: str | os.PathLike, *, progress: ProgressCallback | None = None) -> SvgContent:
+    """Parse an SVG file into strokes and outline rings (px at 96 dpi, transforms applied).
+
+    progress: called with `onestroke.progress.Progress` reports (bytes parsed, then shapes read).
+    """
     path = str(path)
     if not os.path.isfile(path):
         raise InputError(f"input file {path!r} does not exist")
     source = _svg_source(path)
     try:
-        svg = se.SVG.parse(source, reify=True)
+        if progress is not None:
+            opened = open(source, "rb") if isinstance(source, str) else source
+            with opened:
+                size = os.fstat(opened.fileno()).st_size if isinstance(source, str) else len(source.getvalue())
+                parsing = Stage(progress, "parsing", size, "bytes")
+                svg = se.SVG.parse(_CountingReader(opened, parsing), reify=True)
+                parsing.finish()
+        else:
+            svg = se.SVG.parse(source, reify=True)
     except Exception as error:  # svgelements raises many kinds on malformed XML
         raise InputError(f"cannot read SVG {path!r}: {str(error).splitlines()[0] if str(error) else type(error).__name__}") from None
     if svg is None:
@@ -190,7 +214,7 @@ def read_svg(path: str | os.PathLike) -> SvgContent:
         elements = list(svg.elements())
     except (ValueError, ArithmeticError, AttributeError, TypeError) as error:
         raise InputError(f"cannot read SVG {path!r}: {error}") from None
-    for element in elements:
+    for element in counted(elements, progress, "reading shapes", len(elements), "elements"):
         if not isinstance(element, se.Shape) or isinstance(element, se.Text):
             continue
         if element.values.get("visibility") == "hidden" or element.values.get("display") == "none":

@@ -267,10 +267,11 @@ def _render_svg(scene: _Scene, path: Path) -> None:
 
 
 def render_gcode_preview(gcode_path: str | os.PathLike, out_path: str | os.PathLike, *,
-                         profile: LaserProfile | None = None) -> JobTime:
+                         profile: LaserProfile | None = None, progress=None) -> JobTime:
     """Draw `gcode_path` into `out_path` (.png or .svg) and return its `JobTime`.
 
     profile: the machine (bed outline, time model); None uses the default profile.
+    progress: an `onestroke.progress.ProgressCallback` (G-code lines read).
     """
     out_path = Path(out_path)
     suffix = out_path.suffix.lower()
@@ -279,7 +280,8 @@ def render_gcode_preview(gcode_path: str | os.PathLike, out_path: str | os.PathL
     check_writable(out_path)
     profile = profile or load_laser_profile()
     program = load_program(gcode_path)
-    stats = analyze_program(program, settings=settings_from_profile(profile), planner_blocks=profile.planner_blocks)
+    stats = analyze_program(program, settings=settings_from_profile(profile), planner_blocks=profile.planner_blocks,
+                             progress=progress)
     if len(stats.moves) == 0:
         raise InputError(f"G-code file {str(gcode_path)!r} holds no moves to preview")
     job = estimate_program_time(program, profile, stats=stats)
