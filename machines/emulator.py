@@ -239,7 +239,7 @@ class GrblEmulator(EmulatorTransport, EmulatorHost, EmulatorClock, EmulatorProto
                 motion = float(self._last_motion - self._first_motion) * self.scale
             job = 0.0
             if self._job_start is not None:
-                job = (max(self._last_motion or 0.0, self._last_ok) - self._job_start) * self.scale
+                job = float(max(self._last_motion or 0.0, self._last_ok) - self._job_start) * self.scale
             result = dict(job_time=job, lines_executed=len(self.executed), blocks_executed=self.blocks_done,
                           motion_time=motion, rx_overflow_bytes=self.rx_overflow,
                           eeprom_lost_bytes=self.eeprom_lost, max_rx_used=self.max_rx, state=self.state,

@@ -50,6 +50,7 @@ class EmulatorClock:
         self._clock = 0.0  # machine clock (machine seconds / time_scale)
         self._offset = time.monotonic()  # wall time of clock 0 (only grows)
         self._clock_next: float | None = None  # the event the clock thread paces towards
+        self._host_wait = False  # ... while it waits for the host
         self._following = False  # the clock follows wall time (hold, stall, quiet host)
         self._waiting: dict[int, float] = {}  # participant thread -> clock deadline (inf: none)
         self._changes = 0  # bumped by every state change that may wake a participant
@@ -76,11 +77,13 @@ class EmulatorClock:
             self._cond.wait(0.1)
         self._waiting.pop(me, None)
 
-    def _sync_to_wall(self, *, pacing: bool = True) -> None:
-        """(lock held) Move the clock to the wall time a byte arrived at, when the clock
-        thread follows wall time or (pacing, for real-time bytes) paces towards an event."""
+    def _sync_to_wall(self, kind: str) -> None:
+        """(lock held) Move the clock towards the wall time a byte from the host arrived at:
+        kind "line" only when the clock follows wall time; "query" (`?`) also while it
+        paces towards an event; "control" (hold, resume, reset, overrides: a person's
+        action in wall time) also while it waits for the host."""
         wall_clock = time.monotonic() - self._offset
-        if pacing and self._clock_next is not None:
+        if self._clock_next is not None and (kind == "control" or (kind == "query" and not self._host_wait)):
             self._clock = max(self._clock, min(wall_clock, self._clock_next))
         elif self._following:
             self._clock = max(self._clock, wall_clock)
@@ -110,7 +113,9 @@ class EmulatorClock:
                     continue
                 if self._parser_idle and not self._host_quiet and t_next > self._host_bound():
                     self._following = False
+                    self._clock_next, self._host_wait = t_next, True
                     self._wait_for_host(changes)
+                    self._clock_next, self._host_wait = None, False
                     continue
                 if t_next == math.inf:
                     self._follow_wall(changes)

@@ -163,7 +163,8 @@ class EmulatorMotion:
                 if self._adding and len(self.planner) < self.options.planner_blocks:
                     # The protocol thread holds a parsed block waiting for this free slot; on
                     # GRBL it would join the look-ahead while this block runs.
-                    while self._adding and not (self._reset_pending or self._stopping):
+                    while (self._adding and len(self.planner) < self.options.planner_blocks
+                           and not (self._reset_pending or self._stopping)):
                         self._clock_wait()  # (the clock stands still meanwhile)
                     if self._reset_pending or not self.planner or self.hold or self.stalled or self.critical:
                         continue  # things changed while the lock was released

@@ -139,11 +139,11 @@ class EmulatorTransport:
                     continue
                 return
             with self._cond:
-                self._sync_to_wall(pacing=False)  # an idle machine's clock runs with wall time
+                self._sync_to_wall("line")  # an idle machine's clock runs with wall time
                 lines = 0
                 for byte in data:
                     if byte in (0x18, 0x3F, 0x7E, 0x21) or byte >= 0x80:
-                        self._sync_to_wall()
+                        self._sync_to_wall("query" if byte == 0x3F else "control")
                         self._realtime(byte)
                         continue
                     if not partial:  # what the host knew when it began this line
