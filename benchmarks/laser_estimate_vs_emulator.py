@@ -46,6 +46,14 @@ def dense_job(lines: int, step: float, feed: float) -> list[str]:
     return make_job(lines, step, feed).splitlines()
 
 
+def straight_job(lines: int, step: float, feed: float) -> list[str]:
+    """`lines` G1 moves of `step` mm along one straight line: no corners, so the planner
+    would run at `feed` and the serial link and the parser set the pace."""
+    out = ["G21", "G90", "M4 S600", "G0 X0 Y10", f"F{feed:g}"]
+    out += [f"G1X{i * step:.3f}" for i in range(1, lines + 1)]
+    return out + ["M5", "G0X0Y0"]
+
+
 def _serve(conn, scale: float) -> None:
     emulator = GrblEmulator(EmulatorOptions(time_scale=scale, parse_time=PROFILE.parse_time,
                                             baud=PROFILE.baud))
@@ -118,6 +126,10 @@ def main() -> None:
                 continue
             diffs.append(row(f"dense {step:g} mm segments, F{feed}", dense_job(4000, step, feed), args.scale,
                              args.repeat))
+        for step, feed in ((0.1, 5000), (0.05, 3000))[:args.count or None]:
+            label = f"dense {step:g} mm segments on a straight line, F{feed}"
+            if args.match in label:
+                diffs.append(row(label, straight_job(4000, step, feed), args.scale, args.repeat))
     print(f"largest |diff|: {max(abs(d) for d in diffs):.2%}; finished {time.strftime('%H:%M:%S')}")
 
 

@@ -16,14 +16,15 @@ The host is the one input the clock cannot foresee. When the parser waits for a 
 the ideal host of `emulator_host` could already have sent one that would arrive before
 the next event, the clock stands still and waits for the host in wall time, up to
 a timeout (HOST_PATIENCE x the host's recent median, within HOST_TIMEOUT); a host
-that sends nothing for that long is "quiet" and the clock runs on
-without it until its next line (a line sent later than that starts no earlier than the
-clock then: the only way a slow host can cost machine time, and it needs a pause ten
-times its usual one while it has lines to send).
+that sends nothing for that long is "quiet" and the clock runs on without it until its
+next line (a line sent later than that starts no earlier than the clock then: the only
+way a slow host can cost machine time, at most what the planner still held, and it
+needs a pause twenty times its usual one while it has lines to send).
 
-What the clock counts while nothing is scheduled:
-- in a feed hold, a stall, or with a quiet host: the clock follows wall time (scaled),
-  so a hold of 2 s counts 2 s x time_scale of machine time, as on a real machine.
+What the clock counts while nothing is scheduled: in a feed hold or a stall it follows
+wall time (scaled), so a hold of 2 s counts 2 s x time_scale of machine time, as on a
+real machine; otherwise (an idle machine) it stands still. Hold, resume, reset and the
+overrides act at the wall time they arrive at, as a person's actions do.
 Clock values are in wall-equivalent seconds like every time in the emulator: machine
 seconds are clock x time_scale. A mixin of `GrblEmulator`.
 """
@@ -39,8 +40,8 @@ from collections import deque
 PARTICIPANTS = 2  # the protocol and motion threads
 # Wall seconds the clock waits for a host that owes a line: HOST_PATIENCE times the median
 # of the host's recent answers (they grow when the host computer is busy), within bounds.
-HOST_PATIENCE = 10.0
-HOST_TIMEOUT = (0.02, 0.3)
+HOST_PATIENCE = 20.0
+HOST_TIMEOUT = (0.05, 0.5)
 
 
 class EmulatorClock:
@@ -118,7 +119,12 @@ class EmulatorClock:
                     self._clock_next, self._host_wait = None, False
                     continue
                 if t_next == math.inf:
-                    self._follow_wall(changes)
+                    if self.hold or self.stalled:
+                        self._follow_wall(changes)
+                    else:  # idle: the clock stands still (a slow host costs nothing)
+                        self._following = False
+                        self._offset = max(self._offset, time.monotonic() - now)
+                        self._cond.wait(0.05)
                     continue
                 self._following = False
                 self._offset = max(self._offset, time.monotonic() - now)
@@ -148,7 +154,7 @@ class EmulatorClock:
             self._host_delays.append(time.monotonic() - start)
 
     def _follow_wall(self, changes: int) -> None:
-        """(lock held) Nothing scheduled and nothing owed: the clock runs with wall time."""
+        """(lock held) Held or stalled with nothing scheduled: the clock runs with wall time."""
         if not self._following:
             self._offset = max(self._offset, time.monotonic() - self._clock)
             self._following = True
