@@ -19,7 +19,7 @@ a timeout (HOST_PATIENCE x the host's recent median, within HOST_TIMEOUT); a hos
 that sends nothing for that long is "quiet" and the clock runs on without it until its
 next line (a line sent later than that starts no earlier than the clock then: the only
 way a slow host can cost machine time, at most what the planner still held, and it
-needs a pause twenty times its usual one while it has lines to send).
+needs a pause fifty times its usual one while it has lines to send).
 
 What the clock counts while nothing is scheduled: in a feed hold or a stall it follows
 wall time (scaled), so a hold of 2 s counts 2 s x time_scale of machine time, as on a
@@ -40,8 +40,8 @@ from collections import deque
 PARTICIPANTS = 2  # the protocol and motion threads
 # Wall seconds the clock waits for a host that owes a line: HOST_PATIENCE times the median
 # of the host's recent answers (they grow when the host computer is busy), within bounds.
-HOST_PATIENCE = 20.0
-HOST_TIMEOUT = (0.05, 0.5)
+HOST_PATIENCE = 50.0
+HOST_TIMEOUT = (0.1, 1.0)
 
 
 class EmulatorClock:
