@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import threading
 import time
 
 import click
@@ -38,6 +39,7 @@ def studio(source: str, port: int, no_browser: bool, edits_path: str | None, pro
     with console.status(f"vectorizing {session.drawing_path.name}"):
         session.vectorize(session.saved_edits())
     server = StudioServer(session, port=port).start()
+    threading.Thread(target=session.warm, name="studio-warm", daemon=True).start()
     done(f"studio for {session.drawing_path.name} at {server.url}")
     console.print(f"edits are saved to {session.edits_path}; Ctrl-C stops the studio")
     if not no_browser and _graphical():
