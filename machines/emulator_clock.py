@@ -112,7 +112,8 @@ class EmulatorClock:
                     self._following = False
                     self._advance(now)
                     continue
-                if self._parser_idle and not self._host_quiet and t_next > self._host_bound():
+                # (in a hold the machine runs on a person's time: no waiting for the host)
+                if self._parser_idle and not (self._host_quiet or self.hold) and t_next > self._host_bound():
                     self._following = False
                     self._clock_next, self._host_wait = t_next, True
                     self._wait_for_host(changes)
