@@ -103,4 +103,5 @@ class LaserSender:
         machine = report.full_state if report is not None else (p.state if p else None)
         return {"state": self.state, "message": self.message, "port": self.port,
                 "acked": p.acked if p else 0, "total": p.total if p else len(self.program),
-                "elapsed": round(p.elapsed, 2) if p else 0.0, "machine": machine}
+                "elapsed": round(p.elapsed, 2) if p else 0.0, "machine": machine,
+                "line": p.last_line if p else 0}
