@@ -56,6 +56,7 @@ class EmulatorClock:
         self._waiting: dict[int, float] = {}  # participant thread -> clock deadline (inf: none)
         self._changes = 0  # bumped by every state change that may wake a participant
         self._host_quiet = False
+        self.host_timeouts = 0  # waits for the host that ran out (see EmulatorStats.host_timeouts)
         self._host_delays: deque[float] = deque([0.005], maxlen=64)  # wall seconds the host took
         self._parser_idle = False  # the protocol thread waits for a line from the host
 
@@ -149,6 +150,7 @@ class EmulatorClock:
             left = deadline - time.monotonic()
             if left <= 0:
                 self._host_quiet = True
+                self.host_timeouts += 1
                 return
             self._cond.wait(left)
         if self._rx_cum != lines:
