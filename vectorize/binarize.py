@@ -179,12 +179,35 @@ def extract_ink(gray: np.ndarray, *, threshold: float | None) -> tuple[np.ndarra
         raise InputError("no ink found: only specks smaller than a stroke")
     ink = np.isin(labels, np.flatnonzero(keep) + 1)
     holes = ndimage.binary_fill_holes(ink) & ~ink
-    hole_labels, _ = ndimage.label(holes)
+    hole_labels, hole_count = ndimage.label(holes)
     hole_areas = np.bincount(hole_labels.ravel())
     small = hole_areas < max(2.0, 0.5 * width * width)
+    # Slivers: a hole nowhere wider than the stroke is not a loop the pen drew round (the
+    # two jittered passes of one retraced line drifting a little apart, `narrow_holes`).
+    small |= narrow_holes(holes, hole_labels, hole_count, width)
     small[0] = False
     ink |= small[hole_labels]
     return ink, level, width, framed
+
+
+def narrow_holes(holes: np.ndarray, labels: np.ndarray, count: int, width: float) -> np.ndarray:
+    """(count + 1,) bool per hole label: the paper gap is at most `width` px everywhere.
+
+    Where the up and down passes of a retraced stroke wobble apart by a little more than
+    their width, the ink opens a sliver of paper between them, and the medial axis would
+    go round it: a loop, read as crossings or three strokes meeting, where the pen drew
+    one line twice. A loop the pen drew leaves a hole it went round; one narrower than the
+    pen itself cannot be told from such a sliver in the ink, and drawing its middle line
+    twice covers it. The gap is the widest inscribed circle: 2 max(distance to ink) - 1 px
+    (the distance runs between pixel centres).
+    """
+    result = np.zeros(count + 1, dtype=bool)
+    if count == 0:
+        return result
+    inside = ndimage.distance_transform_edt(holes)
+    widest = ndimage.maximum(inside, labels, index=np.arange(1, count + 1))
+    result[1:] = 2.0 * np.asarray(widest) - 1.0 <= width
+    return result
 
 
 def binarize(image: np.ndarray, *, max_size: int, blur: float, threshold: float | None) -> InkImage:
