@@ -128,6 +128,10 @@ def ink_threshold(gray: np.ndarray, threshold: float | None) -> float:
 
 def estimate_stroke_width(ink: np.ndarray) -> float:
     """Typical ink width in px: twice the median distance-to-paper on the ink's ridge."""
+    # Only the ink's bounding box (and one row or column of paper around it, where the
+    # image has one) matters: every paper pixel beyond it is farther from the ink than the
+    # paper row between them. The transform over the whole page costs 2-3 times more.
+    ink = ink[ink_box(ink, 1)]
     distance = ndimage.distance_transform_edt(ink)
     # Ridge pixels: local maxima of the distance across the stroke.
     ridge = (distance >= ndimage.maximum_filter(distance, size=3) - 1e-6) & ink
@@ -135,6 +139,16 @@ def estimate_stroke_width(ink: np.ndarray) -> float:
     if values.size == 0:
         return 1.0
     return float(max(1.0, 2.0 * np.median(values) - 0.5))
+
+
+def ink_box(ink: np.ndarray, margin: int) -> tuple[slice, slice]:
+    """The bounding box of the True pixels of `ink`, grown by `margin` px within the image."""
+    rows = np.flatnonzero(ink.any(axis=1))
+    cols = np.flatnonzero(ink.any(axis=0))
+    if rows.size == 0:
+        return slice(0, 0), slice(0, 0)
+    return (slice(max(int(rows[0]) - margin, 0), int(rows[-1]) + margin + 1),
+            slice(max(int(cols[0]) - margin, 0), int(cols[-1]) + margin + 1))
 
 
 def frame_labels(labels: np.ndarray, count: int) -> np.ndarray:
@@ -178,12 +192,13 @@ def extract_ink(gray: np.ndarray, *, threshold: float | None) -> tuple[np.ndarra
     if not keep.any():
         raise InputError("no ink found: only specks smaller than a stroke")
     ink = np.isin(labels, np.flatnonzero(keep) + 1)
-    holes = ndimage.binary_fill_holes(ink) & ~ink
-    hole_labels, _ = ndimage.label(holes)
-    hole_areas = np.bincount(hole_labels.ravel())
-    small = hole_areas < max(2.0, 0.5 * width * width)
+    # Holes are the 4-connected pieces of paper that do not reach the image edge (what
+    # `binary_fill_holes` fills), found with one labelling instead of its dilation loop.
+    paper, _ = ndimage.label(~ink)
+    small = np.bincount(paper.ravel()) < max(2.0, 0.5 * width * width)
     small[0] = False
-    ink |= small[hole_labels]
+    small[np.concatenate([paper[0], paper[-1], paper[:, 0], paper[:, -1]])] = False
+    ink |= small[paper]
     return ink, level, width, framed
 
 
@@ -194,7 +209,9 @@ def binarize(image: np.ndarray, *, max_size: int, blur: float, threshold: float 
     ink, level, width, framed = extract_ink(gray, threshold=threshold)
     # Whiten everything that is not kept ink (specks, a frame) and blacken filled holes, so
     # that the sub-pixel outline of the gray image matches the kept ink exactly.
-    near = ndimage.binary_dilation(ink, iterations=2)
+    near = np.zeros_like(ink)
+    box = ink_box(ink, 2)  # the dilation cannot reach beyond 2 px of the ink
+    near[box] = ndimage.binary_dilation(ink[box], iterations=2)
     work = np.where(near, gray, 1.0).astype(np.float32)
     work[(work < level) & ~ink] = 1.0
     work[ink & (work >= level)] = 0.0

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 from scipy.ndimage import map_coordinates
-from scipy.spatial import Voronoi, cKDTree
+from scipy.spatial import Voronoi
 
 from onestroke.errors import VectorizeError
 from vectorize.graph import Branch, MedialGraph
@@ -57,7 +57,10 @@ def medial_axis(rings: list[np.ndarray], gray: np.ndarray, level: float) -> Medi
     used, local = np.unique(edges, return_inverse=True)
     local = local.reshape(-1, 2)
     xy = voronoi.vertices[used]
-    radius = cKDTree(samples).query(xy)[0]
+    # A Voronoi vertex is equally far from its generating samples and no sample is nearer
+    # (the empty circle): its radius is the distance to either sample of any ridge it ends.
+    radius = np.empty(len(used))
+    radius[local] = np.linalg.norm(xy[local] - samples[p[keep]][:, None, :], axis=2)
     return _collapse_chains(xy, radius, local, sins)
 
 
