@@ -14,6 +14,7 @@ from __future__ import annotations
 from collections.abc import Callable
 
 import numpy as np
+import shapely
 from scipy.ndimage import map_coordinates
 from scipy.spatial import cKDTree
 
@@ -24,6 +25,24 @@ from vectorize.stroke import Stroke
 # is smaller than a nearer one's (they are 0.25-1 px apart along the line).
 NEIGHBOURS = 8
 SPLIT_DEPTH = 4
+# A curve is checked at points at most STEP px apart along a polyline within FLATNESS px of
+# it. The excess is 1-Lipschitz (moving a point by d changes it by at most d), so between
+# two checked points it exceeds the larger of theirs by at most STEP / 2 + FLATNESS.
+FLATNESS = 0.1
+STEP = 0.4
+
+
+def curve_points(control: np.ndarray) -> np.ndarray:
+    """Points along a Bézier spline ((K, 4, 2)) no more than `STEP` px apart: (N, 2).
+
+    The vertices of a flattening alone are not enough: a straight piece flattens to its two
+    ends, and a chord across a corner of the drawing would be checked only where it meets
+    the ink.
+    """
+    polyline = Stroke(control).flatten(FLATNESS)
+    if len(polyline) < 2:
+        return polyline
+    return shapely.get_coordinates(shapely.segmentize(shapely.linestrings(polyline), STEP))
 
 
 class InkGuard:
@@ -65,13 +84,13 @@ class InkGuard:
         return excess
 
     def stroke_excess(self, stroke: Stroke) -> float:
-        """Largest excess along a stroke (px), sampled within 0.2 px of the curve."""
-        return float(self.excess(stroke.flatten(0.2)).max())
+        """Largest excess along a stroke (px), checked every `STEP` px (`curve_points`)."""
+        return float(self.excess(curve_points(stroke.control)).max())
 
 
 def curve_excess(guard: InkGuard, control: np.ndarray) -> tuple[float, np.ndarray]:
     """Largest excess of a piece and where it is."""
-    pts = Stroke(control).flatten(0.2)
+    pts = curve_points(control)
     ex = guard.excess(pts)
     k = int(np.argmax(ex))
     return float(ex[k]), pts[k]

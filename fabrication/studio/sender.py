@@ -82,7 +82,13 @@ class LaserSender:
         self._thread.join(timeout)
 
     def status(self) -> dict:
+        """State, progress and the machine's own latest status report (e.g. "Hold:0"
+        while paused: no line is acknowledged during a hold, so the last progress report
+        would still say "Run")."""
         p = self.progress
+        streamer = self._streamer
+        report = streamer.status if streamer is not None else None
+        machine = report.full_state if report is not None else (p.state if p else None)
         return {"state": self.state, "message": self.message, "port": self.port,
                 "acked": p.acked if p else 0, "total": p.total if p else len(self.program),
-                "elapsed": round(p.elapsed, 2) if p else 0.0, "machine": p.state if p else None}
+                "elapsed": round(p.elapsed, 2) if p else 0.0, "machine": machine}

@@ -44,6 +44,10 @@ def _clean(values: dict, allowed: tuple[str, ...]) -> dict:
     return {k: v for k, v in values.items() if v is not None and v != ""}
 
 
+class Superseded(Exception):
+    """A page asked for a newer state while this request waited for the vectorizer."""
+
+
 class StudioSession:
     """drawing: the input file; edits_path: where the page saves its edits; profile: an
     optional laser profile TOML; classifier: the vectorizer's crossing classifier."""
@@ -59,6 +63,7 @@ class StudioSession:
         self.cache = StageCache()
         self.lock = threading.Lock()  # one vectorization at a time: the cache is not shared-safe
         self.sender = None
+        self._tickets: dict[str, int] = {}  # page id -> number of its latest state request
 
     # -- edits -----------------------------------------------------------------------
     def saved_edits(self) -> Edits:
@@ -71,13 +76,26 @@ class StudioSession:
         return edits
 
     # -- vectorization ---------------------------------------------------------------
-    def vectorize(self, edits: Edits):
+    def vectorize(self, edits: Edits, *, superseded=None):
+        """The vectorization with these edits. superseded: a callable; when it says True
+        once the vectorizer is free, `Superseded` is raised instead of the work."""
         with self.lock:
+            if superseded is not None and superseded():
+                raise Superseded
             return vectorize_file(self.drawing_path, self.options, edits=edits, cache=self.cache)
 
-    def state(self, edits: Edits) -> dict:
+    def ticket(self, page: str):
+        """A state request of page `page`: a callable saying whether the page has asked for
+        another state since. A slider dragged over several values while a re-run takes a
+        second queues a request per value; only the latest is worth the vectorizer's time.
+        (Called on the server's event loop: one at a time.)"""
+        number = self._tickets.get(page, 0) + 1
+        self._tickets[page] = number
+        return lambda: self._tickets.get(page) != number
+
+    def state(self, edits: Edits, *, superseded=None) -> dict:
         """What the page draws: curve samples in drawing order, junctions, branches, report."""
-        result = self.vectorize(edits)
+        result = self.vectorize(edits, superseded=superseded)
         drawing, report = result.drawing, result.report
         strokes = []
         for stroke in drawing.strokes:

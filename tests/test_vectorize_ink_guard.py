@@ -1,0 +1,55 @@
+"""The curve never leaves the ink at sharp corners: the ink guard checks a fitted piece along
+its whole length, and real glyphs whose corners once drew a chord across the paper stay
+within half the stroke width + 1 px of their centre line."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from benchmarks.hershey import glyph_ground_truth
+from benchmarks.ink_metrics import excursion, excursion_bound
+from benchmarks.relief import relief_glyphs
+from benchmarks.render import render, to_uint8
+from tests.conftest import render_polylines
+from vectorize import VectorizeOptions, vectorize_image
+from vectorize.ink_guard import InkGuard, curve_excess, curve_points
+from vectorize.stroke import Stroke
+
+
+def _guard(image: np.ndarray) -> InkGuard:
+    stages = vectorize_image(image, VectorizeOptions(classifier="geometric", keep_stages=True)).stages
+    ink = stages["ink"]
+    return InkGuard(stages["simplified"], ink.gray, ink.threshold)
+
+
+def test_a_straight_chord_across_a_corner_is_outside_the_ink():
+    # An acute corner (about 35 degrees) drawn 6 px wide. A straight piece from one arm to the
+    # other has both ends in the ink and its middle on the paper inside the corner; a check
+    # at a flattening's vertices alone sees only its two ends.
+    corner = [(80, 60), (200, 340), (320, 60)]
+    guard = _guard(render_polylines([corner], width=6.0))
+    a, b = np.array([110.0, 130.0]), np.array([290.0, 130.0])  # on the arms (working frame)
+    assert guard.excess(np.array([a, b])).max() <= 0.0
+    chord = Stroke.from_polyline(np.array([a, b]))
+    points = curve_points(chord.control)
+    assert np.linalg.norm(np.diff(points, axis=0), axis=1).max() <= 0.4 + 1e-9
+    worst, at = curve_excess(guard, chord.control)
+    assert worst > 50.0  # the chord's middle is far out on the paper
+    assert abs(at[0] - 200.0) < 60.0
+    # The arms themselves are in the ink.
+    arm = Stroke.from_polyline(np.array([[80.0, 60.0], [200.0, 340.0]]) - 0.5)
+    assert curve_excess(guard, arm.control)[0] <= 0.0
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name, width", [("Delta", 6.75), ("uni2074", 3.25), ("uni1E9E", 3.75)])
+def test_relief_glyphs_with_acute_corners_stay_in_the_ink(name, width):
+    # Relief SingleLine glyphs at their benchmark widths. Before the guard checked pieces along
+    # their length, each drew a straight piece across an acute corner (Delta's foot, the
+    # superscript four, the capital sharp s) up to 0.89 widths from the centre line.
+    glyph = next(g for g in relief_glyphs() if g.name == name)
+    gt = glyph_ground_truth(glyph, width, close_gaps=True)
+    result = vectorize_image(to_uint8(render(gt.drawing)), VectorizeOptions(multi=False, classifier="cnn", seed=0))
+    assert len(result.drawing.strokes) == 1
+    assert excursion(gt.drawing, result.drawing) <= excursion_bound(width)
