@@ -202,10 +202,15 @@ def extract_ink(gray: np.ndarray, *, threshold: float | None) -> tuple[np.ndarra
     return ink, level, width, framed
 
 
-def binarize(image: np.ndarray, *, max_size: int, blur: float, threshold: float | None) -> InkImage:
-    """Run the whole preprocessing stage."""
+def paper_gray(image: np.ndarray, *, max_size: int, blur: float) -> tuple[np.ndarray, float]:
+    """The working gray image with the paper's shading divided out (H, W) float32, and the
+    scale: what the threshold does not change (`binarize` without the ink)."""
     gray, scale = working_gray(image, max_size=max_size, blur=blur)
-    gray = flatten_paper(gray)
+    return flatten_paper(gray), scale
+
+
+def ink_image(gray: np.ndarray, scale: float, *, threshold: float | None) -> InkImage:
+    """The ink of a `paper_gray` image at this threshold (None: Li's)."""
     ink, level, width, framed = extract_ink(gray, threshold=threshold)
     # Whiten everything that is not kept ink (specks, a frame) and blacken filled holes, so
     # that the sub-pixel outline of the gray image matches the kept ink exactly.
@@ -216,3 +221,9 @@ def binarize(image: np.ndarray, *, max_size: int, blur: float, threshold: float 
     work[(work < level) & ~ink] = 1.0
     work[ink & (work >= level)] = 0.0
     return InkImage(gray=work, ink=ink, threshold=level, scale=scale, stroke_width=width, frame=framed)
+
+
+def binarize(image: np.ndarray, *, max_size: int, blur: float, threshold: float | None) -> InkImage:
+    """Run the whole preprocessing stage."""
+    gray, scale = paper_gray(image, max_size=max_size, blur=blur)
+    return ink_image(gray, scale, threshold=threshold)

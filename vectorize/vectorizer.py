@@ -9,7 +9,7 @@ from typing import NamedTuple
 import numpy as np
 
 from onestroke.errors import InputError
-from vectorize.binarize import binarize
+from vectorize.binarize import ink_image, paper_gray
 from vectorize.drawing import Drawing
 from vectorize.edits import Edits
 from vectorize.fitting import TracedPoint, fit_stroke
@@ -259,12 +259,16 @@ def _refuse_noise(count: int, what: str, limit: int, threshold: float, given: bo
                          f"drawing; {hint}")
 
 
-def _front(image: np.ndarray, options: VectorizeOptions, clock: _Clock):
-    """Binarize, outline, medial axis, pruning and (single-line) gap bridging: the stages
-    that only threshold, blur and mode change. Returns (ink, rings, graph, bridged, dropped)."""
+def _axis(image: np.ndarray, options: VectorizeOptions, clock: _Clock, cache: StageCache | None = None):
+    """Binarize, outline and medial axis: the stages that threshold and blur change, and the
+    mode does not. Returns (ink, rings, graph before pruning)."""
     # Every piece of ink is kept here; in single-line mode the pieces of a line broken by
-    # pen gaps are bridged below, and only then is the largest kept.
-    ink = binarize(image, max_size=options.max_size, blur=options.blur, threshold=options.threshold)
+    # pen gaps are bridged later, and only then is the largest kept.
+    def paper():
+        return paper_gray(image, max_size=options.max_size, blur=options.blur)
+
+    gray, scale = paper() if cache is None else cache.stage("paper", (options.blur, options.max_size), paper)
+    ink = ink_image(gray, scale, threshold=options.threshold)
     clock.lap("binarize")
     w = ink.stroke_width
     spacing = float(np.clip(w / 8.0, 0.3, 1.0))
@@ -276,6 +280,22 @@ def _front(image: np.ndarray, options: VectorizeOptions, clock: _Clock):
                   options.threshold is not None)
     graph = medial_axis(rings, ink.gray, ink.threshold)
     clock.lap("medial axis")
+    return ink, rings, graph
+
+
+def _front(image: np.ndarray, options: VectorizeOptions, clock: _Clock, cache: StageCache | None = None):
+    """Binarize, outline, medial axis, pruning and (single-line) gap bridging: the stages
+    that only threshold, blur and mode change. Returns (ink, rings, graph, bridged, dropped).
+
+    With `cache`, the stages before pruning are shared between the modes (a copy of the
+    cached graph is pruned) and the paper-flattened gray between thresholds."""
+    if cache is None:
+        ink, rings, graph = _axis(image, options, clock)
+    else:
+        key = (options.threshold, options.blur, options.max_size)
+        ink, rings, graph = cache.stage("axis", key, lambda: _axis(image, options, clock, cache))
+        graph = graph.copy()
+    w = ink.stroke_width
     prune(graph, threshold=PRUNE_MULTI if options.multi else PRUNE_SINGLE, stroke_width=w)
     trim_free_ends(graph, stroke_width=w)
     clock.lap("pruning")
@@ -306,7 +326,7 @@ def run_pipeline(image: np.ndarray, options: VectorizeOptions, *,
         edits = edits if edits is not None else Edits()
         options = edits.applied_to(options)
         cache = cache if cache is not None else StageCache()
-        front = cache.front_for(image, options, lambda: _front(image, options, clock))
+        front = cache.front_for(image, options, lambda stages: _front(image, options, clock, stages))
     else:
         front = _front(image, options, clock)
     ink, rings, graph, bridged, dropped = front
