@@ -123,33 +123,35 @@ def _trace(graph: MedialGraph, simple: Simplified, ordering: Ordering, junctions
         zones.append((graph.positions[node], reach, True))
     result = []
     for passes, closed in zip(ordering.strokes, ordering.closed):
-        traced: list[TracedPoint] = []
+        parts, keeps, tips = [], [], []
         for index, step in enumerate(passes):
             branch = graph.branches[step.branch]
             # By end, not by node: a loop starts and ends at the same node.
             points = branch.points if step.start == "a" else branch.points[::-1]
             far_node = branch.b if step.start == "a" else branch.a
             points = points if index == 0 else points[1:]
+            if not len(points):
+                continue
             on_foot = step.branch in foot_branches
             # The pen turns back on itself: a cusp (the fit splits there, never loops).
             turns_back = (index + 1 < len(passes) and passes[index + 1].branch == step.branch
                           and passes[index + 1].start != step.start)
-            for k, xy in enumerate(points):
-                last = k == len(points) - 1
-                tip = last and (far_node in simple.y_tips or turns_back)
-                keep = (not on_foot) or tip
-                traced.append(TracedPoint(xy, keep, tip))
-        xy = np.array([t.xy for t in traced])
+            tip = np.zeros(len(points), dtype=bool)
+            tip[-1] = far_node in simple.y_tips or turns_back
+            parts.append(points)
+            keeps.append(tip | (not on_foot))
+            tips.append(tip)
+        if not parts:
+            result.append(([], closed))
+            continue
+        xy, keep, split = np.concatenate(parts), np.concatenate(keeps), np.concatenate(tips)
         for base in sharp_points:
-            for i in np.flatnonzero(np.all(xy == base, axis=1)):
-                traced[i] = TracedPoint(traced[i].xy, traced[i].keep, True, traced[i].corner)
+            split[np.all(xy == base, axis=1)] = True
         for center, reach, crossing in zones:
             dist = np.linalg.norm(xy - center, axis=1)
-            for i in np.flatnonzero(dist < reach):
-                at_node = dist[i] < 1e-6
-                traced[i] = TracedPoint(traced[i].xy, crossing and at_node and traced[i].keep, traced[i].split,
-                                        traced[i].corner)
-        result.append((traced, closed))
+            near = dist < reach
+            keep[near] &= crossing & (dist[near] < 1e-6)
+        result.append(([TracedPoint(p, k, t) for p, k, t in zip(xy, keep.tolist(), split.tolist())], closed))
     return result
 
 
