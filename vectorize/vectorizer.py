@@ -43,14 +43,20 @@ SMOOTHER_TOUCH = 0.85
 
 
 class _Clock:
+    """Wall and CPU seconds per stage (CPU: on a shared machine the wall time includes
+    waiting for a core)."""
+
     def __init__(self) -> None:
         self.seconds: dict[str, float] = {}
+        self.cpu_seconds: dict[str, float] = {}
         self._last = time.perf_counter()
+        self._last_cpu = time.process_time()
 
     def lap(self, stage: str) -> None:
-        now = time.perf_counter()
+        now, cpu = time.perf_counter(), time.process_time()
         self.seconds[stage] = self.seconds.get(stage, 0.0) + now - self._last
-        self._last = now
+        self.cpu_seconds[stage] = self.cpu_seconds.get(stage, 0.0) + cpu - self._last_cpu
+        self._last, self._last_cpu = now, cpu
 
 
 def _junctions(graph: MedialGraph, nodes, stroke_width: float) -> list[Junction]:
@@ -393,7 +399,8 @@ def run_pipeline(image: np.ndarray, options: VectorizeOptions, *,
     report = VectorizeReport(
         strokes=len(strokes), intersections=len(simple.crossings), y_junctions=len(simple.y_feet),
         dropped_components=dropped, gaps_bridged=bridged, high_degree_junctions=len(simple.unresolved), retries=tried - 1,
-        scale=scale, stroke_width=w / scale, warnings=tuple(warnings), seconds=clock.seconds)
+        scale=scale, stroke_width=w / scale, warnings=tuple(warnings), seconds=clock.seconds,
+        cpu_seconds=clock.cpu_seconds)
     if stages is not None:
         stages.update(simplified=graph, simple=simple, junctions=junctions, verdicts=verdicts,
                       ordering=ordering, working_strokes=strokes)
