@@ -113,11 +113,19 @@ def test_sliders_dragged_show_busy_and_the_latest_value_wins(page):
     page.mouse.down()
     page.mouse.move(x_of(0.25), y, steps=4)
     page.wait_for_function("document.body.classList.contains('busy')")  # its preview re-run started
+    resting = page.inner_text("#threshold-value")
+    # From here on, every threshold the page draws is recorded.
+    page.evaluate("""() => { window.drawn = [];
+        new MutationObserver(() => window.drawn.push(document.getElementById('summary').textContent + ' @ ' +
+            window.studio.state.settings.threshold)).observe(document.getElementById('summary'),
+            {childList: true, characterData: true, subtree: true}); }""")
     page.mouse.move(x_of(0.6), y, steps=4)
     page.mouse.up()
     final = float(page.eval_on_selector("#threshold", "e => e.value"))
     assert abs(final - 0.59) < 0.011
     settle(page)
+    drawn = page.evaluate("window.drawn")
+    assert drawn and all(text.endswith(f"@ {final}") for text in drawn), (resting, drawn)  # never the old value
     assert page.evaluate(f"{STATE}.settings.threshold") == final
     assert page.evaluate(f"{STATE}.edits.threshold") == final
     assert page.inner_text("#threshold-value") == f"{final:.2f}"
@@ -175,6 +183,49 @@ def test_split_merge_start_and_reverse_by_clicking(page):
     last = page.evaluate(f"{STATE}.strokes[0].points.slice(-1)[0]")
     assert abs(last[0] - end[0]) < 3 and abs(last[1] - end[1]) < 3
     page.screenshot(path=str(ARTIFACTS / "studio-7-after-edits.png"))
+    page.check("input[name=tool][value=pairing]")
+
+
+def test_zoom_pan_and_reverse_one_stroke(page):
+    count = page.evaluate(f"{STATE}.edits.edits.length")
+    fitted = page.evaluate("({...window.studio.view})")
+    junction = page.evaluate(f"{STATE}.graph.junctions.find(j => j.role === 'crossing')")
+    x, y = page.evaluate(f"window.studio.toScreen({junction['at'][0]}, {junction['at'][1]})")
+    # The wheel zooms about the pointer: the junction under it stays there.
+    page.mouse.move(x, y)
+    page.mouse.wheel(0, -400)
+    page.wait_for_function(f"window.studio.view.scale > {fitted['scale'] * 1.5}")
+    after = page.evaluate(f"window.studio.toScreen({junction['at'][0]}, {junction['at'][1]})")
+    assert abs(after[0] - x) < 2 and abs(after[1] - y) < 2
+    # A drag pans, even when it starts on a junction: no edit is made.
+    page.mouse.move(x, y)
+    page.mouse.down()
+    page.mouse.move(x - 150, y - 60, steps=5)
+    page.mouse.up()
+    moved = page.evaluate(f"window.studio.toScreen({junction['at'][0]}, {junction['at'][1]})")
+    assert abs(moved[0] - (x - 150)) < 2 and abs(moved[1] - (y - 60)) < 2
+    page.wait_for_timeout(200)
+    assert page.evaluate(f"{STATE}.edits.edits.length") == count and page.evaluate("window.studio.at") == \
+        page.evaluate("window.studio.history.length") - 1
+    page.screenshot(path=str(ARTIFACTS / "studio-8-zoomed.png"))
+    # Clicks still find what is under the pointer in the zoomed, panned view.
+    click_at(page, junction["at"])
+    settle(page, count + 1 if not junction["fixed"] else count)
+    assert junction_near(page, junction["at"])["fixed"]
+    page.click("#undo")
+    settle(page, count)
+    # Double-click fits the drawing again.
+    page.dblclick("#canvas", position={"x": 5, "y": 5})
+    assert page.evaluate("window.studio.view.scale") == pytest.approx(fitted["scale"])
+
+    # The reverse tool: a click on a stroke makes it run the other way.
+    before = page.evaluate(f"{STATE}.strokes.map(s => [s.points[0], s.points[s.points.length - 1]])")
+    point = page.evaluate(f"{STATE}.strokes[0].points[Math.floor({STATE}.strokes[0].points.length / 3)]")
+    page.check("input[name=tool][value=reverse]")
+    click_at(page, point)
+    settle(page, count + 1)
+    now = page.evaluate(f"{STATE}.strokes.map(s => [s.points[0], s.points[s.points.length - 1]])")
+    assert now[0][0] == pytest.approx(before[0][1], abs=2) and now[0][1] == pytest.approx(before[0][0], abs=2)
     page.check("input[name=tool][value=pairing]")
 
 

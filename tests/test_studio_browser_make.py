@@ -23,6 +23,19 @@ def edited(page):
     return edits
 
 
+def play_the_panel(page, panel: str) -> None:
+    """The panel's player shows the finished job; its Play runs it from the start: the
+    stitch (or line) number moves on, then stops where Play is pressed again."""
+    number = f"#{panel}-player [data-role=number]"
+    total = page.inner_text(number)
+    page.click(f"#{panel}-player [data-role=play]")
+    page.wait_for_timeout(700)
+    page.click(f"#{panel}-player [data-role=play]")
+    now = page.inner_text(number)
+    count = int(now.split("/")[0].replace(",", "").strip())
+    assert now != total and count > 0, (now, total)
+
+
 @pytest.mark.parametrize("kind", ["svg", "json"])
 def test_drawing_downloads(page, studio, edited, tmp_path, kind):
     page.click("nav .tab[data-tab=refine]")
@@ -48,6 +61,7 @@ def test_embroidery_downloads(page, studio, edited, tmp_path, kind, style, size,
     page.press(f"{form} input[name=stitch_length]", "Tab")  # a typed field reports its change on leaving it
     settle(page, extra="document.getElementById('embroidery-stats').textContent.includes('stitches')")
     if kind == "pes":
+        play_the_panel(page, "embroidery")
         page.screenshot(path=str(ARTIFACTS / "studio-make-embroidery.png"))
     name, data = download(page, f"[data-export={kind}]")
     assert name == f"loops.{kind}"
@@ -65,6 +79,7 @@ def test_gcode_download(page, studio, edited, tmp_path):
     page.select_option(f"{form} select[name=origin]", "center")
     page.check(f"{form} input[name=arcs]")
     settle(page, extra="document.getElementById('laser-time').textContent.includes('estimated')")
+    play_the_panel(page, "laser")
     page.screenshot(path=str(ARTIFACTS / "studio-make-laser.png"))
     name, data = download(page, "[data-export=gcode]")
     assert name == "loops.gcode"

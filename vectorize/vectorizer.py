@@ -24,6 +24,7 @@ from vectorize.outline import outline_rings
 from vectorize.options import InputFrame, VectorizeOptions, VectorizeReport, VectorizeResult
 from vectorize.pruning import prune, trim_free_ends
 from vectorize.refine import Refinement, StageCache
+from vectorize.retraces import Twin, foot_is_retraced, twin_spans
 from vectorize.route_inspection import connect_pairings, plan_routes
 from vectorize.simplify import Simplified, is_t_shape, directions, simplify, slots
 from vectorize.stroke import Stroke
@@ -101,12 +102,16 @@ def _pairing_costs(verdict: JunctionVerdict) -> tuple[float, float, float]:
 
 
 def _trace(graph: MedialGraph, simple: Simplified, ordering: Ordering, junctions: dict,
-           verdicts: dict, stroke_width: float) -> list[tuple[list[TracedPoint], bool]]:
-    """Turn branch passes into point lists flagged for filtering (paper 3.4)."""
+           verdicts: dict, stroke_width: float) -> list[tuple[list[TracedPoint], bool, list[Twin]]]:
+    """Turn branch passes into point lists flagged for filtering (paper 3.4), with the
+    stretches each stroke draws twice (`vectorize.retraces`)."""
     # V-spikes: the foot is where both sides' inks merge, its points are uncertain; the
     # sides run straight to the tip. Retraced (T) spikes: the foot is the spike itself,
     # its points are good, and the line turns sharply at both of its ends.
-    foot_branches = {slots(graph, n)[f][0] for n, f in simple.y_feet.items() if n not in simple.retraced}
+    # V-spikes whose foot runs on far beyond the corner are a line drawn down and back up:
+    # there the foot is the centre line both passes follow (`vectorize.retraces`).
+    foot_branches = {slots(graph, n)[f][0] for n, f in simple.y_feet.items()
+                     if n not in simple.retraced and not foot_is_retraced(graph, n, f, stroke_width)}
     sharp_points = [graph.positions[n] for n in simple.retraced]
     crossing_of = dict(zip(simple.crossings, ordering.choice))
     # Uncertain zone around each degree-4 node: where the two strokes' inks still overlap.
@@ -128,16 +133,22 @@ def _trace(graph: MedialGraph, simple: Simplified, ordering: Ordering, junctions
         reach = float(np.clip(graph.spans.get(node, 0.0) + stroke_width, graph.radii[node], 12.0 * stroke_width))
         zones.append((graph.positions[node], reach, True))
     result = []
+    # Not retraced stretches: a loop (its direction cannot be told from where it starts) and
+    # the foot of a V-spike (each side of the V runs to the tip on its own ink).
+    not_twins = {bid for bid, b in graph.branches.items() if b.a == b.b} | foot_branches
     for passes, closed in zip(ordering.strokes, ordering.closed):
-        parts, keeps, tips = [], [], []
+        parts, keeps, tips, spans = [], [], [], []
+        count = 0  # traced points so far
         for index, step in enumerate(passes):
             branch = graph.branches[step.branch]
             # By end, not by node: a loop starts and ends at the same node.
             points = branch.points if step.start == "a" else branch.points[::-1]
             far_node = branch.b if step.start == "a" else branch.a
             points = points if index == 0 else points[1:]
+            spans.append((max(count - 1, 0), count + len(points) - 1))
             if not len(points):
                 continue
+            count += len(points)
             on_foot = step.branch in foot_branches
             # The pen turns back on itself: a cusp (the fit splits there, never loops).
             turns_back = (index + 1 < len(passes) and passes[index + 1].branch == step.branch
@@ -147,8 +158,9 @@ def _trace(graph: MedialGraph, simple: Simplified, ordering: Ordering, junctions
             parts.append(points)
             keeps.append(tip | (not on_foot))
             tips.append(tip)
+        twins = twin_spans([p.branch for p in passes], [p.start for p in passes], spans, not_twins)
         if not parts:
-            result.append(([], closed))
+            result.append(([], closed, twins))
             continue
         xy, keep, split = np.concatenate(parts), np.concatenate(keeps), np.concatenate(tips)
         for base in sharp_points:
@@ -157,7 +169,8 @@ def _trace(graph: MedialGraph, simple: Simplified, ordering: Ordering, junctions
             dist = np.linalg.norm(xy - center, axis=1)
             near = dist < reach
             keep[near] &= crossing & (dist[near] < 1e-6)
-        result.append(([TracedPoint(p, k, t) for p, k, t in zip(xy, keep.tolist(), split.tolist())], closed))
+        traced = [TracedPoint(p, k, t) for p, k, t in zip(xy, keep.tolist(), split.tolist())]
+        result.append((traced, closed, twins))
     return result
 
 
@@ -365,10 +378,11 @@ def run_pipeline(image: np.ndarray, options: VectorizeOptions, *,
     sigma = float(np.clip(0.065 * w, 0.15, 0.8))
     guard = InkGuard(graph, ink.gray, ink.threshold) if solved is None else None
     strokes = list(solved[1]) if solved is not None else []
-    for traced, closed in _trace(graph, simple, ordering, junctions, verdicts, w) if solved is None else ():
+    for traced, closed, twins in _trace(graph, simple, ordering, junctions, verdicts, w) if solved is None else ():
         if len(traced) < 2:
             continue
-        strokes.append(_orient(fit_stroke(traced, closed=closed, sigma=sigma, stroke_width=w, guard=guard), closed))
+        strokes.append(_orient(fit_stroke(traced, closed=closed, sigma=sigma, stroke_width=w, guard=guard,
+                                          twins=tuple(twins)), closed))
     if refine is not None and solved is None:
         refine.keep_solved(best, strokes)
     strokes = [s for s in strokes if s.length > 0.5 * w or len(strokes) == 1]

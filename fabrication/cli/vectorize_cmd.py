@@ -7,7 +7,7 @@ import time
 
 import click
 
-from fabrication.cli.common import console, done, edits_option, warn
+from fabrication.cli.common import console, done, edits_option, step, warn
 from fabrication.cli.options import drawing_input_options, input_argument, output_option
 from onestroke.errors import InputError
 from onestroke.paths import check_distinct
@@ -23,9 +23,12 @@ from onestroke.paths import check_distinct
 def vectorize(source: str, output: str, multi: bool, threshold: float | None, blur: float,
               classifier: str, debug_dir: str | None, edits: str | None) -> None:
     """Vectorize SOURCE into one ordered cubic Bézier curve (or several with --multi)."""
-    check_distinct(inputs=[("input", source), ("--edits file", edits)], outputs=[("output", output)])
     if debug_dir is not None and os.path.exists(debug_dir) and not os.path.isdir(debug_dir):
         raise InputError(f"--debug {debug_dir!r} is a file; give a folder for the stage images")
+    from vectorize.debug_overlay import STAGE_IMAGES
+
+    stage_images = [("--debug image", os.path.join(debug_dir, name)) for name in STAGE_IMAGES] if debug_dir else []
+    check_distinct(inputs=[("input", source), ("--edits file", edits)], outputs=[("output", output), *stage_images])
     from vectorize import VectorizeOptions, vectorize_file
     from vectorize.edits import read_edits
     from vectorize.svg_write import write_drawing
@@ -34,8 +37,8 @@ def vectorize(source: str, output: str, multi: bool, threshold: float | None, bl
     started = time.perf_counter()
     options = VectorizeOptions(multi=multi, threshold=threshold, blur=blur, classifier=classifier,
                                keep_stages=debug_dir is not None)
-    with console.status(f"vectorizing {os.path.basename(source)}"):
-        result = vectorize_file(source, options, edits=replay)
+    with step(f"vectorizing {os.path.basename(source)}") as progress:
+        result = vectorize_file(source, options, edits=replay, progress=progress)
     for message in result.report.warnings:
         warn(message)
     write_drawing(result.drawing, output)

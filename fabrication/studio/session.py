@@ -9,7 +9,6 @@ with the same options.
 
 from __future__ import annotations
 
-import json
 import os
 import threading
 from pathlib import Path
@@ -116,6 +115,18 @@ class StudioSession:
         }
 
     # -- make it ---------------------------------------------------------------------
+    PANEL_MODULES = ("fabrication.embroidery.pipeline", "fabrication.embroidery.export", "fabrication.player",
+                     "fabrication.laser.program", "machines.hoops", "machines.job_time", "vectorize.svg_write")
+
+    def warm(self) -> None:
+        """Import what the make-it panels and downloads use (about 1 s of CPU), so that the
+        first click on the Embroidery or Laser tab answers as fast as the next ones. The
+        CLI runs it in the background once the page is served."""
+        import importlib
+
+        for name in self.PANEL_MODULES:
+            importlib.import_module(name)
+
     def embroidery(self, edits: Edits, values: dict, extension: str = "pes"):
         """(settings, result) of `onestroke embroider` for these option values."""
         from fabrication.embroidery.pipeline import embroider
@@ -139,7 +150,7 @@ class StudioSession:
         data = stitch_player_data(result.plan, title=self.drawing_path.stem, stats=stats,
                                   stitches_per_minute=job.stitches_per_minute, trim_seconds=job.trim_seconds,
                                   hoop=(-hoop.width / 2, -hoop.height / 2, hoop.width / 2, hoop.height / 2))
-        return {"player": json.loads(data.to_json()), "stats": stats.lines(), "stitches": stats.stitches,
+        return {"player": data.to_dict(), "stats": stats.lines(), "stitches": stats.stitches,
                 "seconds": stats.seconds, "warnings": list(settings.warnings) + list(result.warnings)}
 
     def laser(self, edits: Edits, values: dict):
@@ -163,7 +174,7 @@ class StudioSession:
         settings, program = self.laser(edits, values)
         time = program.time
         data = gcode_player_data(program.lines, title=self.drawing_path.stem, profile=settings.profile)
-        return {"player": json.loads(data.to_json()), "seconds": time.total_seconds,
+        return {"player": data.to_dict(), "seconds": time.total_seconds,
                 "time": format_duration(time.total_seconds), "naive": format_duration(time.naive_seconds),
                 "burn_length": round(float(time.burn_length), 1), "travel_length": round(float(time.travel_length), 1),
                 "lines": len(program.lines), "profile": settings.profile.name,
