@@ -39,7 +39,7 @@ def page(studio, browser):
     errors = []
     page.on("pageerror", lambda error: errors.append(str(error)))
     page.goto(studio[0].url)
-    page.wait_for_function(f"window.studio.state !== null && {IDLE}")
+    page.wait_for_function(f"window.studio.state !== null && {IDLE}", timeout=90000)  # the first vectorization
     yield page
     context.close()
     assert not errors, errors

@@ -205,3 +205,18 @@ def test_a_queued_state_request_gives_way_to_the_same_pages_newer_one(drawing):
         assert answers[0.42, "p1"] == {"superseded": True}
         assert answers[0.44, "p1"]["settings"]["threshold"] == 0.44
         assert answers[0.43, "p2"]["settings"]["threshold"] == 0.43  # another page's request is its own
+
+
+def test_abort_while_connecting(client):
+    """Abort pressed before the controller has answered: no line is streamed."""
+    state = client.get("/api/state").json()
+    started = client.post("/api/send", json={"edits": state["edits"], "options": {"size": "20mm"},
+                                             "port": "sim://?speed=2"})
+    assert started.status_code == 200 and started.json()["state"] == "connecting", started.text
+    assert client.post("/api/send/abort").json()["state"] == "aborting"
+    deadline = time.monotonic() + 20
+    status = client.get("/api/send").json()
+    while status["state"] in ("connecting", "streaming", "aborting") and time.monotonic() < deadline:
+        time.sleep(0.05)
+        status = client.get("/api/send").json()
+    assert status["state"] == "aborted" and status["acked"] < status["total"], status

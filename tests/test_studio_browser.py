@@ -113,11 +113,19 @@ def test_sliders_dragged_show_busy_and_the_latest_value_wins(page):
     page.mouse.down()
     page.mouse.move(x_of(0.25), y, steps=4)
     page.wait_for_function("document.body.classList.contains('busy')")  # its preview re-run started
+    resting = page.inner_text("#threshold-value")
+    # From here on, every threshold the page draws is recorded.
+    page.evaluate("""() => { window.drawn = [];
+        new MutationObserver(() => window.drawn.push(document.getElementById('summary').textContent + ' @ ' +
+            window.studio.state.settings.threshold)).observe(document.getElementById('summary'),
+            {childList: true, characterData: true, subtree: true}); }""")
     page.mouse.move(x_of(0.6), y, steps=4)
     page.mouse.up()
     final = float(page.eval_on_selector("#threshold", "e => e.value"))
     assert abs(final - 0.59) < 0.011
     settle(page)
+    drawn = page.evaluate("window.drawn")
+    assert drawn and all(text.endswith(f"@ {final}") for text in drawn), (resting, drawn)  # never the old value
     assert page.evaluate(f"{STATE}.settings.threshold") == final
     assert page.evaluate(f"{STATE}.edits.threshold") == final
     assert page.inner_text("#threshold-value") == f"{final:.2f}"

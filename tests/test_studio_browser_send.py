@@ -16,6 +16,11 @@ STATUS = "document.getElementById('send-status')"
 ACKED = "document.getElementById('send-progress').value"
 
 
+def player_line(page) -> int:
+    """The G-code line the laser panel's player shows."""
+    return int(page.inner_text("#laser-player [data-role=number]").split("/")[0].replace(",", "").strip())
+
+
 def state(page) -> str:
     return page.eval_on_selector("#send-status", "e => e.dataset.state")
 
@@ -34,6 +39,10 @@ def test_send_pause_resume_abort_on_the_emulator(page):
     total = page.evaluate("document.getElementById('send-progress').max")
     assert first < page.evaluate(ACKED) < total and total > 100
     assert not page.is_enabled("#send") and page.is_enabled("#pause") and not page.is_enabled("#resume")
+    # The laser preview's head follows the job: the player shows the line acknowledged last.
+    shown = player_line(page)
+    page.wait_for_function(f"{ACKED} > {page.evaluate(ACKED)} + 5")
+    assert 1 < shown < player_line(page) < page.evaluate("document.getElementById('send-progress').max") + 10
     page.screenshot(path=str(ARTIFACTS / "studio-send-1-streaming.png"))
 
     page.click("#pause")

@@ -41,9 +41,11 @@ export async function refreshPanel() {
 
 // Stitches and laser moves play in the project's player (fabrication/player), one per panel.
 const players = {};
+let laserShown = 0, laserSent = -1;  // which toolpath the laser player shows, which one was sent
 function showPlayer(kind, data) {
   if (!players[kind]) players[kind] = createPlayer($(`${kind}-player`), data);
   else players[kind].load(data);
+  if (kind === "laser") laserShown += 1;
   players[kind].seek(data.total);  // the finished job first; Play starts it from the beginning
   window.studio.players = players;
 }
@@ -89,6 +91,7 @@ async function sendAction(action) {
     const status = action === "send"
       ? await call("api/send", { edits: edits(), options: panelOptions("laser"), port: $("port").value.trim() })
       : await call(`api/send/${action}`, {});
+    if (action === "send") laserSent = laserShown;
     showSend(status);
   } catch (error) {
     sendError(error.message);
@@ -109,6 +112,9 @@ function showSend(s) {
   $("send-status").textContent = `${s.state}${s.port ? ` on ${s.port}` : ""}${lines}${machine}` +
     `${s.message ? ` · ${s.message}` : ""}`;
   $("send-status").dataset.state = s.state;
+  // The laser player follows the job (the line the machine acknowledged last) while it
+  // shows the toolpath that was sent.
+  if (active && s.line && players.laser && laserSent === laserShown) players.laser.seekNumber(s.line);
   $("send").disabled = active;
   $("pause").disabled = s.state !== "streaming";
   $("resume").disabled = s.state !== "paused";
