@@ -7,14 +7,15 @@ drawings, the examples) and for dense 4,000-line jobs of 0.1 mm segments, it pri
 - planner: the estimate's planner-only figure;
 - emulator: the machine time of a real character-counting stream (GrblStreamer over a
   pty at 115,200 baud, 2 ms parse per line) into the GRBL emulator (`sim://`'s machine),
-  run in a child process like firmware on its own CPU: wall time x time scale, from the
-  first byte sent to Idle at the end; median of --repeat runs;
+  run in a child process like firmware on its own CPU, on the emulator's machine clock
+  (`EmulatorStats.job_time`: from the first line sent to the end of the last block or
+  the last `ok`, whichever is later); median of --repeat runs;
 - diff: estimate / emulator - 1.
-The emulator runs `time_scale` times faster than a machine (wire, parsing and motion all
-scale); the host's own overhead does not scale, so a high scale overstates the time of
-dense jobs. Medians; say the load (`uptime`) with the figures.
+The machine clock does not depend on the host's speed or load (machines/emulator_clock.py):
+the figures are the same on a quiet and a loaded machine, only the wall time differs.
+`--scale` only sets how fast the emulator paces its replies in wall time.
 
-    python benchmarks/laser_estimate_vs_emulator.py [--scale 2] [--repeat 1] [--only dense]
+    python benchmarks/laser_estimate_vs_emulator.py [--scale 2] [--repeat 1] [--only dense] [--count N] [--match TEXT]
 """
 
 from __future__ import annotations
@@ -45,10 +46,21 @@ def dense_job(lines: int, step: float, feed: float) -> list[str]:
     return make_job(lines, step, feed).splitlines()
 
 
+def straight_job(lines: int, step: float, feed: float) -> list[str]:
+    """`lines` G1 moves of `step` mm along one straight line: no corners, so the planner
+    would run at `feed` and the serial link and the parser set the pace."""
+    out = ["G21", "G90", "M4 S600", "G0 X0 Y10", f"F{feed:g}"]
+    out += [f"G1X{i * step:.3f}" for i in range(1, lines + 1)]
+    return out + ["M5", "G0X0Y0"]
+
+
 def _serve(conn, scale: float) -> None:
     emulator = GrblEmulator(EmulatorOptions(time_scale=scale, parse_time=PROFILE.parse_time,
                                             baud=PROFILE.baud))
     conn.send(emulator.start_pty())
+    conn.recv()  # the host has connected: the job starts with its next line
+    emulator.mark_job_start()
+    conn.send("marked")
     conn.recv()
     emulator.wait_idle(30.0)
     conn.send(emulator.stats())
@@ -65,12 +77,14 @@ def emulated_seconds(lines: list[str], scale: float) -> tuple[float, float]:
     try:
         with GrblStreamer(open_port(device)) as streamer:
             streamer.connect()
-            result = streamer.stream(program_from_lines(lines))
+            parent.send("connected")
+            parent.recv()
+            streamer.stream(program_from_lines(lines))
     finally:
         parent.send("stop")
     stats = parent.recv()
     process.join(5)
-    return result.elapsed * scale, stats.planner_limited_time
+    return stats.job_time, stats.planner_limited_time
 
 
 def row(label: str, lines: list[str], scale: float, repeat: int) -> float:
@@ -88,6 +102,8 @@ def main() -> None:
     parser.add_argument("--scale", type=float, default=2.0, help="emulator time scale")
     parser.add_argument("--repeat", type=int, default=1)
     parser.add_argument("--only", choices=["all", "jobs", "dense"], default="all")
+    parser.add_argument("--count", type=int, default=0, help="only the first N jobs of each kind (0: all)")
+    parser.add_argument("--match", default="", help="only jobs whose label contains this text")
     args = parser.parse_args()
     load = os.getloadavg()[0]
     print(f"emulator {args.scale:g}x, {PROFILE.baud} baud, parse {PROFILE.parse_time * 1000:g} ms/line, "
@@ -95,14 +111,25 @@ def main() -> None:
     print(f"{'job':46s} {'lines':>6s} {'estimate':>9s} {'bound':>7s} {'planner':>9s} {'emulator':>9s} {'diff':>7s}")
     diffs = []
     if args.only in ("all", "jobs"):
-        for label, lines in jobs():
+        for number, (label, lines) in enumerate(jobs()):
+            if args.count and number >= args.count:
+                break
+            if args.match not in label:
+                continue
             diffs.append(row(label, lines, args.scale, args.repeat))
     if args.only in ("all", "dense"):
         print("dense jobs: 4,000 lines; the emulator's time is what a character-counting stream at "
               f"{PROFILE.baud} baud allows")
-        for step, feed in ((0.1, 3000), (0.1, 5000), (0.1, 6000), (0.05, 3000), (0.05, 6000)):
+        dense = ((0.1, 3000), (0.1, 5000), (0.1, 6000), (0.05, 3000), (0.05, 6000))
+        for step, feed in dense[:args.count or None]:
+            if args.match not in f"dense {step:g} mm segments, F{feed}":
+                continue
             diffs.append(row(f"dense {step:g} mm segments, F{feed}", dense_job(4000, step, feed), args.scale,
                              args.repeat))
+        for step, feed in ((0.1, 5000), (0.05, 3000))[:args.count or None]:
+            label = f"dense {step:g} mm segments on a straight line, F{feed}"
+            if args.match in label:
+                diffs.append(row(label, straight_job(4000, step, feed), args.scale, args.repeat))
     print(f"largest |diff|: {max(abs(d) for d in diffs):.2%}; finished {time.strftime('%H:%M:%S')}")
 
 

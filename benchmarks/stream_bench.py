@@ -3,7 +3,8 @@
 The emulator runs in a child process (like real firmware, it does not share the sender's
 interpreter lock) on a pseudo-terminal; the sender opens the pty with pyserial. For each
 mode (character counting, send-response) it prints, as medians over --repeat runs: the
-run time in machine seconds (wall x time scale), the emulator's planner-limited time,
+run time in machine seconds (the emulator's machine clock, `EmulatorStats.job_time`: the
+same whatever the load), the emulator's planner-limited time,
 their ratio, RX overflow bytes and whether the emulator's log equals the file.
 
     python benchmarks/stream_bench.py [--lines 20000] [--scale 4] [--repeat 3]
@@ -44,6 +45,9 @@ def make_job(lines: int, step: float, feed: float) -> str:
 def _serve(conn, scale: float) -> None:
     emulator = GrblEmulator(EmulatorOptions(time_scale=scale))
     conn.send(emulator.start_pty())
+    conn.recv()  # the host has connected: time the job from its next line
+    emulator.mark_job_start()
+    conn.send("marked")
     conn.recv()  # "stop"
     emulator.wait_idle(10.0)
     stats = emulator.stats()
@@ -61,6 +65,8 @@ def run_once(text: str, scale: float, send_response: bool) -> dict:
     streamer = GrblStreamer(open_port(device), options=StreamOptions(send_response=send_response))
     try:
         streamer.connect()
+        parent.send("connected")
+        parent.recv()
         result = streamer.stream(program)
     finally:
         streamer.close()
@@ -68,8 +74,8 @@ def run_once(text: str, scale: float, send_response: bool) -> dict:
     stats, executed = parent.recv()
     process.join(5)
     expected = [line for _, line in program.lines] + [DRAIN_LINE]
-    return {"machine_s": result.elapsed * scale, "limited_s": stats.planner_limited_time,
-            "ratio": result.elapsed * scale / stats.planner_limited_time, "wall_s": result.elapsed,
+    return {"machine_s": stats.job_time, "limited_s": stats.planner_limited_time,
+            "ratio": stats.job_time / stats.planner_limited_time, "wall_s": result.elapsed,
             "overflow": stats.rx_overflow_bytes, "max_rx": stats.max_rx_used, "log_ok": executed == expected,
             "lines": len(program)}
 

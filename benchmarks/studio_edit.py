@@ -12,6 +12,10 @@ or merge with the simplification cache emptied first), so the figures are for th
 each kind really re-runs: pairing -> traversal and fitting; start/reverse -> nothing but the
 orientation (the fitted curve of the same earlier edits is cached); split/merge ->
 simplification on; threshold/blur/multi -> everything from binarization.
+
+`--panels` also times what the page asks next when its Embroidery or Laser tab is open
+(POST /api/embroidery and /api/laser with the page's default option values for the same
+edits: the stitch or toolpath preview regenerated for the player), as CPU seconds.
 """
 
 from __future__ import annotations
@@ -33,10 +37,14 @@ from fabrication.studio.session import StudioSession  # noqa: E402
 from vectorize.edits import PAIRINGS  # noqa: E402
 
 REPEATS = 7
+# The page's default panel values (fabrication/studio/static/index.html).
+PANELS = {"embroidery": {"style": "running", "size": "90mm", "hoop": "100x100", "color": "#1f3a93", "fit": False},
+          "laser": {"size": "80mm", "feed": "1500mm/min", "power": "60%", "passes": "1", "origin": "lower-left",
+                    "arcs": False}}
 DEFAULT = ["examples/loops.png", "examples/touch-drawing.png", "examples/hershey-HersheySans1-ampersand.png"]
 
 
-def bench(path: Path) -> dict[str, float]:
+def bench(path: Path, panels: bool = False) -> tuple[dict, dict, dict]:
     session = StudioSession(path, edits_path=Path(os.devnull))
     host = "127.0.0.1:1"
     client = TestClient(create_app(session, token="t", hosts={host}), base_url=f"http://{host}")
@@ -49,13 +57,21 @@ def bench(path: Path) -> dict[str, float]:
     stroke = base["strokes"][0]["points"]
 
     cpu: dict[str, list[float]] = {}
+    panel_cpu: dict[str, list[float]] = {}
 
     def post(extra: dict, items: list) -> float:
         start, start_cpu = time.perf_counter(), time.process_time()
         answer = client.post("/api/state", json={"edits": dict(edits, **extra, edits=items)})
         assert answer.status_code == 200, answer.text
         post.cpu = time.process_time() - start_cpu
-        return time.perf_counter() - start
+        wall = time.perf_counter() - start
+        post.panels = {}
+        for panel, options in PANELS.items() if panels else ():
+            start_cpu = time.process_time()
+            answer = client.post(f"/api/{panel}", json={"edits": dict(edits, **extra, edits=items), "options": options})
+            assert answer.status_code == 200, answer.text
+            post.panels[panel] = time.process_time() - start_cpu
+        return wall
 
     class Times(dict):
         """kind -> wall seconds; the CPU seconds of the same answer go to `cpu`."""
@@ -63,6 +79,8 @@ def bench(path: Path) -> dict[str, float]:
         def add(self, kind: str, seconds: float) -> None:
             self.setdefault(kind, []).append(seconds)
             cpu.setdefault(kind, []).append(post.cpu)
+            for panel, seconds in post.panels.items():
+                panel_cpu.setdefault((panel, kind), []).append(seconds)
 
     times = Times()
     for rep in range(REPEATS):
@@ -89,13 +107,16 @@ def bench(path: Path) -> dict[str, float]:
         times.add("multi", post({"multi": True}, []))
     result = {k: median(v) for k, v in times.items() if v}
     result["first"] = first
-    return result, {k: median(v) for k, v in cpu.items() if v}
+    return result, {k: median(v) for k, v in cpu.items() if v}, {k: median(v) for k, v in panel_cpu.items()}
 
 
 def main() -> None:
     parser = argparse.ArgumentParser(description="Median answer time of each studio edit kind.")
     parser.add_argument("drawings", nargs="*", type=Path, help="raster drawings (default: three 1000 px examples)")
-    paths = parser.parse_args().drawings or [Path(p) for p in DEFAULT]
+    parser.add_argument("--panels", action="store_true",
+                        help="also time the embroidery and laser previews the page asks for after each edit")
+    args = parser.parse_args()
+    paths = args.drawings or [Path(p) for p in DEFAULT]
     print(f"load: {os.getloadavg()[0]:.2f} (1 min), {os.cpu_count()} cores; median of {REPEATS} per edit kind, seconds")
     kinds = ("first", "pairing", "start", "reverse", "split", "merge", "threshold", "blur", "multi")
     print(f"{'drawing':40s} " + " ".join(f"{k:>9s}" for k in kinds))
@@ -104,9 +125,12 @@ def main() -> None:
 
         with Image.open(path) as picture:
             size = "x".join(map(str, picture.size))
-        wall, cpu = bench(path)
+        wall, cpu, panel_cpu = bench(path, args.panels)
         print(f"{path.name + ' ' + size:40s} " + " ".join(f"{wall.get(k, float('nan')):9.3f}" for k in kinds))
         print(f"{'  CPU s of this process':40s} " + " ".join(f"{cpu.get(k, float('nan')):9.3f}" for k in kinds))
+        for panel in PANELS if args.panels else ():
+            print(f"{'  then ' + panel + ' preview, CPU s':40s} " +
+                  " ".join(f"{panel_cpu.get((panel, k), float('nan')):9.3f}" for k in kinds))
 
 
 if __name__ == "__main__":

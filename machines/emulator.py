@@ -7,8 +7,14 @@ real-time bytes (status, hold, resume, reset, overrides); check mode; the common
 and alarms; and a log of every line it executed. `time_scale` > 1 runs everything (wire,
 parsing, motion) that many times faster than a real machine.
 
-The emulator is three mixins over one state: `emulator_transport` (pty, wire, serial
-interrupt), `emulator_protocol` (real-time bytes, lines, `$` commands, status) and
+Its time is a machine clock that does not depend on the host computer's speed or load
+(`emulator_clock`): every byte from the host gets a machine arrival time (`emulator_host`),
+parsing and motion advance the clock by their modelled times only, and wall time merely
+paces the replies. `EmulatorStats` reports machine seconds.
+
+The emulator is five mixins over one state: `emulator_transport` (pty, reader and writer
+threads), `emulator_host` (the wire and the host's send times), `emulator_clock` (the
+machine clock), `emulator_protocol` (real-time bytes, lines, `$` commands, status) and
 `emulator_motion` (the planner core's incremental driver, holds, limits).
 
 Use it in-process (`GrblEmulator(...).start_pty()` returns a device path for pyserial),
@@ -26,6 +32,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from machines.emulator_clock import EmulatorClock
+from machines.emulator_host import EmulatorHost
 from machines.emulator_motion import EmulatorMotion, Planned
 from machines.emulator_protocol import BUILD_DATE, VERSION, EmulatorProtocol
 from machines.emulator_transport import EmulatorTransport
@@ -98,11 +106,15 @@ class EmulatorOptions:
 
 @dataclass(frozen=True)
 class EmulatorStats:
-    """What the emulator measured. Times are machine seconds (wall time x time_scale).
+    """What the emulator measured. Times are machine seconds (the machine clock x
+    time_scale; the same whatever the host computer's load, see `emulator_clock`).
 
     planner_limited_time: the motion time if the planner had never been starved (each
     block planned with the full look-ahead), from the blocks actually executed.
     motion_time: from the first block's start to the last block's end, as it ran.
+    job_time: from the moment the host sent the first line after `mark_job_start` to the
+    end of the last block or the arrival of the last `ok` at the host, whichever is
+    later (0 if no job was marked). Includes holds (see `emulator_clock`).
     """
 
     lines_executed: int
@@ -117,11 +129,12 @@ class EmulatorStats:
     spindle_s: float
     resets: int
     alarms: tuple[int, ...]
+    job_time: float = 0.0
 
 
-class GrblEmulator(EmulatorTransport, EmulatorProtocol, EmulatorMotion):
-    """GRBL 1.1 on a file descriptor (the master side of a pty): transport, protocol and
-    motion mixins over one shared state, guarded by `_cond`."""
+class GrblEmulator(EmulatorTransport, EmulatorHost, EmulatorClock, EmulatorProtocol, EmulatorMotion):
+    """GRBL 1.1 on a file descriptor (the master side of a pty): transport, host, clock,
+    protocol and motion mixins over one shared state, guarded by `_cond`."""
 
     def __init__(self, options: EmulatorOptions = EmulatorOptions()):
         self.options = options
@@ -145,6 +158,8 @@ class GrblEmulator(EmulatorTransport, EmulatorProtocol, EmulatorMotion):
         self._threads: list[threading.Thread] = []
         self._stopping = False
         self.disconnected = False
+        self._init_clock()
+        self._init_host()
         self._reset_state(power_up=True)
 
     def _reset_state(self, *, power_up: bool = False) -> None:
@@ -189,7 +204,6 @@ class GrblEmulator(EmulatorTransport, EmulatorProtocol, EmulatorMotion):
         self.spindle_mode, self.spindle_s = "M5", 0.0
         self.coolant: frozenset = frozenset()
         self.feed_ov, self.rapid_ov, self.spindle_ov = 100, 100, 100
-        self._eeprom_until = 0.0
         self._status_count = 0
         self._homing = False
 
@@ -223,7 +237,10 @@ class GrblEmulator(EmulatorTransport, EmulatorProtocol, EmulatorMotion):
             motion = 0.0
             if self._first_motion is not None and self._last_motion is not None:
                 motion = float(self._last_motion - self._first_motion) * self.scale
-            result = dict(lines_executed=len(self.executed), blocks_executed=self.blocks_done,
+            job = 0.0
+            if self._job_start is not None:
+                job = float(max(self._last_motion or 0.0, self._last_ok) - self._job_start) * self.scale
+            result = dict(job_time=job, lines_executed=len(self.executed), blocks_executed=self.blocks_done,
                           motion_time=motion, rx_overflow_bytes=self.rx_overflow,
                           eeprom_lost_bytes=self.eeprom_lost, max_rx_used=self.max_rx, state=self.state,
                           spindle=self.spindle_mode, spindle_s=self.spindle_s, resets=self.resets,

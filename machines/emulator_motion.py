@@ -2,7 +2,7 @@
 
 Blocks from `machines.planner_model.BlockBuilder` (step-quantized like the firmware) wait
 in a 15-block planner; the running block follows `trapezoid(v_entry, exit_speed(planner))`
-in real time (scaled), re-planned when a new block arrives, as GRBL re-plans; forced stops
+on the machine clock (`emulator_clock`), re-planned when a new block arrives, as GRBL re-plans; forced stops
 drain the planner; feed hold decelerates inside the block; hard and soft limits and probe
 failures raise their alarms with the beam off. The job-time estimate runs the same rules
 over a whole program (`plan_times`). A mixin of `GrblEmulator`.
@@ -11,7 +11,6 @@ over a whole program (`plan_times`). A mixin of `GrblEmulator`.
 from __future__ import annotations
 
 import dataclasses
-import time
 from dataclasses import dataclass
 
 import numpy as np
@@ -42,7 +41,7 @@ class EmulatorMotion:
             planned, profile, t0 = self._current
             if self.hold and self.hold_complete:
                 return self.position.copy()
-            d = profile.distance_at((time.monotonic() - t0) * self.scale)
+            d = profile.distance_at((self._now() - t0) * self.scale)
             return planned.start + np.array(planned.block.unit) * d
         return self.position.copy()
 
@@ -65,8 +64,8 @@ class EmulatorMotion:
                     if not self.check_mode:
                         self._ref_dwell += float(action[1])
                         self._ref_rest = True
-                        deadline = time.monotonic() + action[1] / self.scale
-                        self._wait(lambda: time.monotonic() >= deadline)
+                        deadline = self._now() + action[1] / self.scale
+                        self._wait(lambda: self._now() >= deadline, until=deadline)
                 elif kind == "spindle":
                     if not self.check_mode:
                         self.spindle_mode, self.spindle_s = action[1], action[2]
@@ -101,7 +100,7 @@ class EmulatorMotion:
             self._adding = False
         self.planner.append(Planned(block, np.array(start, dtype=float), np.array(target, dtype=float),
                                      number, mode, s))
-        self._cond.notify_all()
+        self._wake_all()
 
     def _planned_end(self) -> np.ndarray:
         if self.planner:
@@ -118,7 +117,7 @@ class EmulatorMotion:
         self.alarm = True
         self.critical = self.critical or critical
         self.alarms.append(code)
-        self._cond.notify_all()
+        self._wake_all()
         self._reply(f"ALARM:{code}")
         if critical:
             self._reply("[MSG:Reset to continue]")
@@ -134,7 +133,7 @@ class EmulatorMotion:
         """Soft limit (lock held): feed hold to a stop, then ALARM:2; position is kept."""
         if self._motion_busy or self.planner:
             self.hold, self.hold_complete = True, False
-            self._cond.notify_all()
+            self._wake_all()
             self._wait(lambda: self.hold_complete or not self._motion_busy)
         self._alarm(2, critical=True)
 
@@ -154,7 +153,7 @@ class EmulatorMotion:
                     if self._stall_pending and not self.stalled:
                         self.stalled, self._stall_pending = True, False
                     v, clock = 0.0, None
-                    self._cond.wait(0.05)
+                    self._clock_wait()
                 if self._stopping:
                     return
                 if self._stall_pending:
@@ -164,7 +163,9 @@ class EmulatorMotion:
                 if self._adding and len(self.planner) < self.options.planner_blocks:
                     # The protocol thread holds a parsed block waiting for this free slot; on
                     # GRBL it would join the look-ahead while this block runs.
-                    self._cond.wait_for(lambda: not self._adding or self._reset_pending, timeout=0.005)
+                    while (self._adding and len(self.planner) < self.options.planner_blocks
+                           and not (self._reset_pending or self._stopping)):
+                        self._clock_wait()  # (the clock stands still meanwhile)
                     if self._reset_pending or not self.planner or self.hold or self.stalled or self.critical:
                         continue  # things changed while the lock was released
                 planned = self.planner[0]
@@ -173,7 +174,7 @@ class EmulatorMotion:
                 block = planned.block
                 profile = trapezoid(v, exit_speed(window, feed_override=fo, rapid_override=ro),
                                     block.nominal(fo, ro), block.acceleration, block.length)
-                now = time.monotonic()
+                now = self._now()
                 t0 = clock if (clock is not None and v > 0 and clock <= now) else now
                 self._current = (planned, profile, t0)
                 self._motion_busy = True
@@ -185,10 +186,9 @@ class EmulatorMotion:
                 end = t0 + profile.duration / self.scale
                 known = len(self.planner)
                 while not (self._stopping or self._reset_pending or self.hold or self.critical):
-                    left = end - time.monotonic()
-                    if left <= 0:
+                    if self._now() >= end:
                         break
-                    self._cond.wait(left)
+                    self._clock_wait(end)
                     if len(self.planner) > known and self.planner and self.planner[0] is planned:
                         # GRBL re-plans the running block when a new one arrives: its exit
                         # speed may rise now that the look-ahead reaches further.
@@ -201,7 +201,7 @@ class EmulatorMotion:
                     self._motion_busy = False
                     self._current = None
                     v, clock = 0.0, None
-                    self._cond.notify_all()
+                    self._wake_all()
                     continue
                 if self.hold:
                     v, clock = 0.0, None
@@ -214,7 +214,7 @@ class EmulatorMotion:
                 self._motion_busy = False
                 self._current = None
                 v, clock = profile.v_exit, end
-                self._cond.notify_all()
+                self._wake_all()
 
     def _replan_running(self, planned: Planned, profile, t0: float, end: float, v_entry: float):
         """Raise the running block's exit speed if the grown look-ahead allows (lock held)."""
@@ -222,7 +222,7 @@ class EmulatorMotion:
         new_exit = exit_speed([p.block for p in self.planner], feed_override=fo, rapid_override=ro)
         if new_exit <= profile.v_exit + 1e-9:
             return profile, t0, end
-        now = time.monotonic()
+        now = self._now()
         tau = (now - t0) * self.scale
         remaining = planned.block.length - profile.distance_at(tau)
         if tau >= profile.duration or remaining <= 1e-9:
@@ -237,14 +237,14 @@ class EmulatorMotion:
 
     def _feed_hold(self, planned: Planned, profile, t0: float) -> None:
         """Decelerate to a stop inside the current block (lock held), then wait in Hold:0."""
-        tau = (time.monotonic() - t0) * self.scale
+        tau = (self._now() - t0) * self.scale
         speed, done = profile.speed_at(tau), profile.distance_at(tau)
         a, length = planned.block.acceleration, planned.block.length
         stop = min(speed * speed / (2 * a), max(0.0, length - done))
         stop_time = (speed - np.sqrt(max(speed * speed - 2 * a * stop, 0.0))) / a
-        deadline = time.monotonic() + stop_time / self.scale
-        while not (self._stopping or self._reset_pending) and time.monotonic() < deadline:
-            self._cond.wait(max(0.0, deadline - time.monotonic()))
+        deadline = self._now() + stop_time / self.scale
+        while not (self._stopping or self._reset_pending) and self._now() < deadline:
+            self._clock_wait(deadline)
         travelled = done + stop
         self.position = planned.start + np.array(planned.block.unit) * travelled
         remaining = length - travelled
@@ -255,9 +255,9 @@ class EmulatorMotion:
             else:
                 self.planner.popleft()
                 self.blocks_done += 1
-        self._last_motion = time.monotonic()
+        self._last_motion = self._now()
         self._motion_busy = False
         self._current = None
         if self.hold:
             self.hold_complete = True
-        self._cond.notify_all()
+        self._wake_all()

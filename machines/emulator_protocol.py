@@ -35,7 +35,7 @@ class EmulatorProtocol:
             self.reset_times.append(time.monotonic())
             self._reset_was_moving = self._moving()
             self._reset_pending = True
-            self._cond.notify_all()
+            self._wake_all()
         elif byte == 0x3F:
             self._reply(self._status_report())
         elif byte == 0x21:
@@ -46,14 +46,14 @@ class EmulatorProtocol:
             if not self.hold and not self.alarm and not self.check_mode:
                 self.hold = True
                 self.hold_complete = not self._motion_busy
-                self._cond.notify_all()
+                self._wake_all()
         elif byte == 0x7E:
             if self.hold and self.hold_complete:  # a resume during deceleration is ignored
                 self.hold = self.hold_complete = False
-                self._cond.notify_all()
+                self._wake_all()
             elif self.stalled:
                 self.stalled = False
-                self._cond.notify_all()
+                self._wake_all()
         elif 0x90 <= byte <= 0x94:
             self.feed_ov = {0x90: 100, 0x91: self.feed_ov + 10, 0x92: self.feed_ov - 10,
                             0x93: self.feed_ov + 1, 0x94: self.feed_ov - 1}[byte]
@@ -83,7 +83,7 @@ class EmulatorProtocol:
         feed = 0.0
         if self._current is not None and self._motion_busy:
             planned, profile, t0 = self._current
-            feed = profile.speed_at((time.monotonic() - t0) * self.scale) * 60.0
+            feed = profile.speed_at((self._now() - t0) * self.scale) * 60.0
         spindle = self.spindle_s * self.spindle_ov / 100.0 if self.spindle_mode != "M5" else 0.0
         fields.append(f"FS:{feed:.0f},{spindle:.0f}")
         self._status_count += 1
@@ -105,10 +105,11 @@ class EmulatorProtocol:
                 raw = self._next_line()
                 if raw is None:
                     return
-                busy_until = max(busy_until, time.monotonic()) + self.options.parse_time / self.scale
-                delay = busy_until - time.monotonic()
-                if delay > 0:
-                    time.sleep(delay)
+                # the line costs parse_time on the machine clock, however long Python takes
+                with self._cond:
+                    busy_until = max(busy_until, self._now()) + self.options.parse_time / self.scale
+                    self._wait(lambda: self._now() >= busy_until, until=busy_until)
+                    self._answering = len(raw) + 1  # its answer frees these bytes (`emulator_host`)
                 self._handle_line(raw)
             except Reset:
                 while True:  # a second reset may arrive while handling the first
@@ -121,7 +122,7 @@ class EmulatorProtocol:
                 return
 
     def _boot_messages(self) -> None:
-        self._send(f"\r\nGrbl {VERSION} ['$' for help]\r\n")
+        self._send(f"\r\nGrbl {VERSION} ['$' for help]\r\n", welcome=True)
         if self.alarm:
             self._reply("[MSG:'$H'|'$X' to unlock]")
 
@@ -129,17 +130,17 @@ class EmulatorProtocol:
         if self._reset_pending:
             raise Reset()
 
-    def _wait(self, predicate, timeout: float | None = None) -> bool:
-        """Wait (lock held) until predicate() or a reset; raise Reset on reset."""
-        deadline = None if timeout is None else time.monotonic() + timeout
+    def _wait(self, predicate, timeout: float | None = None, *, until: float | None = None) -> bool:
+        """Wait (lock held) until predicate() or a reset; raise Reset on reset. timeout (a
+        duration) or until (a clock time): give up then (the clock stops there for it)."""
+        deadline = until if timeout is None else self._now() + timeout
         while not predicate():
             self._check_reset()
             if self._stopping:
                 raise OSError("emulator stopped")
-            left = 0.05 if deadline is None else min(0.05, deadline - time.monotonic())
-            if left <= 0:
+            if deadline is not None and self._now() >= deadline:
                 return False
-            self._cond.wait(left)
+            self._clock_wait(deadline)
         self._check_reset()
         return True
 
@@ -155,7 +156,11 @@ class EmulatorProtocol:
                             line = bytes(self.rx[:index])
                             del self.rx[:index + 1]
                             return line
-                self._cond.wait(0.05)
+                self._parser_idle = True  # the clock may wait for the host (`emulator_clock`)
+                try:
+                    self._clock_wait()
+                finally:
+                    self._parser_idle = False
 
     def _handle_line(self, raw: bytes) -> None:
         text = clean_line(raw.decode("latin-1"))
@@ -190,7 +195,7 @@ class EmulatorProtocol:
             return
         with self._cond:
             self.executed.append(text)
-            self._cond.notify_all()
+            self._wake_all()
         if faults.drop_ok_at != number:
             self._reply("ok")
         if faults.garbage_at == number:
@@ -205,19 +210,19 @@ class EmulatorProtocol:
         with self._cond:
             was_moving = self._reset_was_moving
             # The motion thread drops its block as soon as it sees the pending reset.
-            deadline = time.monotonic() + 1.0
-            while self._motion_busy and time.monotonic() < deadline:
-                self._cond.wait(0.01)
+            while self._motion_busy and not self._stopping:
+                self._clock_wait()
             self.planner.clear()
             self.rx.clear()
             alarm = self.alarm or was_moving
             self.resets += 1
             self._reset_state()
+            self._host_pipelines = False  # a new connection: learn the host again
             self.alarm = alarm
             self.spindle_history.append(("M5", 0.0))
             if was_moving:
                 self.alarms.append(3)
-            self._cond.notify_all()
+            self._wake_all()
         if was_moving:
             self._reply("ALARM:3")
         self._boot_messages()
@@ -312,7 +317,7 @@ class EmulatorProtocol:
 
     def _eeprom_write(self) -> None:
         """Write EEPROM like the AVR: the line's answer waits, and serial input is lost meanwhile."""
-        until = time.monotonic() + self.options.eeprom_write_time / self.scale
         with self._cond:
-            self._eeprom_until = until
-            self._wait(lambda: time.monotonic() >= until)
+            until = self._now() + self.options.eeprom_write_time / self.scale
+            self._eeprom_window = (self._now(), until)
+            self._wait(lambda: self._now() >= until, until=until)

@@ -1,10 +1,10 @@
-"""The emulator's transport: a pseudo-terminal, the wire and the serial interrupt.
+"""The emulator's transport: a pseudo-terminal, its reader and writer threads.
 
-Bytes from the host arrive at the wire rate (10 bits a byte at `baud`, after the USB
-adapter's latency); the interrupt routine picks out real-time bytes and puts the rest into
-the 128-byte RX buffer, DROPPING what does not fit, as GRBL's serial.c does. Replies go
-out through a writer thread at the wire rate too. A mixin of `GrblEmulator`: the state it
-uses is created there.
+The reader acts on real-time bytes at once (at the machine time matching the wall time
+they came) and hands complete lines to `emulator_host`, which times their way over the
+wire into the 128-byte RX buffer. Replies go out at the wire rate after the USB latency,
+on the machine clock; the writer thread puts them on the pty when wall time reaches
+them (`emulator_clock`). A mixin of `GrblEmulator`: the state it uses is created there.
 """
 
 from __future__ import annotations
@@ -34,7 +34,7 @@ class EmulatorTransport:
         os.set_blocking(fd, False)
         self._fd = fd
         for target, name in ((self._reader_loop, "rx"), (self._protocol_loop, "protocol"),
-                             (self._motion_loop, "motion"), (self._writer_loop, "tx")):
+                             (self._motion_loop, "motion"), (self._writer_loop, "tx"), (self._clock_loop, "clock")):
             thread = threading.Thread(target=target, name=f"grbl-emu-{name}", daemon=True)
             self._threads.append(thread)
             thread.start()
@@ -43,7 +43,7 @@ class EmulatorTransport:
         """Stop the threads and close the pty."""
         with self._cond:
             self._stopping = True
-            self._cond.notify_all()
+            self._wake_all()
         with self._out_cond:
             self._out_cond.notify_all()
         for thread in self._threads:
@@ -67,31 +67,38 @@ class EmulatorTransport:
     def __exit__(self, *exc) -> None:
         self.stop()
 
-    def _send(self, text: str | bytes) -> None:
-        """Queue bytes for the host; they arrive after the USB latency and their wire time."""
+    def _send(self, text: str | bytes, *, answer: bool = False, welcome: bool = False) -> None:
+        """Queue bytes for the host (lock held or not); they reach it after the USB latency
+        and their wire time, on the machine clock. answer: an `ok` / `error:N` that frees
+        its line's bytes; welcome: a (re)boot that empties every buffer."""
         if self.options.faults.silent or self._fd is None:
             return
         data = text.encode("ascii") if isinstance(text, str) else text
-        byte_time = 10.0 / self.options.baud / self.scale
-        with self._out_cond:
-            start = max(time.monotonic() + self.options.usb_latency / self.scale, self._out_free)
-            self._out_free = start + len(data) * byte_time
-            self._outbox.append((self._out_free, data))
+        with self._cond, self._out_cond:  # (_cond is reentrant; always taken before _out_cond)
+            start = max(self._now() + self.options.usb_latency / self.scale, self._out_free)
+            self._out_free = start + len(data) * self._byte_time
+            cum = self._record_answer(self._out_free, all_lines=welcome) if answer or welcome else -1
+            self._outbox.append((self._out_free, data, cum))
             self._out_cond.notify()
 
     def _writer_loop(self) -> None:
+        # Paced in wall time: a reply due at clock t goes out at wall time offset + t.
         while True:
             with self._out_cond:
                 while not self._outbox and not self._stopping:
                     self._out_cond.wait(0.05)
                 if self._stopping and not self._outbox:
                     return
-                due, data = self._outbox[0]
-                wait = due - time.monotonic()
+                due, data, cum = self._outbox[0]
+                wait = self._offset + due - time.monotonic()
                 if wait > 0:
-                    self._out_cond.wait(wait)
+                    self._out_cond.wait(min(wait, 0.05))
                     continue
                 self._outbox.popleft()
+                # before the write: a host may answer before this thread runs again
+                self._written_due = due
+                if cum >= 0:
+                    self._acked_written = cum
             with self._write_lock:
                 while data and self._fd is not None:
                     try:
@@ -102,68 +109,53 @@ class EmulatorTransport:
                         break
 
     def _reply(self, line: str) -> None:
-        self._send(line + "\r\n")
+        answer = line == "ok" or line.startswith("error:")
+        self._send(line + "\r\n", answer=answer)
+        if line == "ok":
+            self._last_ok = self._out_free
 
     def _reader_loop(self) -> None:
-        byte_time = 10.0 / self.options.baud / self.scale
-        pending = bytearray()
-        wire_t = 0.0
+        partial = bytearray()
+        pipelined, known = False, 0.0
         while not self._stopping and self._fd is not None:
-            now = time.monotonic()
-            if pending:
-                wait = max(0.0003, min(wire_t + byte_time * min(len(pending), 16) - now, 0.05))
-            else:
-                wait = 0.05
             fd = self._fd
             if fd is None:
                 return
             try:
-                ready, _, _ = select.select([fd], [], [], wait)
+                ready, _, _ = select.select([fd], [], [], 0.05)
             except (OSError, ValueError, TypeError):
                 return
-            if ready:
-                try:
-                    data = os.read(fd, 4096)
-                except BlockingIOError:
-                    data = b""
-                except (TypeError, ValueError):
-                    return
-                except OSError as error:
-                    if error.errno == errno.EIO:  # no host has the port open
-                        time.sleep(0.01)
-                        continue
-                    return
-                if data:
-                    if not pending:  # a new burst: the USB adapter delivers it after its latency
-                        wire_t = max(wire_t, time.monotonic() + self.options.usb_latency / self.scale)
-                    pending += data
-            if pending:
-                now = time.monotonic()
-                count = min(len(pending), int((now - wire_t) / byte_time))
-                if count > 0:
-                    chunk = bytes(pending[:count])
-                    del pending[:count]
-                    wire_t += count * byte_time
-                    self._deliver(chunk, now)
-
-    def _deliver(self, chunk: bytes, now: float) -> None:
-        with self._cond:
-            notify = False
-            for byte in chunk:
-                if byte in (0x18, 0x3F, 0x7E, 0x21) or byte >= 0x80:
-                    self._realtime(byte)
+            if not ready:
+                continue
+            try:
+                data = os.read(fd, 4096)
+            except BlockingIOError:
+                continue
+            except (TypeError, ValueError):
+                return
+            except OSError as error:
+                if error.errno == errno.EIO:  # no host has the port open
+                    time.sleep(0.01)
                     continue
-                if now < self._eeprom_until:
-                    self.eeprom_lost += 1  # interrupts are off while EEPROM is written
-                elif len(self.rx) >= self.options.rx_buffer:
-                    self.rx_overflow += 1  # the firmware drops the byte silently
-                else:
-                    self.rx.append(byte)
+                return
+            with self._cond:
+                self._sync_to_wall("line")  # an idle machine's clock runs with wall time
+                lines = 0
+                for byte in data:
+                    if byte in (0x18, 0x3F, 0x7E, 0x21) or byte >= 0x80:
+                        self._sync_to_wall("query" if byte == 0x3F else "control")
+                        self._realtime(byte)
+                        continue
+                    if not partial:  # what the host knew when it began this line
+                        pipelined = self._rx_cum > self._acked_written
+                        known = self._written_due
+                    partial.append(byte)
                     if byte in (0x0A, 0x0D):
-                        notify = True
-            self.max_rx = max(self.max_rx, len(self.rx))
-            if notify:
-                self._cond.notify_all()
+                        self._line_from_host(bytes(partial), pipelined, known)
+                        partial.clear()
+                        lines += 1
+                if lines:
+                    self._wake_all()
 
     def _unplug(self) -> None:
         """The USB cable is pulled: the board loses power (beam off) and the port vanishes."""
@@ -173,6 +165,6 @@ class EmulatorTransport:
             self.spindle_history.append(("M5", 0.0))
             self.disconnected = True
             self._stopping = True
-            self._cond.notify_all()
+            self._wake_all()
         with self._write_lock:
             self._close_fds()

@@ -8,7 +8,8 @@ Two bounds, both modelled:
   (2 ms for an ATmega328). A line is parsed once its last byte arrived and the previous
   line is done; it needs a free planner block (one of `planner_blocks`) for each move,
   and its `ok` frees its bytes in the sender's count. Blocks run in order, each as soon
-  as it is planned and the previous one has finished.
+  as it is planned and the previous one has finished, planned with the look-ahead of
+  the blocks in the planner by then (a starved planner slows the machine down).
 Dense jobs of very short moves (0.05-0.1 mm at high feed) are bound by the link and the
 parser; everything else by the planner. `JobTime.bound` says which.
 
@@ -18,6 +19,8 @@ profile)` -> `JobTime` (with per-line and per-block seconds for progress and pla
 
 from __future__ import annotations
 
+import bisect
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -26,6 +29,7 @@ import numpy as np
 from machines.gcode_program import GcodeMoves, Program, ProgramStats, analyze_program, program_from_lines
 from machines.grbl_settings import settings_from_profile
 from machines.laser_profile import LaserProfile
+from machines.planner_model import Kinematics, block_table, trapezoid, window_limits
 
 # A USB-serial adapter delivers a burst about half a millisecond after it was written
 # (about 1 ms for a round trip, grbl.md); the emulator uses the same figure.
@@ -74,10 +78,14 @@ class JobTime:
         return "bound by GRBL's planner"
 
 
-def link_schedule(program: Program, stats: ProgramStats, *, baud: int, rx_buffer: int, parse_time: float,
-                  planner_blocks: int, latency: float = USB_LATENCY) -> tuple[np.ndarray, np.ndarray]:
+def link_schedule(program: Program, stats: ProgramStats, kin: Kinematics, *, baud: int, rx_buffer: int,
+                  parse_time: float, latency: float = USB_LATENCY) -> tuple[np.ndarray, np.ndarray]:
     """When each line is acknowledged and each block ends, streamed by character counting.
 
+    Two interleaved passes: the parser side (each line's arrival over the wire, its parse,
+    a free planner block for each of its moves) and the motion side (each block runs when
+    the previous one ended and it is planned, with the look-ahead of the blocks planned
+    by then: a starved planner must be able to stop after its last block, as GRBL's).
     Returns (ack (len(program),), block_end (B,)) in seconds from the first byte sent.
     """
     byte_time = BITS_PER_BYTE / float(baud)
@@ -91,42 +99,83 @@ def link_schedule(program: Program, stats: ProgramStats, *, baud: int, rx_buffer
     # answers come in order, so waiting for the newest of them is waiting for all)
     head = np.minimum(np.searchsorted(total, total[1:] - rx_buffer, side="left"), np.arange(n)).tolist()
     wire = (sizes * byte_time).tolist()
-    moving = np.flatnonzero(seg.seconds > 0)
+    table = block_table(seg.start, seg.end, seg.feed, seg.rapid, seg.stop_before, kin)
+    moving = np.flatnonzero(table.keep)
     lines_of = seg.index[moving]
     first = np.searchsorted(lines_of, np.arange(n), side="left").tolist()
     last = np.searchsorted(lines_of, np.arange(n), side="right").tolist()
-    duration = seg.seconds[moving].tolist()
     syncs, dwell = stats.syncs.tolist(), stats.dwell.tolist()
-    ends = [0.0] * len(moving)  # end time of each block, in order
+    blocks = len(moving)
+    window = kin.planner_blocks
+    planned = [math.inf] * blocks  # when each block entered the planner
+    ends = [0.0] * blocks  # when each block finished moving
     ack = [0.0] * n
-    wire_free = 0.0  # when the host's last byte has arrived at the controller
-    parser_free = 0.0
-    last_end = 0.0
-    for i in range(n):
-        h = head[i]
-        send = ack[h - 1] if h else 0.0
-        # (comparisons instead of max(): the same values, this loop runs once per line)
-        arrived = send + latency
-        if arrived < wire_free:
-            arrived = wire_free
-        arrived += wire[i]
-        wire_free = arrived
-        done = (arrived if arrived >= parser_free else parser_free) + parse_time
-        if syncs[i]:  # M3/M4/M5, M8/M9, G4, S without motion: the planner drains first
-            done = max(done, last_end) + dwell[i]
-            last_end = done
-        for b in range(first[i], last[i]):
-            if b >= planner_blocks:  # a free planner block: the one 15 back has run
-                free = ends[b - planner_blocks]
-                if free > done:
-                    done = free
-            last_end = (last_end if last_end >= done else done) + duration[b]
-            ends[b] = last_end
-        parser_free = done
-        ack[i] = done + ok_time
+    done_blocks = [0]  # how many blocks have their end time
+
+    def parser_side():
+        # yields whenever it needs the end of a block the motion side has not reached
+        wire_free = 0.0  # when the host's last byte has arrived at the controller
+        parser_free = 0.0
+        for i in range(n):
+            h = head[i]
+            send = ack[h - 1] if h else 0.0
+            # (comparisons instead of max(): the same values, this loop runs once per line)
+            arrived = send + latency
+            if arrived < wire_free:
+                arrived = wire_free
+            arrived += wire[i]
+            wire_free = arrived
+            done = (arrived if arrived >= parser_free else parser_free) + parse_time
+            if syncs[i]:  # M3/M4/M5, M8/M9, G4, S without motion: the planner drains first
+                while done_blocks[0] < first[i]:
+                    yield
+                done = max(done, ends[first[i] - 1] if first[i] else 0.0) + dwell[i]
+            for b in range(first[i], last[i]):
+                if b >= window:  # a free planner block: the one `window` back has run
+                    while done_blocks[0] <= b - window:
+                        yield
+                    if ends[b - window] > done:
+                        done = ends[b - window]
+                planned[b] = done
+            parser_free = done
+            ack[i] = done + ok_time
+
+    parser = parser_side()
+    length, accel, nominal = table.length.tolist(), table.accel.tolist(), table.nominal.tolist()
+    max_entry, reach = table.max_entry.tolist(), table.reach.tolist()
+    full = window_limits(table, window).tolist()  # exit limits with a full planner
+    v, previous_end = 0.0, 0.0
+    for b in range(blocks):
+        next(parser, None)  # plans every block it can before block b ends
+        start = max(previous_end, planned[b])
+        if planned[b] > previous_end or max_entry[b] == 0.0:
+            v = 0.0  # the planner ran dry (or a forced stop): from rest
+        top = min(b + window, blocks)
+        if planned[top - 1] <= start:  # the whole look-ahead is planned: the batch's limit
+            profile = trapezoid(v, math.sqrt(full[b]), nominal[b], accel[b], length[b])
+        else:
+            seen = bisect.bisect_right(planned, start, b, top)
+            profile = _block_profile(b, seen, v, length, accel, nominal, max_entry, reach)
+            more = bisect.bisect_right(planned, start + profile.duration, b, top)
+            if more > seen:  # blocks planned while this one runs raise its exit speed (GRBL re-plans)
+                profile = _block_profile(b, more, v, length, accel, nominal, max_entry, reach)
+        previous_end = ends[b] = start + profile.duration
+        v = profile.v_exit
+        done_blocks[0] = b + 1
+    for _ in parser:  # lines after the last block (and any left if there are no blocks)
+        pass
     block_end = np.zeros(len(seg))
     block_end[moving] = ends
     return np.array(ack), block_end
+
+
+def _block_profile(b: int, seen: int, v0: float, length, accel, nominal, max_entry, reach):
+    """Trapezoid of block b entered at v0, with blocks b..seen-1 in the planner (the last
+    of them must be able to stop)."""
+    limit = 0.0
+    for k in range(seen - 1, b, -1):
+        limit = min(max_entry[k], limit + reach[k])
+    return trapezoid(v0, math.sqrt(limit), nominal[b], accel[b], length[b])
 
 
 def estimate_program_time(program: Program, profile: LaserProfile, *, stats: ProgramStats | None = None,
@@ -144,8 +193,9 @@ def estimate_program_time(program: Program, profile: LaserProfile, *, stats: Pro
     planner = stats.total_seconds
     n_lines = max(program.n_lines, max((n for n, _ in program.lines), default=0))
     if link and len(program):
-        ack, block_end = link_schedule(program, stats, baud=profile.baud, rx_buffer=profile.rx_buffer,
-                                       parse_time=profile.parse_time, planner_blocks=profile.planner_blocks)
+        kin = Kinematics.from_settings(settings_from_profile(profile), planner_blocks=profile.planner_blocks)
+        ack, block_end = link_schedule(program, stats, kin, baud=profile.baud, rx_buffer=profile.rx_buffer,
+                                       parse_time=profile.parse_time)
         link_total = float(ack[-1])
         total = max(float(block_end.max()) if len(block_end) else 0.0, link_total, planner)
         line_done = np.maximum(ack, np.maximum.accumulate(_line_ends(stats, block_end, len(program))))

@@ -216,22 +216,35 @@ def _axis_limit(limits: np.ndarray, unit: np.ndarray) -> np.ndarray:
     return ratio.min(axis=1)
 
 
-def plan_times(start: np.ndarray, end: np.ndarray, feed: np.ndarray, rapid: np.ndarray,
-               stop_before: np.ndarray, kin: Kinematics) -> np.ndarray:
-    """Batch driver: seconds of each straight move when the planner is never starved.
+@dataclass(frozen=True)
+class BlockTable:
+    """The planner blocks of a program as arrays, for the batch drivers.
 
-    start, end (B, D) mm with D <= 3 axes (X, Y[, Z]); feed (B,) mm/min (NaN: undefined);
-    rapid (B,) G0; stop_before (B,) the planner drains before the move (forced stop).
-    Same rules as the incremental driver (`BlockBuilder`, `exit_speed`, `trapezoid`):
-    each block may leave at most at the speed from which the next planner_blocks - 1
-    blocks can still brake to rest; it enters at the speed the previous one left with.
-    Returns (B,) seconds (0 for moves of zero steps).
+    keep (M,) bool: the move makes a block (not zero steps); for the B kept ones, in
+    order: length mm, accel mm/s^2, nominal mm/s, max_entry (mm/s)^2 (junction and
+    nominal limits, 0 after a forced stop) and reach = 2 * accel * length ((mm/s)^2).
+    """
+
+    keep: np.ndarray
+    length: np.ndarray
+    accel: np.ndarray
+    nominal: np.ndarray
+    max_entry: np.ndarray
+    reach: np.ndarray
+
+
+def block_table(start: np.ndarray, end: np.ndarray, feed: np.ndarray, rapid: np.ndarray,
+                stop_before: np.ndarray, kin: Kinematics) -> BlockTable:
+    """GRBL's planner blocks (planner.c plan_buffer_line) for straight moves at once.
+
+    start, end (M, D) mm with D <= 3 axes (X, Y[, Z]); feed (M,) mm/min (NaN: undefined);
+    rapid (M,) G0; stop_before (M,) the planner drains before the move (forced stop).
     """
     start, end = np.asarray(start, dtype=float), np.asarray(end, dtype=float)
-    dims = start.shape[1] if start.ndim == 2 else 2
-    out = np.zeros(len(start))
     if not len(start):
-        return out
+        empty = np.zeros(0)
+        return BlockTable(np.zeros(0, dtype=bool), empty, empty, empty, empty, empty)
+    dims = start.shape[1] if start.ndim == 2 else 2
     steps = np.asarray(kin.steps_per_mm[:dims], dtype=float)
     s1 = lround(end * steps)
     s0 = np.vstack([lround(start[:1] * steps), s1[:-1]])  # each block starts where the last ended
@@ -239,7 +252,8 @@ def plan_times(start: np.ndarray, end: np.ndarray, feed: np.ndarray, rapid: np.n
     length_all = np.sqrt((delta * delta).sum(axis=1))
     keep = length_all > 0
     if not keep.any():
-        return out
+        empty = np.zeros(0)
+        return BlockTable(keep, empty, empty, empty, empty, empty)
     # a stop before a dropped block still happens before the next kept one
     stop_cum = np.cumsum(stop_before)
     idx = np.flatnonzero(keep)
@@ -267,28 +281,51 @@ def plan_times(start: np.ndarray, end: np.ndarray, feed: np.ndarray, rapid: np.n
     prev_nominal = np.concatenate([[0.0], nominal[:-1]])
     max_entry = np.minimum(vj2, np.minimum(nominal, prev_nominal) ** 2)
     max_entry[stop] = 0.0
-    b = len(length)
-    reach = 2.0 * accel * length  # v^2 gained or lost over a block
-    window = kin.planner_blocks
-    pad_entry = np.concatenate([max_entry, np.zeros(window)])
-    pad_reach = np.concatenate([reach, np.zeros(window)])
+    return BlockTable(keep, length, accel, nominal, max_entry, 2.0 * accel * length)
+
+
+def window_limits(table: BlockTable, window: int) -> np.ndarray:
+    """(B,) the squared exit speed each block may have with `window` blocks in the planner
+    (itself and the next window - 1, the last of which must be able to stop): the backward
+    pass of every look-ahead window at once."""
+    b = len(table.length)
+    pad_entry = np.concatenate([table.max_entry, np.zeros(window)])
+    pad_reach = np.concatenate([table.reach, np.zeros(window)])
     j = np.arange(b)
-    # backward pass of every look-ahead window at once: block j+window-1 exits at 0
     limit = np.zeros(b)
     for d in range(window - 1, 0, -1):
         k = j + d
         limit = np.minimum(pad_entry[k], limit + pad_reach[k])
+    return limit
+
+
+def plan_times(start: np.ndarray, end: np.ndarray, feed: np.ndarray, rapid: np.ndarray,
+               stop_before: np.ndarray, kin: Kinematics) -> np.ndarray:
+    """Batch driver: seconds of each straight move when the planner is never starved.
+
+    Arguments as `block_table`. Same rules as the incremental driver (`BlockBuilder`,
+    `exit_speed`, `trapezoid`): each block may leave at most at the speed from which the
+    next planner_blocks - 1 blocks can still brake to rest; it enters at the speed the
+    previous one left with. Returns (M,) seconds (0 for moves of zero steps).
+    """
+    table = block_table(start, end, feed, rapid, stop_before, kin)
+    out = np.zeros(len(table.keep))
+    if not len(table.length):
+        return out
+    length, accel, nominal, max_entry, reach = (table.length, table.accel, table.nominal, table.max_entry,
+                                                table.reach)
+    limit = window_limits(table, kin.planner_blocks)
     # forward pass e_j = min(limit_j, e_{j-1} + reach_j), e_{-1} = 0, in closed form
     cum = np.cumsum(reach)
     exit_sq = np.maximum(cum + np.minimum(0.0, np.minimum.accumulate(limit - cum)), 0.0)
     exit_sq = np.minimum(exit_sq, limit)
     entry_sq = np.concatenate([[0.0], exit_sq[:-1]])
-    entry_sq[stop] = 0.0
+    entry_sq[max_entry == 0.0] = 0.0
     # trapezoid (or triangle) per block
     peak_sq = np.minimum(nominal ** 2, (reach + entry_sq + exit_sq) / 2.0)
     peak_sq = np.maximum(peak_sq, np.maximum(entry_sq, exit_sq))
     v0, v1, vp = np.sqrt(entry_sq), np.sqrt(exit_sq), np.sqrt(peak_sq)
     ramp = (peak_sq - entry_sq) / (2 * accel) + (peak_sq - exit_sq) / (2 * accel)
     cruise = np.maximum(length - ramp, 0.0)
-    out[keep] = (vp - v0) / accel + (vp - v1) / accel + cruise / vp
+    out[table.keep] = (vp - v0) / accel + (vp - v1) / accel + cruise / vp
     return out

@@ -82,16 +82,23 @@ def test_a_vectorize_run_never_imports_torch(tmp_path):
     assert result.stdout.strip() == "ok"
 
 
-def test_training_smoke_run(tmp_path):
+def test_training_smoke_run(tmp_path, monkeypatch):
+    """Also issue 14 item 7: without --out the model goes to ./crossing_cnn.onnx (+ .json,
+    .md) in the current folder, and the shipped model is not touched."""
     pytest.importorskip("torch")
     from click.testing import CliRunner
 
     from fabrication.cli import main
+    from vectorize.cnn_classifier import DEFAULT_MODEL
 
-    out = tmp_path / "tiny.onnx"
+    shipped = DEFAULT_MODEL.read_bytes()
+    monkeypatch.chdir(tmp_path)
     result = CliRunner().invoke(main, ["train-classifier", "--seed", "3", "--samples", "256", "--epochs", "1",
-                                       "--batch", "64", "--validation", "128", "--workers", "1", "--out", str(out)])
+                                       "--batch", "64", "--validation", "128", "--workers", "1"])
     assert result.exit_code == 0, result.output
+    out = tmp_path / "crossing_cnn.onnx"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["crossing_cnn.json", "crossing_cnn.md", "crossing_cnn.onnx"]
+    assert DEFAULT_MODEL.read_bytes() == shipped
     assert json.loads(result.stdout)["n"] == 128
     meta = json.loads(out.with_suffix(".json").read_text())
     assert meta["sha256"] == hashlib.sha256(out.read_bytes()).hexdigest()

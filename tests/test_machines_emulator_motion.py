@@ -60,14 +60,23 @@ def test_planner_limited_time_is_the_estimate_s_planner_time(link):
     assert grbl.emu.stats().planner_limited_time == pytest.approx(stats.total_seconds, rel=1e-9)
 
 
+def status_x(grbl):
+    """X of the machine position in a status report (`?`)."""
+    return float(grbl.send(b"?", until=lambda l: l.startswith("<"))[-1].split("MPos:")[1].split(",")[0])
+
+
 def test_feed_hold_stops_inside_the_block_and_resumes(link):
     grbl = link(time_scale=5.0)
     grbl.port.write(b"G21G90\nM4S500\nG1X200F3000\n")
     assert grbl.emu.wait_until(lambda: grbl.emu.state == "Run", timeout=10)
+    # moving (the clock starts the block once it is sure no line from us comes first)
+    deadline = time.monotonic() + 10
+    while status_x(grbl) < 1.0 and time.monotonic() < deadline:
+        time.sleep(0.01)
     grbl.port.write(b"!")
     assert grbl.emu.wait_until(lambda: grbl.emu.state == "Hold:0", timeout=10)
     held = grbl.emu.stats()
-    x = float(grbl.send(b"?", until=lambda l: l.startswith("<"))[-1].split("MPos:")[1].split(",")[0])
+    x = status_x(grbl)
     assert 0 < x < 200 and held.blocks_executed == 0
     grbl.port.write(b"~")
     assert grbl.emu.wait_idle(30) and grbl.emu.stats().blocks_executed == 1

@@ -172,3 +172,51 @@ def test_multi_stroke_mode_and_a_bad_threshold(client):
     assert multi["edits"]["multi"] is True
     answer = client.post("/api/state", json={"edits": dict(edits, threshold=1.5)})
     assert answer.status_code == 400 and "threshold" in answer.json()["error"]
+
+
+def test_a_queued_state_request_gives_way_to_the_same_pages_newer_one(drawing):
+    """A slider dragged over values while a re-run takes a second: the requests that wait
+    for the vectorizer are skipped once the page asked for a newer state."""
+    import threading
+
+    session = StudioSession(drawing)
+    app = create_app(session, token=TOKEN, hosts={HOST})
+    with TestClient(app, base_url=f"http://{HOST}", headers={"X-Studio-Token": TOKEN}) as test_client:
+        edits = test_client.get("/api/state").json()["edits"]
+        answers = {}
+
+        def post(threshold, page="p1"):
+            answers[threshold, page] = test_client.post(
+                "/api/state", json={"edits": dict(edits, threshold=threshold), "page": page}).json()
+
+        def queued(count):
+            deadline = time.monotonic() + 10
+            while sum(session._tickets.values()) < count and time.monotonic() < deadline:
+                time.sleep(0.01)
+
+        threads = []
+        with session.lock:  # a re-run in progress: the next requests queue behind it
+            for n, (threshold, page) in enumerate([(0.42, "p1"), (0.43, "p2"), (0.44, "p1")], start=1):
+                threads.append(threading.Thread(target=post, args=(threshold, page)))
+                threads[-1].start()
+                queued(n)
+        for thread in threads:
+            thread.join(30)
+        assert answers[0.42, "p1"] == {"superseded": True}
+        assert answers[0.44, "p1"]["settings"]["threshold"] == 0.44
+        assert answers[0.43, "p2"]["settings"]["threshold"] == 0.43  # another page's request is its own
+
+
+def test_abort_while_connecting(client):
+    """Abort pressed before the controller has answered: no line is streamed."""
+    state = client.get("/api/state").json()
+    started = client.post("/api/send", json={"edits": state["edits"], "options": {"size": "20mm"},
+                                             "port": "sim://?speed=2"})
+    assert started.status_code == 200 and started.json()["state"] == "connecting", started.text
+    assert client.post("/api/send/abort").json()["state"] == "aborting"
+    deadline = time.monotonic() + 20
+    status = client.get("/api/send").json()
+    while status["state"] in ("connecting", "streaming", "aborting") and time.monotonic() < deadline:
+        time.sleep(0.05)
+        status = client.get("/api/send").json()
+    assert status["state"] == "aborted" and status["acked"] < status["total"], status

@@ -1,12 +1,14 @@
-"""The studio page in a real browser (Playwright driving Debian's Chromium): load, see the
-curve, click a junction and see the order change, move the threshold, undo, play, export
-.pes and G-code and compare their bytes with the CLI's for the same edits. Screenshots go
-to test-artifacts/ (kept by CI as artifacts of the run)."""
+"""The studio's refinement as a user clicks it, in a real browser (Playwright driving
+Debian's Chromium): the curve on the page, a junction clicked through its three pairings,
+undo/redo by button and keyboard, play and the scrubber, the threshold and blur sliders
+dragged with the mouse (busy state shown, the latest value wins), multi-stroke, split,
+merge, start, reverse, and the edits file saved, loaded and opened. Exports and "send to
+laser": test_studio_browser_make.py, test_studio_browser_send.py. Screenshots go to
+test-artifacts/ (kept by CI as artifacts of the run)."""
 
 from __future__ import annotations
 
 import json
-import shutil
 from pathlib import Path
 
 import pytest
@@ -14,196 +16,256 @@ from click.testing import CliRunner
 
 from conftest import ARTIFACTS
 from fabrication.cli import main
-from fabrication.studio.server import StudioServer
-from fabrication.studio.session import StudioSession
-
-ROOT = Path(__file__).resolve().parents[1]
+from studio_fixtures import (IDLE, click_at, coloured_pixels, download, drag_slider, page, settle,  # noqa: F401
+                             studio)
 
 pytestmark = pytest.mark.slow
 
-
-@pytest.fixture(scope="module")
-def studio(tmp_path_factory):
-    folder = tmp_path_factory.mktemp("studio-browser")
-    drawing = folder / "loops.png"
-    shutil.copy(ROOT / "examples" / "loops.png", drawing)
-    server = StudioServer(StudioSession(drawing), port=0).start()
-    yield server, drawing
-    server.stop()
+STATE = "window.studio.state"
 
 
-@pytest.fixture(scope="module")
-def page(studio, browser):
-    context = browser.new_context(viewport={"width": 1280, "height": 760}, accept_downloads=True)
-    page = context.new_page()
-    page.set_default_timeout(20000)
-    errors = []
-    page.on("pageerror", lambda error: errors.append(str(error)))
-    page.goto(studio[0].url)
-    page.wait_for_function("window.studio.state !== null && document.body.classList.contains('busy') === false")
-    yield page
-    context.close()
-    assert not errors, errors
+def junction_near(page, at):
+    return page.evaluate(f"""{STATE}.graph.junctions.filter(j => j.role === 'crossing').reduce((best, j) =>
+        Math.hypot(j.at[0] - {at[0]}, j.at[1] - {at[1]}) < Math.hypot(best.at[0] - {at[0]}, best.at[1] - {at[1]})
+        ? j : best)""")
 
 
-def coloured_pixels(page) -> int:
-    """Strongly coloured pixels on the drawing canvas: the curve (the raster is drawn grey)."""
-    return page.evaluate("""() => {
-        const c = document.getElementById('canvas');
-        const d = c.getContext('2d').getImageData(0, 0, c.width, c.height).data;
-        let n = 0;
-        for (let i = 0; i < d.length; i += 4) {
-            const mx = Math.max(d[i], d[i + 1], d[i + 2]), mn = Math.min(d[i], d[i + 1], d[i + 2]);
-            if (mx - mn > 80) n++;
-        }
-        return n;
-    }""")
+def order(page):
+    return page.evaluate(f"{STATE}.strokes.map(s => s.points)")
 
 
-def settle(page, edits_count=None) -> None:
-    condition = "!document.body.classList.contains('busy')"
-    if edits_count is not None:
-        condition += f" && window.studio.state.edits.edits.length === {edits_count}"
-    page.wait_for_function(condition)
-
-
-def cli_bytes(command: str, drawing: Path, edits: dict, tmp_path: Path, suffix: str, *flags) -> bytes:
-    (tmp_path / "edits.json").write_text(json.dumps(edits))
-    out = tmp_path / f"cli{suffix}"
-    run = CliRunner().invoke(main, [command, str(drawing), "--edits", str(tmp_path / "edits.json"),
-                                    "-o", str(out), *flags])
-    assert run.exit_code == 0, run.output
-    return out.read_bytes()
-
-
-def test_page_refine_play_and_export(page, studio, tmp_path):
-    _, drawing = studio
+def test_click_a_junction_through_its_pairings_undo_redo_and_play(page):
     page.screenshot(path=str(ARTIFACTS / "studio-1-loaded.png"))
     assert coloured_pixels(page) > 3000  # the curve, coloured start to end, is on the canvas
     assert "1 stroke, 3 crossings" in page.inner_text("#summary")
+    count = page.evaluate(f"{STATE}.edits.edits.length")
 
-    # Click a junction: its pairing cycles and the drawing order changes.
-    before = page.evaluate("window.studio.state.strokes.map(s => s.points)")
-    junction = page.evaluate("window.studio.state.graph.junctions.find(j => j.role === 'crossing')")
-    x, y = page.evaluate(f"window.studio.toScreen({junction['at'][0]}, {junction['at'][1]})")
-    page.mouse.click(x, y)
-    settle(page, 1)
-    after = page.evaluate("window.studio.state.graph.junctions.find(j => j.role === 'crossing' && j.fixed)")
-    assert after is not None and after["decision"] != junction["decision"]
-    assert page.evaluate("window.studio.state.strokes.map(s => s.points)") != before
-    assert "fixed by you" in page.inner_text("#junctions")
-    page.screenshot(path=str(ARTIFACTS / "studio-2-junction-clicked.png"))
+    # Each click on a junction moves it to the next pairing (crossing -> touching -> third
+    # -> crossing), re-runs traversal and fitting and changes the drawing order.
+    start = page.evaluate(f"{STATE}.graph.junctions.find(j => j.role === 'crossing')")
+    seen, orders = [start["decision"]], [order(page)]
+    for click in range(3):
+        click_at(page, start["at"])
+        settle(page, count + 1)  # the click set the busy state at once: this waits for its answer
+        junction = junction_near(page, start["at"])
+        assert junction["fixed"] and "fixed by you" in page.inner_text("#junctions")
+        seen.append(junction["decision"])
+        orders.append(order(page))
+        if click == 0:
+            page.screenshot(path=str(ARTIFACTS / "studio-2-junction-clicked.png"))
+    assert sorted(seen[:3]) == ["crossing", "third", "touching"] and seen[3] == seen[0], seen
+    assert orders[1] != orders[0] and orders[2] != orders[1]
+    assert len(page.evaluate(f"{STATE}.edits.edits")) == count + 1  # one pairing per junction, replaced
 
-    # The threshold slider re-runs from binarization; undo goes back to the automatic one.
-    page.eval_on_selector("#auto-threshold", "e => { e.checked = false; }")
-    page.eval_on_selector("#threshold", "e => { e.value = 0.3; e.dispatchEvent(new Event('change')); }")
-    page.wait_for_function("window.studio.state.settings.threshold === 0.3 && !document.body.classList.contains('busy')")
-    assert page.inner_text("#threshold-value") == "0.30"
+    # Undo and redo, by the buttons and by Ctrl+Z / Ctrl+Y.
     page.click("#undo")
-    page.wait_for_function("window.studio.state.settings.threshold === null && !document.body.classList.contains('busy')")
+    page.wait_for_function(f"window.studio.at === 2 && {IDLE}")
+    assert junction_near(page, start["at"])["decision"] == seen[2] and order(page) == orders[2]
+    page.keyboard.press("Control+z")
+    page.wait_for_function(f"window.studio.at === 1 && {IDLE}")
+    assert junction_near(page, start["at"])["decision"] == seen[1] and order(page) == orders[1]
+    page.keyboard.press("Control+y")
+    page.wait_for_function(f"window.studio.at === 2 && {IDLE}")
     page.click("#redo")
-    page.wait_for_function("window.studio.state.settings.threshold === 0.3 && !document.body.classList.contains('busy')")
+    page.wait_for_function(f"window.studio.at === 3 && {IDLE}")
+    assert junction_near(page, start["at"])["decision"] == seen[3] and page.is_disabled("#redo")
     page.click("#undo")
-    page.wait_for_function("window.studio.state.settings.threshold === null && !document.body.classList.contains('busy')")
-    assert page.evaluate("window.studio.state.edits.edits.length") == 1
+    page.click("#undo")  # back to the first click's pairing: the later tests start from it
+    page.wait_for_function(f"window.studio.at === 1 && {IDLE}")
 
-    # Play: the pen moves along the curve; part of the curve is drawn, the rest is grey.
+    # Play: the pen moves along the curve; the part behind it is coloured, the rest grey.
     full = coloured_pixels(page)
     page.click("#play")
     page.wait_for_function("window.studio.pen > 0.2 && window.studio.pen < 0.8", polling=50)
     page.click("#play")  # pause
     pen = page.evaluate("window.studio.pen")
     assert 0.2 < pen < 0.8 and coloured_pixels(page) < full
+    assert "/" in page.inner_text("#where")
     page.screenshot(path=str(ARTIFACTS / "studio-3-playing.png"))
-    page.eval_on_selector("#scrub", "e => { e.value = 1000; e.dispatchEvent(new Event('input')); }")
+    # The scrubber, dragged with the mouse, puts the pen where it is let go.
+    drag_slider(page, "#scrub", 0.25)
+    assert abs(page.evaluate("window.studio.pen") - 0.25) < 0.03
+    quarter = coloured_pixels(page)
+    assert quarter < full * 0.45
+    drag_slider(page, "#scrub", 1.0)
+    assert page.evaluate("window.studio.pen") == 1 and coloured_pixels(page) == full
 
-    # Exports: the same bytes as the CLI for the same edits and options.
-    edits = page.evaluate("window.studio.history[window.studio.at]")
-    page.click("nav .tab[data-tab=embroidery]")
-    page.select_option("#embroidery-form select[name=style]", "zigzag")
+
+def test_sliders_dragged_show_busy_and_the_latest_value_wins(page):
+    at = page.evaluate("window.studio.at")
+    # Threshold: dragging it leaves the automatic threshold and re-runs from binarization,
+    # with a visible busy state until the answer is drawn.
+    drag_slider(page, "#threshold", 0.45)
+    value = float(page.eval_on_selector("#threshold", "e => e.value"))
+    assert page.is_visible("#rerun") and page.is_visible("#busy") and not page.is_checked("#auto-threshold")
+    page.screenshot(path=str(ARTIFACTS / "studio-4-threshold-busy.png"))
+    settle(page, extra=f"{STATE}.settings.threshold === {value}")
+    assert not page.is_visible("#rerun") and page.inner_text("#threshold-value") == f"{value:.2f}"
+    assert page.evaluate("window.studio.at") == at + 1
+
+    # Latest value wins: rest on one value long enough for its re-run to start, move on and
+    # let go at another while it runs. The earlier answer is dropped; the page ends on the
+    # value the slider shows, with one new step in the history.
+    box = page.locator("#threshold").bounding_box()
+    y = box["y"] + box["height"] / 2
+    x_of = lambda f: box["x"] + 8 + f * (box["width"] - 16)  # noqa: E731 - as drag_slider
+    page.mouse.move(x_of((value - 0.05) / 0.9), y)
+    page.mouse.down()
+    page.mouse.move(x_of(0.25), y, steps=4)
+    page.wait_for_function("document.body.classList.contains('busy')")  # its preview re-run started
+    resting = page.inner_text("#threshold-value")
+    # From here on, every threshold the page draws is recorded.
+    page.evaluate("""() => { window.drawn = [];
+        new MutationObserver(() => window.drawn.push(document.getElementById('summary').textContent + ' @ ' +
+            window.studio.state.settings.threshold)).observe(document.getElementById('summary'),
+            {childList: true, characterData: true, subtree: true}); }""")
+    page.mouse.move(x_of(0.6), y, steps=4)
+    page.mouse.up()
+    final = float(page.eval_on_selector("#threshold", "e => e.value"))
+    assert abs(final - 0.59) < 0.011
     settle(page)
-    page.wait_for_function("document.getElementById('embroidery-stats').textContent.includes('stitches')")
-    # The stitches play in the project's player: press its play, the stitch number moves.
-    page.click("#embroidery-player [data-role=play]")
-    page.wait_for_timeout(600)
-    page.click("#embroidery-player [data-role=play]")
-    assert page.inner_text("#embroidery-player [data-role=number]").strip() not in ("", "0")
-    page.screenshot(path=str(ARTIFACTS / "studio-4-embroidery.png"))
-    with page.expect_download() as download:
-        page.click("[data-export=pes]")
-    pes = Path(download.value.path()).read_bytes()
-    assert download.value.suggested_filename == "loops.pes"
-    assert pes == cli_bytes("embroider", drawing, edits, tmp_path, ".pes", "--style", "zigzag", "--size", "90mm",
-                            "--color", "#1f3a93")
-    page.click("nav .tab[data-tab=laser]")
-    settle(page)
-    page.wait_for_function("document.getElementById('laser-time').textContent.includes('estimated')")
-    page.screenshot(path=str(ARTIFACTS / "studio-5-laser.png"))
-    with page.expect_download() as download:
-        page.click("[data-export=gcode]")
-    gcode = Path(download.value.path()).read_bytes()
-    assert gcode == cli_bytes("laser", drawing, edits, tmp_path, ".gcode", "--size", "80mm", "--feed", "1500mm/min",
-                              "--power", "60%", "--passes", "1")
+    drawn = page.evaluate("window.drawn")
+    assert drawn and all(text.endswith(f"@ {final}") for text in drawn), (resting, drawn)  # never the old value
+    assert page.evaluate(f"{STATE}.settings.threshold") == final
+    assert page.evaluate(f"{STATE}.edits.threshold") == final
+    assert page.inner_text("#threshold-value") == f"{final:.2f}"
+    assert float(page.eval_on_selector("#threshold", "e => e.value")) == final
+    assert page.evaluate("window.studio.at") == at + 2
 
-    # Save: the edits file beside the drawing replays to the page's SVG.
-    page.click("nav .tab[data-tab=refine]")
-    page.click("#save")
-    saved = drawing.with_suffix(".edits.json")
-    page.wait_for_function("document.getElementById('summary').textContent.includes('saved')")
-    with page.expect_download() as download:
-        page.click("[data-export=svg]")
-    svg = Path(download.value.path()).read_bytes()
-    run = CliRunner().invoke(main, ["vectorize", str(drawing), "--edits", str(saved), "-o", str(tmp_path / "r.svg")])
-    assert run.exit_code == 0, run.output
-    assert svg == (tmp_path / "r.svg").read_bytes()
+    # Back to the automatic threshold; blur by dragging; multi-stroke by its checkbox.
+    page.click("#auto-threshold")
+    settle(page, extra=f"{STATE}.settings.threshold === null")
+    assert page.inner_text("#threshold-value") == "auto"
+    drag_slider(page, "#blur", 0.25)
+    assert page.is_visible("#rerun")
+    settle(page, extra=f"{STATE}.settings.blur === 1")
+    assert page.inner_text("#blur-value") == "1"
+    page.click("#multi")
+    settle(page, extra=f"{STATE}.settings.multi === true")
+    assert page.evaluate(f"{STATE}.report.strokes") >= 1 and page.is_checked("#multi")
+    page.screenshot(path=str(ARTIFACTS / "studio-5-multi.png"))
+    while page.evaluate("window.studio.at") > at:
+        page.click("#undo")
+    settle(page, extra=f"{STATE}.settings.threshold === null && {STATE}.settings.blur === 0 && "
+                       f"{STATE}.settings.multi === false")
+    assert page.is_checked("#auto-threshold") and not page.is_checked("#multi")
 
 
-def click_at(page, at) -> None:
-    x, y = page.evaluate(f"window.studio.toScreen({at[0]}, {at[1]})")
-    page.mouse.click(x, y)
-
-
-def test_page_split_merge_blur_start_reverse_load(page, studio):
-    _, drawing = studio
-    count = page.evaluate("window.studio.state.edits.edits.length")
-    crossings = page.evaluate("window.studio.state.report.intersections")
-    target = page.evaluate("window.studio.state.graph.junctions.find(j => j.role === 'crossing' && !j.fixed)")
+def test_split_merge_start_and_reverse_by_clicking(page):
+    count = page.evaluate(f"{STATE}.edits.edits.length")
+    crossings = page.evaluate(f"{STATE}.report.intersections")
+    target = page.evaluate(f"{STATE}.graph.junctions.find(j => j.role === 'crossing' && !j.fixed)")
 
     # Split a crossing into its two degree-3 halves, then merge them back by their branch.
     page.check("input[name=tool][value=split]")
     click_at(page, target["at"])
     settle(page, count + 1)
-    assert page.evaluate("window.studio.state.report.intersections") == crossings - 1
+    assert page.evaluate(f"{STATE}.report.intersections") == crossings - 1
     page.check("input[name=tool][value=merge]")
-    branch = page.evaluate(f"""window.studio.state.graph.branches.reduce((best, b) =>
+    branch = page.evaluate(f"""{STATE}.graph.branches.reduce((best, b) =>
         Math.hypot(b.at[0] - {target['at'][0]}, b.at[1] - {target['at'][1]}) <
         Math.hypot(best.at[0] - {target['at'][0]}, best.at[1] - {target['at'][1]}) ? b : best)""")
     page.screenshot(path=str(ARTIFACTS / "studio-6-split-merge-handles.png"))
     click_at(page, branch["at"])
     settle(page, count + 2)
-    assert page.evaluate("window.studio.state.report.intersections") == crossings
-
-    # Blur re-runs from binarization.
-    page.eval_on_selector("#blur", "e => { e.value = 1; e.dispatchEvent(new Event('change')); }")
-    page.wait_for_function("window.studio.state.settings.blur === 1 && !document.body.classList.contains('busy')")
+    assert page.evaluate(f"{STATE}.report.intersections") == crossings
 
     # Start at the other end, then reverse: back where it started.
-    strokes = page.evaluate("window.studio.state.strokes.map(s => [s.points[0], s.points[s.points.length - 1]])")
+    strokes = page.evaluate(f"{STATE}.strokes.map(s => [s.points[0], s.points[s.points.length - 1]])")
     end = strokes[0][1]
     page.check("input[name=tool][value=start]")
     click_at(page, end)
     settle(page, count + 3)
-    first = page.evaluate("window.studio.state.strokes[0].points[0]")
+    first = page.evaluate(f"{STATE}.strokes[0].points[0]")
     assert abs(first[0] - end[0]) < 3 and abs(first[1] - end[1]) < 3
     page.click("#reverse-all")
     settle(page, count + 4)
-    last = page.evaluate("window.studio.state.strokes[0].points.slice(-1)[0]")
+    last = page.evaluate(f"{STATE}.strokes[0].points.slice(-1)[0]")
     assert abs(last[0] - end[0]) < 3 and abs(last[1] - end[1]) < 3
     page.screenshot(path=str(ARTIFACTS / "studio-7-after-edits.png"))
+    page.check("input[name=tool][value=pairing]")
 
-    # Load edits: back to the file saved by the first test.
+
+def test_zoom_pan_and_reverse_one_stroke(page):
+    count = page.evaluate(f"{STATE}.edits.edits.length")
+    fitted = page.evaluate("({...window.studio.view})")
+    junction = page.evaluate(f"{STATE}.graph.junctions.find(j => j.role === 'crossing')")
+    x, y = page.evaluate(f"window.studio.toScreen({junction['at'][0]}, {junction['at'][1]})")
+    # The wheel zooms about the pointer: the junction under it stays there.
+    page.mouse.move(x, y)
+    page.mouse.wheel(0, -400)
+    page.wait_for_function(f"window.studio.view.scale > {fitted['scale'] * 1.5}")
+    after = page.evaluate(f"window.studio.toScreen({junction['at'][0]}, {junction['at'][1]})")
+    assert abs(after[0] - x) < 2 and abs(after[1] - y) < 2
+    # A drag pans, even when it starts on a junction: no edit is made.
+    page.mouse.move(x, y)
+    page.mouse.down()
+    page.mouse.move(x - 150, y - 60, steps=5)
+    page.mouse.up()
+    moved = page.evaluate(f"window.studio.toScreen({junction['at'][0]}, {junction['at'][1]})")
+    assert abs(moved[0] - (x - 150)) < 2 and abs(moved[1] - (y - 60)) < 2
+    page.wait_for_timeout(200)
+    assert page.evaluate(f"{STATE}.edits.edits.length") == count and page.evaluate("window.studio.at") == \
+        page.evaluate("window.studio.history.length") - 1
+    page.screenshot(path=str(ARTIFACTS / "studio-8-zoomed.png"))
+    # Clicks still find what is under the pointer in the zoomed, panned view.
+    click_at(page, junction["at"])
+    settle(page, count + 1 if not junction["fixed"] else count)
+    assert junction_near(page, junction["at"])["fixed"]
+    page.click("#undo")
+    settle(page, count)
+    # Double-click fits the drawing again.
+    page.dblclick("#canvas", position={"x": 5, "y": 5})
+    assert page.evaluate("window.studio.view.scale") == pytest.approx(fitted["scale"])
+
+    # The reverse tool: a click on a stroke makes it run the other way.
+    before = page.evaluate(f"{STATE}.strokes.map(s => [s.points[0], s.points[s.points.length - 1]])")
+    point = page.evaluate(f"{STATE}.strokes[0].points[Math.floor({STATE}.strokes[0].points.length / 3)]")
+    page.check("input[name=tool][value=reverse]")
+    click_at(page, point)
+    settle(page, count + 1)
+    now = page.evaluate(f"{STATE}.strokes.map(s => [s.points[0], s.points[s.points.length - 1]])")
+    assert now[0][0] == pytest.approx(before[0][1], abs=2) and now[0][1] == pytest.approx(before[0][0], abs=2)
+    page.check("input[name=tool][value=pairing]")
+
+
+def test_edits_file_save_load_and_open(page, studio, tmp_path):
+    _, drawing = studio
+    edits = page.evaluate(f"{STATE}.edits")
+    assert edits["edits"], "the earlier tests left edits to save"
+
+    # Save writes the edits file named on the command line; the CLI replays it to the
+    # page's SVG, byte for byte.
+    page.click("#save")
+    page.wait_for_function("document.getElementById('summary').textContent.includes('saved')")
+    saved = drawing.with_suffix(".edits.json")
+    assert json.loads(saved.read_text()) == edits
+    name, svg = download(page, "[data-export=svg]")
+    assert name == "loops.svg"
+    run = CliRunner().invoke(main, ["vectorize", str(drawing), "--edits", str(saved), "-o", str(tmp_path / "r.svg")])
+    assert run.exit_code == 0, run.output
+    assert svg == (tmp_path / "r.svg").read_bytes()
+    # The edits.json download is the same file.
+    name, data = download(page, "[data-export=edits]")
+    assert name == "loops.edits.json" and data == saved.read_bytes()
+    (tmp_path / name).write_bytes(data)
+
+    # Change something, then Load: back to the saved file.
+    page.click("#reverse-all")
+    settle(page, len(edits["edits"]) + 1)
     page.click("#load")
-    page.wait_for_function(f"window.studio.state.edits.edits.length === {count} && "
-                           "!document.body.classList.contains('busy')")
-    saved = json.loads(drawing.with_suffix(".edits.json").read_text())
-    assert page.evaluate("window.studio.state.edits.edits") == saved["edits"]
+    settle(page, len(edits["edits"]))
+    assert page.evaluate(f"{STATE}.edits") == edits
+
+    # Change again, then open the downloaded file through the page's file picker.
+    page.click("#reverse-all")
+    settle(page, len(edits["edits"]) + 1)
+    page.set_input_files("#open", str(tmp_path / name))
+    settle(page, len(edits["edits"]))
+    assert page.evaluate(f"{STATE}.edits") == edits
+    # A file that is not an edits file is answered on the page, not applied.
+    (tmp_path / "bad.json").write_text('{"format": "something else"}')
+    page.set_input_files("#open", str(tmp_path / "bad.json"))
+    page.wait_for_function("document.getElementById('warnings').textContent.includes('not an onestroke edits file')")
+    settle(page)
+    assert page.evaluate(f"{STATE}.edits") == edits

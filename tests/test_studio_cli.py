@@ -34,12 +34,45 @@ def test_studio_serves_the_page_and_stops_on_ctrl_c(tmp_path):
             assert page.status_code == 200 and "onestroke studio" in page.text
             state = client.get(url.group(0).split("?")[0] + "api/state")  # the cookie carries the token
             assert state.status_code == 200 and state.json()["report"]["strokes"] == 1
+            # Every file the page loads is served, and shipped in the package (package-data).
+            for name in page_assets(client, url.group(0).split("?")[0], page.text):
+                assert shipped(name), f"{name} is not in pyproject's package-data"
             assert httpx.get(url.group(0).split("?")[0] + "api/state").status_code == 403
     finally:
         process.send_signal(signal.SIGINT)
         out, err = process.communicate(timeout=20)
     assert process.returncode == 0, err
     assert "Traceback" not in err
+
+
+def page_assets(client, base: str, html: str) -> set[str]:
+    """The static files the page loads: its <link>/<script> files and the JS modules they
+    import, each fetched (200, not empty)."""
+    names, todo = set(), re.findall(r'(?:href|src)="static/([^"]+)"', html)
+    while todo:
+        name = todo.pop()
+        if name in names:
+            continue
+        names.add(name)
+        answer = client.get(base + "static/" + name)
+        assert answer.status_code == 200 and answer.content, name
+        if name.endswith(".js"):
+            todo += re.findall(r'from "\./([^"]+)"', answer.text)
+    assert {"app.js", "api.js", "panels.js", "player.js", "style.css", "player.css"} <= names
+    return names
+
+
+def shipped(name: str) -> bool:
+    """Whether pyproject's package-data globs take static/NAME of the studio or the player."""
+    import fnmatch
+    import tomllib
+
+    data = tomllib.loads((ROOT / "pyproject.toml").read_text())["tool"]["setuptools"]["package-data"]
+    for package in ("fabrication.studio", "fabrication.player"):
+        folder = ROOT / package.replace(".", "/") / "static"
+        if (folder / name).is_file() and any(fnmatch.fnmatch(f"static/{name}", g) for g in data.get(package, [])):
+            return True
+    return False
 
 
 def test_studio_refuses_bad_input(tmp_path):

@@ -13,6 +13,9 @@ from PIL import Image, ImageDraw
 from onestroke.atomic import atomic_open
 from vectorize.options import VectorizeResult
 
+# The files write_debug_images may write, in stage order (the CLI refuses a --debug folder
+# where one of them is an input).
+STAGE_IMAGES = ("1-binary.png", "2-medial-axis.png", "3-graph.png", "4-intersections.png", "5-curve.png")
 DEGREE_COLORS = {1: (0, 160, 0), 2: (120, 120, 120), 3: (230, 120, 0), 4: (200, 0, 200)}
 
 
@@ -55,16 +58,16 @@ def write_debug_images(result: VectorizeResult, folder: str | os.PathLike) -> li
     ink = stages["ink"]
 
     binary = Image.fromarray(np.where(ink.ink, 0, 255).astype(np.uint8))
-    _save(binary, folder / "1-binary.png")
-    written.append(folder / "1-binary.png")
+    _save(binary, folder / STAGE_IMAGES[0])
+    written.append(folder / STAGE_IMAGES[0])
 
     image = _base(ink.gray)
     draw = ImageDraw.Draw(image)
     for ring in stages["rings"]:
         draw.line([tuple(p) for p in np.vstack([ring, ring[:1]])], fill=(0, 170, 170), width=1)
     _draw_graph(draw, stages["pruned"], degrees=False)
-    _save(image, folder / "2-medial-axis.png")
-    written.append(folder / "2-medial-axis.png")
+    _save(image, folder / STAGE_IMAGES[1])
+    written.append(folder / STAGE_IMAGES[1])
 
     image = _base(ink.gray)
     draw = ImageDraw.Draw(image)
@@ -73,8 +76,8 @@ def write_debug_images(result: VectorizeResult, folder: str | os.PathLike) -> li
     for node in simple.y_feet:
         pos = stages["simplified"].positions[node]
         draw.text((pos[0] + 4, pos[1] + 2), "Y", fill=(230, 120, 0))
-    _save(image, folder / "3-graph.png")
-    written.append(folder / "3-graph.png")
+    _save(image, folder / STAGE_IMAGES[2])
+    written.append(folder / STAGE_IMAGES[2])
 
     image = _base(ink.gray, fade=0.3)
     draw = ImageDraw.Draw(image)
@@ -86,8 +89,8 @@ def write_debug_images(result: VectorizeResult, folder: str | os.PathLike) -> li
             draw.line([tuple(c), tuple(c + d * 3 * junction.width)], fill=color, width=2)
         label = f"{'X' if verdict.is_crossing else 'T'} {verdict.confidence:.2f}"
         draw.text((c[0] + 6, c[1] + 6), label, fill=color)
-    _save(image, folder / "4-intersections.png")
-    written.append(folder / "4-intersections.png")
+    _save(image, folder / STAGE_IMAGES[3])
+    written.append(folder / STAGE_IMAGES[3])
 
     image = _base(ink.gray, fade=0.85)
     draw = ImageDraw.Draw(image)
@@ -103,6 +106,6 @@ def write_debug_images(result: VectorizeResult, folder: str | os.PathLike) -> li
         s = stroke.start
         draw.ellipse([s[0] - 5, s[1] - 5, s[0] + 5, s[1] + 5], outline=(0, 0, 0), width=2)
         done += stroke.length
-    _save(image, folder / "5-curve.png")
-    written.append(folder / "5-curve.png")
+    _save(image, folder / STAGE_IMAGES[4])
+    written.append(folder / STAGE_IMAGES[4])
     return written

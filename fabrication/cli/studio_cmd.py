@@ -2,12 +2,14 @@
 
 from __future__ import annotations
 
+import threading
 import time
 
 import click
 
 from fabrication.cli.common import console, done
 from onestroke.errors import InputError
+from onestroke.paths import check_distinct
 
 
 @click.command()
@@ -29,6 +31,7 @@ def studio(source: str, port: int, no_browser: bool, edits_path: str | None, pro
 
     if not 0 <= port <= 65535:
         raise InputError(f"--port {port} must be between 0 and 65535")
+    check_distinct(inputs=[("input", source), ("--profile", profile_path)], outputs=[("--edits file", edits_path)])
     session = StudioSession(source, edits_path=edits_path, profile=profile_path, classifier=classifier)
     if profile_path is not None:
         from machines.laser_profile import load_laser_profile
@@ -38,6 +41,7 @@ def studio(source: str, port: int, no_browser: bool, edits_path: str | None, pro
     with console.status(f"vectorizing {session.drawing_path.name}"):
         session.vectorize(session.saved_edits())
     server = StudioServer(session, port=port).start()
+    threading.Thread(target=session.warm, name="studio-warm", daemon=True).start()
     done(f"studio for {session.drawing_path.name} at {server.url}")
     console.print(f"edits are saved to {session.edits_path}; Ctrl-C stops the studio")
     if not no_browser and _graphical():

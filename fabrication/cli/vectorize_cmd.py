@@ -23,9 +23,12 @@ from onestroke.paths import check_distinct
 def vectorize(source: str, output: str, multi: bool, threshold: float | None, blur: float,
               classifier: str, debug_dir: str | None, edits: str | None) -> None:
     """Vectorize SOURCE into one ordered cubic Bézier curve (or several with --multi)."""
-    check_distinct(inputs=[("input", source), ("--edits file", edits)], outputs=[("output", output)])
     if debug_dir is not None and os.path.exists(debug_dir) and not os.path.isdir(debug_dir):
         raise InputError(f"--debug {debug_dir!r} is a file; give a folder for the stage images")
+    from vectorize.debug_overlay import STAGE_IMAGES
+
+    stage_images = [("--debug image", os.path.join(debug_dir, name)) for name in STAGE_IMAGES] if debug_dir else []
+    check_distinct(inputs=[("input", source), ("--edits file", edits)], outputs=[("output", output), *stage_images])
     from vectorize import VectorizeOptions, vectorize_file
     from vectorize.edits import read_edits
     from vectorize.svg_write import write_drawing

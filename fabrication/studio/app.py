@@ -22,7 +22,7 @@ from starlette.requests import Request
 from starlette.responses import JSONResponse, PlainTextResponse, Response
 from starlette.routing import Route
 
-from fabrication.studio.session import StudioSession
+from fabrication.studio.session import StudioSession, Superseded
 from onestroke.errors import InputError, OnestrokeError
 from vectorize.edits import Edits, edits_from_dict
 
@@ -154,8 +154,15 @@ def create_app(session: StudioSession, *, token: str, hosts: set[str]) -> Guard:
         return Response(buffer.getvalue(), media_type="image/png")
 
     async def state(request: Request):
-        edits = session.saved_edits() if request.method == "GET" else (await payload(request))[0]
-        return JSONResponse(await run_in_threadpool(session.state, edits))
+        if request.method == "GET":
+            return JSONResponse(await run_in_threadpool(session.state, session.saved_edits()))
+        edits, _, data = await payload(request)
+        superseded = session.ticket(str(data["page"])) if data.get("page") else None
+        try:
+            return JSONResponse(await run_in_threadpool(session.state, edits, superseded=superseded))
+        except Superseded:
+            # The page sent a newer state request meanwhile and ignores this answer.
+            return JSONResponse({"superseded": True})
 
     async def embroidery(request: Request):
         edits, options, _ = await payload(request)
@@ -192,6 +199,14 @@ def create_app(session: StudioSession, *, token: str, hosts: set[str]) -> Guard:
         session.sender = LaserSender(content.decode(), port=port, baud=baud, name=name).start()
         return JSONResponse(session.sender.status())
 
+    async def ports(request: Request):
+        from machines.ports import list_ports
+
+        found = await run_in_threadpool(list_ports, probe=False)
+        return JSONResponse({"ports": [{"device": "sim://", "description": "GRBL emulator (dry run)"}] +
+                             [{"device": p.device, "description": p.description, "problem": p.problem}
+                              for p in found]})
+
     async def control(request: Request):
         action = request.path_params["action"]
         if session.sender is None or action not in ("pause", "resume", "abort"):
@@ -211,5 +226,6 @@ def create_app(session: StudioSession, *, token: str, hosts: set[str]) -> Guard:
         Route("/api/edits", api(save_edits), methods=["POST"]),
         Route("/api/send", api(send), methods=["GET", "POST"]),
         Route("/api/send/{action}", api(control), methods=["POST"]),
+        Route("/api/ports", api(ports), methods=["GET"]),
     ]
     return Guard(Starlette(routes=routes), token=token, hosts=hosts)

@@ -27,6 +27,7 @@ class LaserSender:
         self.progress: StreamProgress | None = None
         self.started = time.monotonic()
         self._streamer: GrblStreamer | None = None
+        self._abort = threading.Event()  # asked for at any time, also while connecting
         self._thread = threading.Thread(target=self._run, name="studio-send", daemon=True)
 
     def start(self) -> "LaserSender":
@@ -44,11 +45,14 @@ class LaserSender:
                 info = streamer.connect()
                 if info.alarm:
                     raise OnestrokeError(f"{self.port} is locked in ALARM: home it ($H) or unlock it ($X) first")
-                self.state = "streaming"
-                result = streamer.stream(self.program, on_progress=self._on_progress)
-                state, message = "done", f"{result.lines} lines in {result.elapsed:.1f} s"
+                if self._abort.is_set():
+                    state, message = "aborted", "stopped before the first line was sent"
+                else:
+                    self.state = "streaming"
+                    result = streamer.stream(self.program, on_progress=self._on_progress)
+                    state, message = "done", f"{result.lines} lines in {result.elapsed:.1f} s"
         except OnestrokeError as error:
-            state, message = ("aborted" if self.state == "aborting" else "failed"), str(error)
+            state, message = ("aborted" if self._abort.is_set() else "failed"), str(error)
         except Exception as error:  # noqa: BLE001 - a thread has no caller: the page shows it
             state, message = "failed", f"{type(error).__name__}: {error}"
         finally:
@@ -57,9 +61,13 @@ class LaserSender:
 
     def _on_progress(self, progress: StreamProgress) -> None:
         self.progress = progress
+        if self._abort.is_set() and self._streamer is not None:
+            # An abort that came as the stream started (which clears the streamer's own
+            # flag) is passed on again at the next acknowledged line.
+            self._streamer.abort()
 
     def pause(self) -> None:
-        if self._streamer is not None and self.state == "streaming":
+        if self._streamer is not None and self.state == "streaming" and not self._abort.is_set():
             self._streamer.pause()
             self.state = "paused"
 
@@ -69,9 +77,13 @@ class LaserSender:
             self.state = "streaming"
 
     def abort(self) -> None:
-        if self._streamer is not None and self.state in ("streaming", "paused", "connecting"):
+        """Stop the job safely (hold, reset: beam off); while connecting, before any line."""
+        if self.state in ("streaming", "paused", "connecting"):
+            self._abort.set()
             self.state = "aborting"
-            self._streamer.abort()
+            streamer = self._streamer
+            if streamer is not None:
+                streamer.abort()
 
     @property
     def running(self) -> bool:
@@ -82,7 +94,14 @@ class LaserSender:
         self._thread.join(timeout)
 
     def status(self) -> dict:
+        """State, progress and the machine's own latest status report (e.g. "Hold:0"
+        while paused: no line is acknowledged during a hold, so the last progress report
+        would still say "Run")."""
         p = self.progress
+        streamer = self._streamer
+        report = streamer.status if streamer is not None else None
+        machine = report.full_state if report is not None else (p.state if p else None)
         return {"state": self.state, "message": self.message, "port": self.port,
                 "acked": p.acked if p else 0, "total": p.total if p else len(self.program),
-                "elapsed": round(p.elapsed, 2) if p else 0.0, "machine": p.state if p else None}
+                "elapsed": round(p.elapsed, 2) if p else 0.0, "machine": machine,
+                "line": p.last_line if p else 0}

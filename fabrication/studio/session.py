@@ -9,7 +9,6 @@ with the same options.
 
 from __future__ import annotations
 
-import json
 import os
 import threading
 from pathlib import Path
@@ -44,6 +43,10 @@ def _clean(values: dict, allowed: tuple[str, ...]) -> dict:
     return {k: v for k, v in values.items() if v is not None and v != ""}
 
 
+class Superseded(Exception):
+    """A page asked for a newer state while this request waited for the vectorizer."""
+
+
 class StudioSession:
     """drawing: the input file; edits_path: where the page saves its edits; profile: an
     optional laser profile TOML; classifier: the vectorizer's crossing classifier."""
@@ -59,6 +62,7 @@ class StudioSession:
         self.cache = StageCache()
         self.lock = threading.Lock()  # one vectorization at a time: the cache is not shared-safe
         self.sender = None
+        self._tickets: dict[str, int] = {}  # page id -> number of its latest state request
 
     # -- edits -----------------------------------------------------------------------
     def saved_edits(self) -> Edits:
@@ -71,13 +75,26 @@ class StudioSession:
         return edits
 
     # -- vectorization ---------------------------------------------------------------
-    def vectorize(self, edits: Edits):
+    def vectorize(self, edits: Edits, *, superseded=None):
+        """The vectorization with these edits. superseded: a callable; when it says True
+        once the vectorizer is free, `Superseded` is raised instead of the work."""
         with self.lock:
+            if superseded is not None and superseded():
+                raise Superseded
             return vectorize_file(self.drawing_path, self.options, edits=edits, cache=self.cache)
 
-    def state(self, edits: Edits) -> dict:
+    def ticket(self, page: str):
+        """A state request of page `page`: a callable saying whether the page has asked for
+        another state since. A slider dragged over several values while a re-run takes a
+        second queues a request per value; only the latest is worth the vectorizer's time.
+        (Called on the server's event loop: one at a time.)"""
+        number = self._tickets.get(page, 0) + 1
+        self._tickets[page] = number
+        return lambda: self._tickets.get(page) != number
+
+    def state(self, edits: Edits, *, superseded=None) -> dict:
         """What the page draws: curve samples in drawing order, junctions, branches, report."""
-        result = self.vectorize(edits)
+        result = self.vectorize(edits, superseded=superseded)
         drawing, report = result.drawing, result.report
         strokes = []
         for stroke in drawing.strokes:
@@ -98,6 +115,18 @@ class StudioSession:
         }
 
     # -- make it ---------------------------------------------------------------------
+    PANEL_MODULES = ("fabrication.embroidery.pipeline", "fabrication.embroidery.export", "fabrication.player",
+                     "fabrication.laser.program", "machines.hoops", "machines.job_time", "vectorize.svg_write")
+
+    def warm(self) -> None:
+        """Import what the make-it panels and downloads use (about 1 s of CPU), so that the
+        first click on the Embroidery or Laser tab answers as fast as the next ones. The
+        CLI runs it in the background once the page is served."""
+        import importlib
+
+        for name in self.PANEL_MODULES:
+            importlib.import_module(name)
+
     def embroidery(self, edits: Edits, values: dict, extension: str = "pes"):
         """(settings, result) of `onestroke embroider` for these option values."""
         from fabrication.embroidery.pipeline import embroider
@@ -121,7 +150,7 @@ class StudioSession:
         data = stitch_player_data(result.plan, title=self.drawing_path.stem, stats=stats,
                                   stitches_per_minute=job.stitches_per_minute, trim_seconds=job.trim_seconds,
                                   hoop=(-hoop.width / 2, -hoop.height / 2, hoop.width / 2, hoop.height / 2))
-        return {"player": json.loads(data.to_json()), "stats": stats.lines(), "stitches": stats.stitches,
+        return {"player": data.to_dict(), "stats": stats.lines(), "stitches": stats.stitches,
                 "seconds": stats.seconds, "warnings": list(settings.warnings) + list(result.warnings)}
 
     def laser(self, edits: Edits, values: dict):
@@ -145,7 +174,7 @@ class StudioSession:
         settings, program = self.laser(edits, values)
         time = program.time
         data = gcode_player_data(program.lines, title=self.drawing_path.stem, profile=settings.profile)
-        return {"player": json.loads(data.to_json()), "seconds": time.total_seconds,
+        return {"player": data.to_dict(), "seconds": time.total_seconds,
                 "time": format_duration(time.total_seconds), "naive": format_duration(time.naive_seconds),
                 "burn_length": round(float(time.burn_length), 1), "travel_length": round(float(time.travel_length), 1),
                 "lines": len(program.lines), "profile": settings.profile.name,

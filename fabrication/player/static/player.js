@@ -325,6 +325,14 @@ export function createPlayer(root, input, options = {}) {
     seek(t) { time = Math.min(Math.max(t, 0), d.total); request(); },
     // jump to the end of row i (and a step never stays put on rows of zero duration)
     seekRow(i) { i = Math.min(Math.max(i, -1), d.n - 1); api.seek(i >= 0 ? d.t[i] : 0); },
+    // jump to the end of the last row numbered n or less (numbers ascend: e.g. the G-code
+    // line a machine has just acknowledged while a job streams)
+    seekNumber(n) {
+      if (!d) return;
+      let lo = 0, hi = d.n;  // first row numbered above n
+      while (lo < hi) { const mid = (lo + hi) >> 1; if (d.num[mid] <= n) lo = mid + 1; else hi = mid; }
+      api.pause(); api.seekRow(lo - 1);
+    },
     step(delta) {
       api.pause();
       const i = rowAt(time);

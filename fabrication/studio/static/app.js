@@ -17,11 +17,19 @@ const studio = {
   tool: "pairing",
   image: new Image(),
   requests: 0,            // answers to ignore when a newer request was sent
+  shown: null,            // the edits of the state shown (what the panels and downloads use)
+  rerunning: 0,           // pending requests that re-run from binarization
+  holding: null,          // the slider the pointer holds ("threshold", "blur")
+  // This page's id: the server skips a queued state request once the page sent a newer one.
+  page: Math.random().toString(36).slice(2) + Date.now().toString(36),
 };
 window.studio = studio;
 
 // ---------------------------------------------------------------- edits and history
 function currentEdits() { return studio.history[studio.at]; }
+const SETTINGS = ["threshold", "blur", "multi"];
+// Only the answer to the latest request is shown: a slow re-run answered after a newer
+// edit (or while a slider moves on) is dropped, so the page never shows a stale state.
 async function apply(edits, push = true) {
   if (push) {
     studio.history = studio.history.slice(0, studio.at + 1);
@@ -30,17 +38,30 @@ async function apply(edits, push = true) {
   }
   updateButtons();
   const ticket = ++studio.requests;
+  const shown = studio.state ? studio.state.edits : null;
+  const rerun = !shown || SETTINGS.some((k) => edits[k] !== shown[k]);
   busy(true);
+  if (rerun) rerunning(1);
   const started = performance.now();
   try {
-    const state = await call("api/state", { edits });
+    const state = await call("api/state", { edits, page: studio.page });
     state.answered = (performance.now() - started) / 1000;
-    if (ticket === studio.requests) show(state);
+    if (ticket === studio.requests && !state.superseded) { studio.shown = edits; show(state); }
   } catch (error) {
-    report(error);
+    // A refused edits state (e.g. an opened file that is not an edits file) is no step.
+    if (push && studio.history[studio.at] === edits) { studio.history.pop(); studio.at -= 1; updateButtons(); }
+    if (ticket === studio.requests) report(error);
   } finally {
     busy(false);
+    if (rerun) rerunning(-1);
   }
+}
+
+// The visible busy state of a re-run from binarization (threshold, blur, mode: ~0.5-1 s).
+function rerunning(step) {
+  studio.rerunning += step;
+  $("rerun").hidden = studio.rerunning <= 0;
+  $("tab-refine").classList.toggle("rerunning", studio.rerunning > 0);
 }
 
 function withEdit(edit, replaceNear) {
@@ -215,11 +236,15 @@ function show(state) {
   }
   const warnings = $("warnings"); warnings.innerHTML = "";
   for (const w of r.warnings) { const li = document.createElement("li"); li.textContent = w; warnings.appendChild(li); }
+  // The controls show the state's settings, except a slider the user holds: writing its
+  // value mid-drag would move the thumb away from the pointer.
   const st = state.settings;
-  $("auto-threshold").checked = st.threshold === null;
-  if (st.threshold !== null) $("threshold").value = st.threshold;
-  $("threshold-value").textContent = st.threshold === null ? "auto" : Number(st.threshold).toFixed(2);
-  $("blur").value = st.blur; $("blur-value").textContent = st.blur;
+  if (studio.holding !== "threshold") {
+    $("auto-threshold").checked = st.threshold === null;
+    if (st.threshold !== null) $("threshold").value = st.threshold;
+    $("threshold-value").textContent = st.threshold === null ? "auto" : Number(st.threshold).toFixed(2);
+  }
+  if (studio.holding !== "blur") { $("blur").value = st.blur; $("blur-value").textContent = st.blur; }
   $("multi").checked = st.multi;
   draw();
   refreshPanel();
@@ -326,9 +351,11 @@ function settingsEdit(change) {
 }
 
 // While a slider is dragged, the value it rests on is vectorized already (not yet a step
-// in the history): on release the answer comes from the cache.
+// in the history): on release the answer comes from the cache. Moving it drops the
+// answers still on their way (they are for values the slider has left).
 let previewTimer = null;
 function preview(change) {
+  studio.requests += 1;
   clearTimeout(previewTimer);
   previewTimer = setTimeout(() => apply(Object.assign(JSON.parse(JSON.stringify(currentEdits())), change), false), 350);
 }
@@ -349,7 +376,10 @@ function setup() {
     const pts = s.strokes[0].points;
     apply(withEdit({ kind: "reverse", at: pts[Math.floor(pts.length / 2)].slice(0, 2) }, false));
   };
+  for (const id of ["threshold", "blur"]) $(id).addEventListener("pointerdown", () => { studio.holding = id; });
+  window.addEventListener("pointerup", () => { studio.holding = null; });
   $("threshold").oninput = () => {
+    $("auto-threshold").checked = false;
     $("threshold-value").textContent = Number($("threshold").value).toFixed(2);
     preview({ threshold: Number($("threshold").value) });
   };
@@ -360,7 +390,7 @@ function setup() {
   $("multi").onchange = () => settingsEdit({ multi: $("multi").checked });
   $("play").onclick = play;
   $("scrub").oninput = () => { studio.playing = false; $("play").textContent = "▶ Play"; studio.pen = $("scrub").value / 1000; draw(); };
-  setupPanels(() => (studio.state ? currentEdits() : null));
+  setupPanels(() => studio.shown);
   $("save").onclick = async () => {
     try { const r = await call("api/edits", { edits: currentEdits() }); $("summary").textContent += ` · saved ${r.saved}`; }
     catch (error) { report(error); }
@@ -379,7 +409,7 @@ function setup() {
     busy(true);
     try {
       const state = await call("api/state");
-      studio.history = [state.edits]; studio.at = 0; updateButtons();
+      studio.history = [state.edits]; studio.at = 0; studio.shown = state.edits; updateButtons();
       show(state);
     } catch (error) { report(error); } finally { busy(false); }
   })();

@@ -41,9 +41,11 @@ export async function refreshPanel() {
 
 // Stitches and laser moves play in the project's player (fabrication/player), one per panel.
 const players = {};
+let laserShown = 0, laserSent = -1;  // which toolpath the laser player shows, which one was sent
 function showPlayer(kind, data) {
   if (!players[kind]) players[kind] = createPlayer($(`${kind}-player`), data);
   else players[kind].load(data);
+  if (kind === "laser") laserShown += 1;
   players[kind].seek(data.total);  // the finished job first; Play starts it from the beginning
   window.studio.players = players;
 }
@@ -80,28 +82,52 @@ async function download(kind) {
 }
 
 // ---------------------------------------------------------------- send to laser
+// The job runs in the server (fabrication/studio/sender.py); the page polls its state
+// while it is active and enables only the controls that state allows.
+const ACTIVE = ["connecting", "streaming", "paused", "aborting"];
 let sendTimer = null;
 async function sendAction(action) {
   try {
     const status = action === "send"
-      ? await call("api/send", { edits: edits(), options: panelOptions("laser"), port: $("port").value })
+      ? await call("api/send", { edits: edits(), options: panelOptions("laser"), port: $("port").value.trim() })
       : await call(`api/send/${action}`, {});
+    if (action === "send") laserSent = laserShown;
     showSend(status);
-    if (!sendTimer) sendTimer = setInterval(pollSend, 300);
   } catch (error) {
-    $("send-status").textContent = "error: " + error.message;
+    sendError(error.message);
   }
 }
 async function pollSend() {
-  const status = await call("api/send");
-  showSend(status);
-  if (!["connecting", "streaming", "paused", "aborting"].includes(status.state)) { clearInterval(sendTimer); sendTimer = null; }
+  try { showSend(await call("api/send")); } catch (error) { sendError(error.message); }
+}
+function sendError(message) {
+  $("send-status").textContent = "error: " + message;
+  $("send-status").dataset.state = "error";
 }
 function showSend(s) {
+  const active = ACTIVE.includes(s.state);
   $("send-progress").max = s.total || 1; $("send-progress").value = s.acked || 0;
-  $("send-status").textContent = `${s.state}${s.total ? ` · ${s.acked}/${s.total} lines` : ""}` +
-    `${s.machine ? ` · ${s.machine}` : ""}${s.message ? ` · ${s.message}` : ""}`;
+  const lines = s.total && (active || s.acked) ? ` · ${s.acked}/${s.total} lines` : "";
+  const machine = s.machine && active ? ` · machine ${s.machine}` : "";
+  $("send-status").textContent = `${s.state}${s.port ? ` on ${s.port}` : ""}${lines}${machine}` +
+    `${s.message ? ` · ${s.message}` : ""}`;
   $("send-status").dataset.state = s.state;
+  // The laser player follows the job (the line the machine acknowledged last) while it
+  // shows the toolpath that was sent.
+  if (active && s.line && players.laser && laserSent === laserShown) players.laser.seekNumber(s.line);
+  $("send").disabled = active;
+  $("pause").disabled = s.state !== "streaming";
+  $("resume").disabled = s.state !== "paused";
+  $("abort").disabled = !active || s.state === "aborting";
+  if (active && !sendTimer) sendTimer = setInterval(pollSend, 250);
+  if (!active && sendTimer) { clearInterval(sendTimer); sendTimer = null; }
+}
+async function listPorts() {
+  try {
+    const found = (await call("api/ports")).ports;
+    $("ports").innerHTML = found.map((p) => `<option value="${escapeHtml(p.device)}">${escapeHtml(p.description || "")}` +
+      `${p.problem ? " (" + escapeHtml(p.problem) + ")" : ""}</option>`).join("");
+  } catch (error) { /* typing a port still works */ }
 }
 
 export function setupPanels(currentEdits) {
@@ -116,4 +142,6 @@ export function setupPanels(currentEdits) {
   for (const form of ["embroidery-form", "laser-form"]) $(form).addEventListener("change", refreshPanel);
   for (const button of document.querySelectorAll("[data-export]")) button.onclick = () => download(button.dataset.export);
   for (const action of ["send", "pause", "resume", "abort"]) $(action).onclick = () => sendAction(action);
+  listPorts();
+  pollSend();  // a job started before this page was (re)loaded
 }

@@ -1,0 +1,88 @@
+"""Every export button of the studio, clicked in a real browser after an edit and with
+option values typed and picked in the panels, downloads the bytes the CLI writes for the
+same drawing, edits file and flags (real `onestroke vectorize|embroider|laser` runs)."""
+
+from __future__ import annotations
+
+import pytest
+
+from conftest import ARTIFACTS
+from studio_fixtures import cli_bytes, click_at, download, page, settle, studio  # noqa: F401 - fixtures
+
+pytestmark = pytest.mark.slow
+
+
+@pytest.fixture(scope="module")
+def edited(page):
+    """The page after a user's edit: one junction clicked to its next pairing."""
+    junction = page.evaluate("window.studio.state.graph.junctions.find(j => j.role === 'crossing')")
+    click_at(page, junction["at"])
+    settle(page, 1)
+    edits = page.evaluate("window.studio.state.edits")
+    assert edits["edits"][0]["kind"] == "pairing"
+    return edits
+
+
+def play_the_panel(page, panel: str) -> None:
+    """The panel's player shows the finished job; its Play runs it from the start: the
+    stitch (or line) number moves on, then stops where Play is pressed again."""
+    number = f"#{panel}-player [data-role=number]"
+    total = page.inner_text(number)
+    page.click(f"#{panel}-player [data-role=play]")
+    page.wait_for_timeout(700)
+    page.click(f"#{panel}-player [data-role=play]")
+    now = page.inner_text(number)
+    count = int(now.split("/")[0].replace(",", "").strip())
+    assert now != total and count > 0, (now, total)
+
+
+@pytest.mark.parametrize("kind", ["svg", "json"])
+def test_drawing_downloads(page, studio, edited, tmp_path, kind):
+    page.click("nav .tab[data-tab=refine]")
+    name, data = download(page, f"[data-export={kind}]")
+    assert name == f"loops.{kind}"
+    assert data == cli_bytes("vectorize", studio[1], edited, tmp_path, f".{kind}")
+
+
+EMBROIDERY = [("pes", "zigzag", "70mm", "130x180", "#c01020"), ("dst", "triple", "60mm", "100x100", "#1f3a93"),
+              ("jef", "arrows", "95mm", "130x180", "#1f3a93"), ("exp", "running", "50mm", "100x100", "#208040"),
+              ("vp3", "running", "80mm", "100x100", "#c01020")]
+
+
+@pytest.mark.parametrize("kind, style, size, hoop, color", EMBROIDERY)
+def test_embroidery_downloads(page, studio, edited, tmp_path, kind, style, size, hoop, color):
+    page.click("nav .tab[data-tab=embroidery]")
+    form = "#embroidery-form"
+    page.select_option(f"{form} select[name=style]", style)
+    page.fill(f"{form} input[name=size]", size)
+    page.select_option(f"{form} select[name=hoop]", hoop)
+    page.fill(f"{form} input[name=stitch_length]", "3mm")
+    page.fill(f"{form} input[name=color]", color)
+    page.press(f"{form} input[name=stitch_length]", "Tab")  # a typed field reports its change on leaving it
+    settle(page, extra="document.getElementById('embroidery-stats').textContent.includes('stitches')")
+    if kind == "pes":
+        play_the_panel(page, "embroidery")
+        page.screenshot(path=str(ARTIFACTS / "studio-make-embroidery.png"))
+    name, data = download(page, f"[data-export={kind}]")
+    assert name == f"loops.{kind}"
+    assert data == cli_bytes("embroider", studio[1], edited, tmp_path, f".{kind}", "--style", style, "--size", size,
+                             "--hoop", hoop, "--stitch-length", "3mm", "--color", color)
+
+
+def test_gcode_download(page, studio, edited, tmp_path):
+    page.click("nav .tab[data-tab=laser]")
+    form = "#laser-form"
+    page.fill(f"{form} input[name=size]", "60mm")
+    page.fill(f"{form} input[name=feed]", "1200mm/min")
+    page.fill(f"{form} input[name=power]", "35%")
+    page.fill(f"{form} input[name=passes]", "2")
+    page.select_option(f"{form} select[name=origin]", "center")
+    page.check(f"{form} input[name=arcs]")
+    settle(page, extra="document.getElementById('laser-time').textContent.includes('estimated')")
+    play_the_panel(page, "laser")
+    page.screenshot(path=str(ARTIFACTS / "studio-make-laser.png"))
+    name, data = download(page, "[data-export=gcode]")
+    assert name == "loops.gcode"
+    assert data == cli_bytes("laser", studio[1], edited, tmp_path, ".gcode", "--size", "60mm", "--feed", "1200mm/min",
+                             "--power", "35%", "--passes", "2", "--origin", "center", "--arcs")
+    assert b"G2" in data or b"G3" in data  # the arcs box took effect
