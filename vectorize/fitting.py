@@ -29,15 +29,24 @@ def _dedupe(points: np.ndarray, min_step: float) -> np.ndarray:
     """Drop points closer than `min_step` to the previous kept one (splprep needs distinct points)."""
     if len(points) < 2:
         return points
-    keep = [0]
-    last = points[0]
-    for i in range(1, len(points)):
-        if np.linalg.norm(points[i] - last) >= min_step:
-            keep.append(i)
-            last = points[i]
-    if keep[-1] != len(points) - 1 and np.linalg.norm(points[-1] - points[keep[-1]]) > 1e-9:
-        keep[-1] = len(points) - 1
-    return points[keep]
+    n = len(points)
+    steps = np.linalg.norm(np.diff(points, axis=0), axis=1)
+    keep = np.ones(n, dtype=bool)
+    # A point is measured from the last kept one, which is its predecessor unless that one
+    # was dropped: only the runs that start with a short step need walking point by point.
+    done = 0
+    for i in (np.flatnonzero(steps < min_step) + 1).tolist():
+        if i <= done:
+            continue
+        last = i - 1
+        while i < n and np.linalg.norm(points[i] - points[last]) < min_step:
+            keep[i] = False
+            i += 1
+        done = i
+    kept = np.flatnonzero(keep)
+    if kept[-1] != n - 1 and np.linalg.norm(points[-1] - points[kept[-1]]) > 1e-9:
+        kept[-1] = n - 1
+    return points[kept]
 
 
 def bspline_to_bezier(tck, u_start: float, u_end: float) -> np.ndarray:
