@@ -12,7 +12,8 @@ drawings, the examples) and for dense 4,000-line jobs of 0.1 mm segments, it pri
   the last `ok`, whichever is later); median of --repeat runs;
 - diff: estimate / emulator - 1.
 The machine clock does not depend on the host's speed or load (machines/emulator_clock.py):
-the figures are the same on a quiet and a loaded machine, only the wall time differs.
+the figures do not change with the load (measured at load averages 12-21), only the wall time does;
+a row whose "host timeouts" exceeds 1 had a host stall that may have cost machine time.
 `--scale` only sets how fast the emulator paces its replies in wall time.
 
     python benchmarks/laser_estimate_vs_emulator.py [--scale 2] [--repeat 1] [--only dense] [--count N] [--match TEXT]
@@ -67,8 +68,9 @@ def _serve(conn, scale: float) -> None:
     emulator.stop()
 
 
-def emulated_seconds(lines: list[str], scale: float) -> tuple[float, float]:
-    """(machine seconds of a character-counting stream, emulator's planner-limited seconds)."""
+def emulated_seconds(lines: list[str], scale: float) -> tuple[float, float, int]:
+    """(machine seconds of a character-counting stream, emulator's planner-limited seconds,
+    times its clock stopped waiting for the host: 1, at the end, unless the host stalled)."""
     ctx = mp.get_context("fork")
     parent, child = ctx.Pipe()
     process = ctx.Process(target=_serve, args=(child, scale), daemon=True)
@@ -84,7 +86,7 @@ def emulated_seconds(lines: list[str], scale: float) -> tuple[float, float]:
         parent.send("stop")
     stats = parent.recv()
     process.join(5)
-    return stats.job_time, stats.planner_limited_time
+    return stats.job_time, stats.planner_limited_time, stats.host_timeouts
 
 
 def row(label: str, lines: list[str], scale: float, repeat: int) -> float:
@@ -93,7 +95,8 @@ def row(label: str, lines: list[str], scale: float, repeat: int) -> float:
     emulated = statistics.median(r[0] for r in runs)
     diff = job.total_seconds / emulated - 1
     print(f"{label:46s} {len(lines):6d} {job.total_seconds:9.3f} {job.bound:>7s} {job.planner_seconds:9.3f} "
-          f"{emulated:9.3f} {diff:+7.2%}  (emulator planner-limited {runs[0][1]:.3f})", flush=True)
+          f"{emulated:9.3f} {diff:+7.2%}  (emulator planner-limited {runs[0][1]:.3f}, host timeouts "
+          f"{runs[0][2]})", flush=True)
     return diff
 
 

@@ -165,7 +165,7 @@ def _run_one(index: int, classifier: str, oracle: bool, conn) -> None:
                 output = Drawing(tuple(s.transformed(matrix) for s in output.strokes),
                                  gt.drawing.width, gt.drawing.height, "px")
         scores = evaluate(gt, output, gray)
-        if PLOT_DIR and not scores.correct:
+        if PLOT_DIR and (not scores.correct or scores.hallucinated):
             overlay(gt, output, gray, PLOT_DIR[0] / f"{set_name}-{classifier}-{gt.name}.png")
         row.update(seconds=seconds, peak_mb=peak, memory_method=method, strokes=scores.stroke_count,
                    ssim=scores.ssim, psnr=scores.psnr, length_ratio=scores.length_ratio,
@@ -350,7 +350,8 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--jobs", type=int, default=1, help="drawings in parallel (timing is cleanest with 1)")
     ap.add_argument("--csv", type=Path, default=None, help="write one row per drawing here")
     ap.add_argument("--plot", type=Path, default=None, metavar="DIR",
-                    help="write an overlay PNG of every drawing that is not one stroke in the correct order")
+                    help="write an overlay PNG of every drawing that is not one stroke in the correct order "
+                         "or reports a crossing the ground truth does not have")
     ap.add_argument("--timeout", type=float, default=120.0, help="seconds per drawing before it counts as failed")
     ap.add_argument("--whole-process", type=int, nargs="?", const=5, default=None, metavar="N",
                     help="instead: time `onestroke vectorize` as a subprocess on N drawings (default 5)")

@@ -115,6 +115,8 @@ class EmulatorStats:
     job_time: from the moment the host sent the first line after `mark_job_start` to the
     end of the last block or the arrival of the last `ok` at the host, whichever is
     later (0 if no job was marked). Includes holds (see `emulator_clock`).
+    host_timeouts: how often the clock stopped waiting for a host that owed a line (one
+    at the end of a stream is normal; more mean a host so slow it may have cost time).
     """
 
     lines_executed: int
@@ -130,6 +132,7 @@ class EmulatorStats:
     resets: int
     alarms: tuple[int, ...]
     job_time: float = 0.0
+    host_timeouts: int = 0
 
 
 class GrblEmulator(EmulatorTransport, EmulatorHost, EmulatorClock, EmulatorProtocol, EmulatorMotion):
@@ -240,7 +243,7 @@ class GrblEmulator(EmulatorTransport, EmulatorHost, EmulatorClock, EmulatorProto
             job = 0.0
             if self._job_start is not None:
                 job = float(max(self._last_motion or 0.0, self._last_ok) - self._job_start) * self.scale
-            result = dict(job_time=job, lines_executed=len(self.executed), blocks_executed=self.blocks_done,
+            result = dict(job_time=job, host_timeouts=self.host_timeouts, lines_executed=len(self.executed), blocks_executed=self.blocks_done,
                           motion_time=motion, rx_overflow_bytes=self.rx_overflow,
                           eeprom_lost_bytes=self.eeprom_lost, max_rx_used=self.max_rx, state=self.state,
                           spindle=self.spindle_mode, spindle_s=self.spindle_s, resets=self.resets,

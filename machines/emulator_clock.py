@@ -15,7 +15,8 @@ grows (when the emulator or the host is late the clock stands still, it never ru
 The host is the one input the clock cannot foresee. When the parser waits for a line and
 the ideal host of `emulator_host` could already have sent one that would arrive before
 the next event, the clock stands still and waits for the host in wall time, up to
-a timeout (HOST_PATIENCE x the host's recent median, within HOST_TIMEOUT); a host
+a timeout (HOST_PATIENCE x the host's recent median, within HOST_TIMEOUT, at least
+STREAMING_HOST_TIMEOUT for a host that pipelines); a host
 that sends nothing for that long is "quiet" and the clock runs on without it until its
 next line (a line sent later than that starts no earlier than the clock then: the only
 way a slow host can cost machine time, at most what the planner still held, and it
@@ -40,8 +41,10 @@ from collections import deque
 PARTICIPANTS = 2  # the protocol and motion threads
 # Wall seconds the clock waits for a host that owes a line: HOST_PATIENCE times the median
 # of the host's recent answers (they grow when the host computer is busy), within bounds.
+# A streaming (pipelining) host always has its next line ready mid-job: wait longer for it.
 HOST_PATIENCE = 50.0
 HOST_TIMEOUT = (0.1, 1.0)
+STREAMING_HOST_TIMEOUT = 0.5  # the shortest wait for a pipelining host
 
 
 class EmulatorClock:
@@ -56,6 +59,7 @@ class EmulatorClock:
         self._waiting: dict[int, float] = {}  # participant thread -> clock deadline (inf: none)
         self._changes = 0  # bumped by every state change that may wake a participant
         self._host_quiet = False
+        self.host_timeouts = 0  # waits for the host that ran out (see EmulatorStats.host_timeouts)
         self._host_delays: deque[float] = deque([0.005], maxlen=64)  # wall seconds the host took
         self._parser_idle = False  # the protocol thread waits for a line from the host
 
@@ -144,11 +148,14 @@ class EmulatorClock:
         """(lock held) The host could send a line now: wait for it, in wall time only."""
         start, lines = time.monotonic(), self._rx_cum
         low, high = HOST_TIMEOUT
+        if self._host_pipelines:
+            low = STREAMING_HOST_TIMEOUT
         deadline = start + min(high, max(low, HOST_PATIENCE * statistics.median(self._host_delays)))
         while changes == self._changes and not self._stopping:
             left = deadline - time.monotonic()
             if left <= 0:
                 self._host_quiet = True
+                self.host_timeouts += 1
                 return
             self._cond.wait(left)
         if self._rx_cum != lines:

@@ -20,6 +20,7 @@ from machines.grbl_codes import describe_error
 from machines.grbl_protocol import MAX_LINE_CHARS, clean_line
 from machines.planner_model import Kinematics, plan_times
 from onestroke.errors import InputError
+from onestroke.progress import ProgressCallback, Stage
 from onestroke.textfile import read_text
 
 SETTINGS_REFUSED = ("a '$' system command inside a job (e.g. $RST=* resets every setting, $32=0 leaves the beam "
@@ -228,12 +229,14 @@ class _Columns:
 def analyze_program(program: Program, *, settings: Mapping[int, float] | None = None,
                     start: Sequence[float] = (0.0, 0.0, 0.0),
                     offsets: Mapping[str, Sequence[float]] | None = None,
-                    planner_blocks: int = 15, allow_settings: bool = True) -> ProgramStats:
+                    planner_blocks: int = 15, allow_settings: bool = True,
+                    progress: ProgressCallback | None = None) -> ProgramStats:
     """Interpret `program` as GRBL 1.1h would with `settings` ($$), from machine position
     `start` (mm) and work offsets from `$#` ({"G54": (x, y, z), ..., "G92": ...}).
 
     allow_settings: False reports every `$` line as an error (a job should not change
     the machine's settings); True skips them like any sender that passes them through.
+    progress: an `onestroke.progress.ProgressCallback` (lines read).
     """
     settings = dict(settings or {})
     kin = Kinematics.from_settings(settings, planner_blocks=planner_blocks)
@@ -259,7 +262,9 @@ def analyze_program(program: Program, *, settings: Mapping[int, float] | None = 
     # index of the next line that is not plain (plain runs are read in bulk)
     other = np.flatnonzero([bool(r[5]) for r in rows]) if rows is not None else np.arange(len(texts))
     index = 0
+    report = Stage(progress, "reading G-code", len(texts), "lines")
     while index < len(texts):
+        report.set(index)
         if rows is not None and not rows[index][5]:
             run_end = int(other[np.searchsorted(other, index)]) if len(other) and other[-1] >= index else len(texts)
             run = read_plain_run(rows[index:run_end], interp)
@@ -308,6 +313,7 @@ def analyze_program(program: Program, *, settings: Mapping[int, float] | None = 
             cols.mv.append((motion.kind, motion.start[:2], motion.end[:2],
                             motion.centre[:2] if motion.centre else (np.nan, np.nan),
                             np.nan if motion.kind == 0 else st.feed, st.s, on, number - 1))
+    report.finish()
     (starts, ends, feeds, rapids, stops, seg_move, seg_index, seg_burn), moves = cols.arrays()
     seconds = plan_times(starts, ends, feeds, rapids, stops, kin)
     segments = Segments(starts, ends, feeds, rapids, stops, seg_move, seg_index, seconds)

@@ -30,6 +30,7 @@ from machines.gcode_program import GcodeMoves, Program, ProgramStats, analyze_pr
 from machines.grbl_settings import settings_from_profile
 from machines.laser_profile import LaserProfile
 from machines.planner_model import Kinematics, block_table, trapezoid, window_limits
+from onestroke.progress import ProgressCallback
 
 # A USB-serial adapter delivers a burst about half a millisecond after it was written
 # (about 1 ms for a round trip, grbl.md); the emulator uses the same figure.
@@ -179,15 +180,18 @@ def _block_profile(b: int, seen: int, v0: float, length, accel, nominal, max_ent
 
 
 def estimate_program_time(program: Program, profile: LaserProfile, *, stats: ProgramStats | None = None,
-                          link: bool = True, allow_settings: bool = False) -> JobTime:
+                          link: bool = True, allow_settings: bool = False,
+                          progress: ProgressCallback | None = None) -> JobTime:
     """`JobTime` of `program` on the machine `profile` describes (see the module doc).
 
     link: False models the planner alone (lines arrive instantly). allow_settings: see
-    `analyze_program` (False: `$` lines are reported in `errors`).
+    `analyze_program` (False: `$` lines are reported in `errors`). progress: an
+    `onestroke.progress.ProgressCallback` (lines read), when `stats` is not given.
     """
     if stats is None:
         stats = analyze_program(program, settings=settings_from_profile(profile),
-                                planner_blocks=profile.planner_blocks, allow_settings=allow_settings)
+                                planner_blocks=profile.planner_blocks, allow_settings=allow_settings,
+                                progress=progress)
     seg, moves = stats.segments, stats.moves
     seconds = seg.seconds
     planner = stats.total_seconds
@@ -227,9 +231,11 @@ def _line_ends(stats: ProgramStats, block_end: np.ndarray, n: int) -> np.ndarray
     return out
 
 
-def estimate_job_time(lines: Sequence[str], profile: LaserProfile, *, link: bool = True) -> JobTime:
-    """`JobTime` of G-code given as lines (str, without line ends)."""
-    return estimate_program_time(program_from_lines(lines), profile, link=link)
+def estimate_job_time(lines: Sequence[str], profile: LaserProfile, *, link: bool = True,
+                      progress: ProgressCallback | None = None) -> JobTime:
+    """`JobTime` of G-code given as lines (str, without line ends); `progress` as in
+    `estimate_program_time`."""
+    return estimate_program_time(program_from_lines(lines), profile, link=link, progress=progress)
 
 
 def read_moves(lines: Sequence[str], profile: LaserProfile) -> tuple[GcodeMoves, ProgramStats]:

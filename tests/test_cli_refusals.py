@@ -20,6 +20,7 @@ import pytest
 from click.testing import CliRunner
 from PIL import Image, ImageDraw
 
+from benchmarks.large_inputs import many_paths_svg
 from fabrication.cli import main
 from vectorize.drawing import Drawing
 from vectorize.stroke import Stroke
@@ -63,6 +64,7 @@ def folder(tmp_path_factory):
     os.link(base / "d.svg", base / "hard.svg")
     (base / "dir.pes").mkdir()
     os.symlink(base / "x.gcode", base / "x.frame.gcode")  # laser -o x.gcode --frame writes it: the same file
+    (base / "many.svg").write_text(many_paths_svg(300), encoding="utf-8")
     return base
 
 
@@ -151,6 +153,62 @@ def test_shared_options_are_spelled_and_checked_the_same_on_every_command(folder
         lines[command] = (result.exit_code, result.stderr.strip())
     assert len(lines) >= 3 and set(lines.values()) == {(2, f"error: {message}")}, lines
     assert list(tmp_path.iterdir()) == []
+
+
+# 6. long work shows progress: (arguments, a progress line that must appear when stderr is
+# not a terminal). ONESTROKE_PROGRESS_SECONDS=0 prints every report instead of one line
+# every 5 s, so a small input shows what a large one shows over minutes.
+PROGRESS = [
+    (["vectorize", "{in}/many.svg", "-o", "{out}/a.svg"], "vectorizing many.svg: reading shapes: 100 %"),
+    (["embroider", "{in}/many.svg", "-o", "{out}/a.pes", "--size", "180mm", "--hoop", "200x200"],
+     "planning the stitches: stitching: 100 % (300/300 strokes)"),
+    (["laser", "{in}/many.svg", "-o", "{out}/a.gcode", "--size", "180mm"],
+     "planning the toolpath: reading G-code: 100 %"),
+    (["laser", "{in}/many.svg", "-o", "{out}/a.gcode", "--size", "180mm"],
+     "planning the toolpath: flattening: 100 % (300/300 strokes)"),
+    (["preview", "{in}/many.svg", "-o", "{out}/a.png"], "reading many.svg: parsing: 100 %"),
+    (["preview", "{in}/job.gcode", "-o", "{out}/a.png"], "drawing job.gcode: reading G-code: 100 % (7/7 lines)"),
+]
+
+
+def _percentages(stderr: str) -> dict[str, list[int]]:
+    """Percent figures of the plain progress lines, by step and stage."""
+    import re
+
+    found: dict[str, list[int]] = {}
+    for line in stderr.splitlines():
+        match = re.match(r"(.+): (\d+) % \(", line)
+        if match:
+            found.setdefault(match.group(1), []).append(int(match.group(2)))
+    return found
+
+
+@pytest.mark.parametrize("args,line", PROGRESS, ids=[f"6:{a[0]} {a[1][5:]}" for a, _ in PROGRESS])
+def test_progress_lines_when_not_on_a_terminal(folder, tmp_path, monkeypatch, args, line):
+    argv = [a.replace("{in}", str(folder)).replace("{out}", str(tmp_path)) for a in args]
+    monkeypatch.setenv("ONESTROKE_PROGRESS_SECONDS", "0")
+    result = CliRunner().invoke(main, argv)
+    assert result.exit_code == 0, result.output
+    assert line in result.stderr, result.stderr
+    stages = _percentages(result.stderr)
+    assert stages and all(p == sorted(p) and p[-1] == 100 for p in stages.values()), stages
+    # a short step stays quiet at the default pace (here: one line a minute at most)
+    monkeypatch.setenv("ONESTROKE_PROGRESS_SECONDS", "60")
+    quiet = CliRunner().invoke(main, argv)
+    assert quiet.exit_code == 0 and _percentages(quiet.stderr) == {}, quiet.stderr
+
+
+def test_progress_through_a_real_pipe(folder, tmp_path):
+    """A real process with stderr piped: plain lines with percentages, the summary on stdout."""
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join(sys.path), "ONESTROKE_PROGRESS_SECONDS": "0"}
+    done = subprocess.run([sys.executable, "-m", "fabrication.cli", "embroider", str(folder / "many.svg"), "-o",
+                           str(tmp_path / "a.pes"), "--size", "180mm", "--hoop", "200x200"],
+                          capture_output=True, text=True, env=env, timeout=600)
+    assert done.returncode == 0, done.stderr
+    stages = _percentages(done.stderr)
+    assert stages["planning the stitches: stitching"][-1] == 100 and stages["reading many.svg: parsing"][-1] == 100
+    assert "\x1b[" not in done.stderr  # no terminal codes in a pipe
+    assert done.stdout.startswith(f"wrote {tmp_path / 'a.pes'}")
 
 
 def test_laser_blur_exists_and_threshold_hint_does_not_chase_itself(folder, tmp_path):

@@ -16,6 +16,8 @@ from emulator_fixtures import emulator, hear_ctrl_c, stream_in_child  # noqa: F4
 from fabrication.cli import main
 from machines.emulator import Faults
 from machines.gcode_program import program_from_text
+from machines.job_time import estimate_program_time
+from machines.laser_profile import load_laser_profile
 from machines.ports import open_port
 from machines.streamer import DRAIN_LINE, GrblStreamer, StreamOptions
 from onestroke.errors import MachineError
@@ -78,6 +80,28 @@ def test_send_response_is_slower_on_dense_work(emulator):
     # machine time: a round trip per line (USB latency both ways, the answer's wire time)
     # starves the planner on dense work, whatever the host computer's load
     assert times[False] < 1.02 and times[True] > times[False] + 0.05
+
+
+def test_machine_time_is_the_estimate_s_whatever_the_host_s_load(emulator):
+    # dense 0.1 mm lines at F5000: the link, the parser and a starved planner all count
+    text = job_text(400, step=0.1, feed=5000)
+    estimate = estimate_program_time(program_from_text(text + DRAIN_LINE + "\n"), load_laser_profile())
+    times = []
+    for busy in (False, True):
+        stop = threading.Event()
+        if busy:  # a host that is slow to answer: another thread of this process spins
+            threading.Thread(target=lambda: [None for _ in iter(stop.is_set, True)], daemon=True).start()
+        emu = emulator(time_scale=4.0)
+        try:
+            stream(emu, text)
+        finally:
+            stop.set()
+        assert emu.executed == cleaned(text) + [DRAIN_LINE]
+        times.append(emu.stats().job_time)
+    print(f"\nmachine time {times[0]:.3f} s, with a busy host {times[1]:.3f} s; estimate "
+          f"{estimate.total_seconds:.3f} s ({estimate.bound})")
+    assert times[1] == pytest.approx(times[0], rel=0.01)
+    assert estimate.total_seconds == pytest.approx(times[0], rel=0.01)
 
 
 def test_pause_and_resume_lose_and_repeat_nothing(emulator):

@@ -93,6 +93,18 @@ def test_each_edit_kind_and_cached_replay_equal_fresh(loop_png):
     assert drawing_to_svg(start.drawing) == drawing_to_svg(results["reverse"].drawing)
 
 
+def test_mode_and_threshold_reuse_earlier_stages(loop_png):
+    """Multi-stroke mode shares binarization and the medial axis with single-line mode, and a
+    new threshold shares the paper-flattened gray: the cached answers equal fresh runs."""
+    cache = StageCache()
+    vectorize_file(loop_png, OPTIONS, edits=Edits(), cache=cache)
+    for edits in (Edits(multi=True), Edits(threshold=0.45), Edits(threshold=0.45, multi=True)):
+        cached = vectorize_file(loop_png, OPTIONS, edits=edits, cache=cache)
+        fresh = vectorize_file(loop_png, OPTIONS, edits=edits)
+        assert drawing_to_svg(cached.drawing) == drawing_to_svg(fresh.drawing), edits
+    assert (len(cache.paper), len(cache.axis), len(cache.front)) == (1, 2, 4)
+
+
 def test_unmatched_edit_is_a_warning(loop_png):
     result = vectorize_file(loop_png, OPTIONS, edits=Edits(items=(Edit(kind="split", at=(2.0, 2.0)),)))
     assert any("matched nothing" in w for w in result.report.warnings)

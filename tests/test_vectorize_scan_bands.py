@@ -37,7 +37,9 @@ def drawing(mode: str, size=(1003, 777), seed: int = 0) -> Image.Image:
     if mode == "LA":
         return Image.merge("LA", (base, base.transpose(Image.Transpose.FLIP_LEFT_RIGHT)))
     if mode in ("P", "P-alpha"):
-        return colour.quantize(100)
+        indexed = Image.frombytes("P", size, (gray % 100).tobytes())
+        indexed.putpalette(rng.integers(0, 256, 300, dtype=np.uint8).tobytes())
+        return indexed
     if mode == "I;16":
         return Image.fromarray(gray.astype(np.uint16) * 257 + rng.integers(0, 256, gray.shape, dtype=np.uint16))
     raise ValueError(mode)

@@ -9,6 +9,7 @@ import numpy as np
 from scipy.interpolate import splev, splprep
 
 from vectorize.ink_guard import InkGuard, curve_excess, keep_in_ink
+from vectorize.retraces import Twin, mirror_flags, mirror_keep, rolled, share_pieces, twin_piece, valid_twins
 from vectorize.stroke import Stroke
 
 
@@ -28,15 +29,24 @@ def _dedupe(points: np.ndarray, min_step: float) -> np.ndarray:
     """Drop points closer than `min_step` to the previous kept one (splprep needs distinct points)."""
     if len(points) < 2:
         return points
-    keep = [0]
-    last = points[0]
-    for i in range(1, len(points)):
-        if np.linalg.norm(points[i] - last) >= min_step:
-            keep.append(i)
-            last = points[i]
-    if keep[-1] != len(points) - 1 and np.linalg.norm(points[-1] - points[keep[-1]]) > 1e-9:
-        keep[-1] = len(points) - 1
-    return points[keep]
+    n = len(points)
+    steps = np.linalg.norm(np.diff(points, axis=0), axis=1)
+    keep = np.ones(n, dtype=bool)
+    # A point is measured from the last kept one, which is its predecessor unless that one
+    # was dropped: only the runs that start with a short step need walking point by point.
+    done = 0
+    for i in (np.flatnonzero(steps < min_step) + 1).tolist():
+        if i <= done:
+            continue
+        last = i - 1
+        while i < n and np.linalg.norm(points[i] - points[last]) < min_step:
+            keep[i] = False
+            i += 1
+        done = i
+    kept = np.flatnonzero(keep)
+    if kept[-1] != n - 1 and np.linalg.norm(points[-1] - points[kept[-1]]) > 1e-9:
+        kept[-1] = n - 1
+    return points[kept]
 
 
 def bspline_to_bezier(tck, u_start: float, u_end: float) -> np.ndarray:
@@ -152,10 +162,11 @@ def _open_fit(points: np.ndarray, sigma: float) -> np.ndarray:
 
 
 def fit_stroke(traced: list[TracedPoint], *, closed: bool, sigma: float, stroke_width: float,
-               guard: InkGuard | None = None) -> Stroke:
+               guard: InkGuard | None = None, twins: tuple[Twin, ...] = ()) -> Stroke:
     """Filter, split at sharp features (Y-feet tips, cusps, corners) and fit one traversed
     stroke; with `guard`, every piece is brought back inside the ink where it strays
-    (`vectorize.ink_guard`)."""
+    (`vectorize.ink_guard`). twins: stretches the stroke draws twice (`vectorize.retraces`):
+    fitted once, the later pass repeats the earlier one's curve."""
     xy = np.array([p.xy for p in traced])
     keep = np.array([p.keep for p in traced])
     split = np.array([p.split for p in traced])
@@ -164,6 +175,8 @@ def fit_stroke(traced: list[TracedPoint], *, closed: bool, sigma: float, stroke_
     corner[found[keep[found] & ~split[found]]] = True
     corner |= np.array([p.corner for p in traced], dtype=bool)
     split |= corner
+    twins = valid_twins(xy, twins)
+    mirror_flags(twins, split, corner)
     split_at = np.flatnonzero(split)
     if closed and split_at.size and len(xy) > 3:
         # Where a closed line starts cannot be read from the ink; start at its top-left
@@ -173,17 +186,28 @@ def fit_stroke(traced: list[TracedPoint], *, closed: bool, sigma: float, stroke_
             split_at = np.flatnonzero(split)
         shift = int(split_at[np.argmin(xy[split_at].sum(axis=1))])
         xy, keep, split, corner = (np.roll(a, -shift, axis=0) for a in (xy, keep, split, corner))
+        twins = rolled(twins, shift, len(xy))
         xy = np.vstack([xy, xy[:1]])
         keep, split, corner = np.append(keep, keep[0]), np.append(split, split[0]), np.append(corner, corner[0])
         closed = False
+        twins = valid_twins(xy, twins)
     # Around a corner the axis is off the centre line for about a stroke width: leave it out.
     arc = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(xy, axis=0), axis=1))])
     for i in np.flatnonzero(corner):
         keep &= np.abs(arc - arc[i]) > stroke_width
+    mirror_keep(twins, keep)
     cuts = [0] + [int(i) for i in np.flatnonzero(split) if 0 < i < len(xy) - 1] + [len(xy) - 1]
     pieces = []
     previous = None
+    fitted: dict[tuple[int, int], int] = {}
     for lo, hi in zip(cuts[:-1], cuts[1:]):
+        source = twin_piece(twins, lo, hi)
+        if source is not None and source[:2] in fitted:
+            # The later pass over a retraced stretch: the earlier pass's curve.
+            control = pieces[fitted[source[:2]]]
+            pieces.append(np.array(control[::-1, ::-1] if source[2] else control))
+            previous = None
+            continue
         mask = keep[lo:hi + 1].copy()
         if not closed:
             mask[0] = mask[-1] = True
@@ -206,6 +230,7 @@ def fit_stroke(traced: list[TracedPoint], *, closed: bool, sigma: float, stroke_
                     whole = np.vstack([whole, whole[:1]])
                 control = keep_in_ink(whole, control, guard, _open_fit, sigma)
         previous = piece
+        fitted[(lo, hi)] = len(pieces)
         pieces.append(np.array(control))  # writable: the joints move its ends
     # Join the pieces: at corners where their sides meet, elsewhere where they end.
     joints = list(zip(range(len(pieces) - 1), range(1, len(pieces)), cuts[1:-1]))
@@ -237,5 +262,6 @@ def fit_stroke(traced: list[TracedPoint], *, closed: bool, sigma: float, stroke_
                 continue  # a closed piece has no joints: it was checked when fitted
             whole[0], whole[-1] = pieces[k][0, 0], pieces[k][-1, 3]
             pieces[k] = keep_in_ink(whole, _open_fit(whole, sigma), guard, _open_fit, sigma)
+    share_pieces(twins, cuts, pieces)
     control = np.concatenate(pieces, axis=0)
     return Stroke(control)

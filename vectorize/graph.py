@@ -8,6 +8,7 @@ The graph is mutable while the stages simplify it; stages hand on finished resul
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from functools import cached_property
 
 import numpy as np
 
@@ -30,11 +31,13 @@ class Branch:
     def edge_lengths(self) -> np.ndarray:
         return np.linalg.norm(np.diff(self.points, axis=0), axis=1)
 
-    @property
+    # Cached: pruning asks every leaf for both on every round, and a branch's arrays are
+    # never changed once made (stages replace branches instead).
+    @cached_property
     def length(self) -> float:
         return float(self.edge_lengths.sum())
 
-    @property
+    @cached_property
     def significance(self) -> float:
         """Length-weighted mean sine of the object angle (vanishing-angle measure)."""
         lengths = self.edge_lengths

@@ -2,9 +2,11 @@
 
 from __future__ import annotations
 
+from itertools import chain
+
 import numpy as np
 from scipy.ndimage import map_coordinates
-from scipy.spatial import Voronoi, cKDTree
+from scipy.spatial import Voronoi
 
 from onestroke.errors import VectorizeError
 from vectorize.graph import Branch, MedialGraph
@@ -34,7 +36,10 @@ def medial_axis(rings: list[np.ndarray], gray: np.ndarray, level: float) -> Medi
     if len(samples) < 8:
         raise VectorizeError("the ink is too small to find its centre line")
     voronoi = Voronoi(samples)
-    ridge_vertices = np.array(voronoi.ridge_vertices, dtype=np.int64)
+    # In the plane every ridge has two vertices (-1: at infinity); flattening the list of
+    # pairs costs half of building an array from it.
+    ridge_vertices = np.fromiter(chain.from_iterable(voronoi.ridge_vertices), dtype=np.int64,
+                                 count=2 * len(voronoi.ridge_vertices)).reshape(-1, 2)
     ridge_points = voronoi.ridge_points
     p, q = ridge_points[:, 0], ridge_points[:, 1]
     gap = np.abs(index_in_ring[p] - index_in_ring[q])
@@ -57,7 +62,10 @@ def medial_axis(rings: list[np.ndarray], gray: np.ndarray, level: float) -> Medi
     used, local = np.unique(edges, return_inverse=True)
     local = local.reshape(-1, 2)
     xy = voronoi.vertices[used]
-    radius = cKDTree(samples).query(xy)[0]
+    # A Voronoi vertex is equally far from its generating samples and no sample is nearer
+    # (the empty circle): its radius is the distance to either sample of any ridge it ends.
+    radius = np.empty(len(used))
+    radius[local] = np.linalg.norm(xy[local] - samples[p[keep]][:, None, :], axis=2)
     return _collapse_chains(xy, radius, local, sins)
 
 
@@ -81,24 +89,30 @@ def _collapse_chains(xy: np.ndarray, radius: np.ndarray, edges: np.ndarray, sins
             node_of[vertex] = graph.add_node(xy[vertex], radius[vertex])
         return node_of[vertex]
 
-    visited = np.zeros(len(edges), dtype=bool)
+    visited = bytearray(len(edges))
+    # For a degree-2 vertex: its two (edge, neighbour) pairs, to step along a chain.
+    two = degree == 2
+    at = np.minimum(start[:-1], len(ends) - 2)
+    first_e, first_n = np.where(two, edge_ids[at], -1).tolist(), np.where(two, ends[at], -1).tolist()
+    second_e, second_n = np.where(two, edge_ids[at + 1], -1).tolist(), np.where(two, ends[at + 1], -1).tolist()
 
     def walk(first: int, k: int) -> None:
         path, path_edges = [first], []
-        prev, e = first, eid[start_l[first] + k]
+        e = eid[start_l[first] + k]
         cur = nbr[start_l[first] + k]
         while True:
-            visited[e] = True
+            visited[e] = 1
             path.append(cur)
             path_edges.append(e)
             if degree_l[cur] != 2 or cur in node_of:
                 break
-            s = start_l[cur]
-            e2 = eid[s] if eid[s] != e else eid[s + 1]
-            nxt = nbr[s] if eid[s] != e else nbr[s + 1]
+            if first_e[cur] != e:
+                e2, nxt = first_e[cur], first_n[cur]
+            else:
+                e2, nxt = second_e[cur], second_n[cur]
             if visited[e2]:
                 break
-            prev, cur, e = cur, nxt, e2
+            cur, e = nxt, e2
         a, b = node_for(path[0]), node_for(path[-1])
         graph.add_branch(Branch(a, b, xy[path], radius[path], sins[path_edges]))
 
@@ -109,7 +123,7 @@ def _collapse_chains(xy: np.ndarray, radius: np.ndarray, edges: np.ndarray, sins
             if not visited[eid[start_l[vertex] + k]]:
                 walk(vertex, k)
     # What is left are closed chains of degree-2 vertices: give each one node and walk it.
-    for e in np.flatnonzero(~visited).tolist():
+    for e in np.flatnonzero(np.frombuffer(visited, dtype=np.uint8) == 0).tolist():
         if visited[e]:
             continue
         vertex = int(edges[e, 0])

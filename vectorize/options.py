@@ -54,7 +54,8 @@ class VectorizeReport:
     out-and-back features kept; dropped_components: ink pieces left out (single-line mode);
     gaps_bridged: pen gaps joined across (single-line mode, `gaps.py`);
     high_degree_junctions: nodes where three or more strokes meet (not resolved);
-    scale: working px per input px (< 1 when downscaled); seconds: wall time per stage.
+    scale: working px per input px (< 1 when downscaled); seconds: wall time per stage;
+    cpu_seconds: CPU time of the process (all threads) per stage.
     """
 
     strokes: int = 0
@@ -68,6 +69,7 @@ class VectorizeReport:
     stroke_width: float = 0.0
     warnings: tuple[str, ...] = ()
     seconds: dict = field(default_factory=dict)
+    cpu_seconds: dict = field(default_factory=dict)
 
     @property
     def total_seconds(self) -> float:

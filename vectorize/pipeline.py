@@ -21,11 +21,12 @@ __all__ = ["InputFrame", "VectorizeOptions", "VectorizeReport", "VectorizeResult
 
 
 def vectorize_file(path: str | os.PathLike, options: VectorizeOptions = VectorizeOptions(), *,
-                   edits=None, cache=None) -> VectorizeResult:
+                   edits=None, cache=None, progress=None) -> VectorizeResult:
     """Vectorize a raster image or read an SVG (strokes as they are; outlines to centre lines).
 
     edits: a `vectorize.edits.Edits` to apply; cache: a `vectorize.refine.StageCache`
     reused between calls on the same file (each edit then re-runs only later stages).
+    progress: an `onestroke.progress.ProgressCallback` for reading a large SVG.
     """
     path = str(path)
     if not os.path.exists(path):
@@ -34,7 +35,7 @@ def vectorize_file(path: str | os.PathLike, options: VectorizeOptions = Vectoriz
         raise InputError(f"input {path!r} is a directory, not an image")
     suffix = os.path.splitext(path)[1].lower()
     if suffix in (".svg", ".svgz"):
-        return _vectorize_svg(path, options, edits, cache)
+        return _vectorize_svg(path, options, edits, cache, progress)
     if cache is not None and cache.loaded is not None and cache.loaded[0] == (path, options.max_size):
         image, frame = cache.loaded[1]
     else:
@@ -46,11 +47,12 @@ def vectorize_file(path: str | os.PathLike, options: VectorizeOptions = Vectoriz
     return vectorize_image(image, options, frame=frame, edits=edits, cache=cache)
 
 
-def _vectorize_svg(path: str, options: VectorizeOptions, edits=None, cache=None) -> VectorizeResult:
+def _vectorize_svg(path: str, options: VectorizeOptions, edits=None, cache=None,
+                   progress=None) -> VectorizeResult:
     from vectorize.svg_read import read_svg
 
     start = time.perf_counter()
-    content = read_svg(path)
+    content = read_svg(path, progress=progress)
     if content.is_outline:
         from vectorize.outline_svg import rasterize_rings
 

@@ -23,35 +23,55 @@ from vectorize.simplify import _merge
 KEEP = 12
 
 
+# Entries of the image-sized stages (a working gray image, an ink image, ~4 MB each at
+# 1000 px): the last few slider positions.
+KEEP_IMAGES = 6
+
+
 class StageCache:
-    """Results of the early stages for one image (the studio keeps one per drawing)."""
+    """Results of the early stages for one image (the studio keeps one per drawing).
+
+    paper: (blur, max_size) -> (gray, scale) of `vectorize.binarize.paper_gray` (the
+    threshold does not change it); axis: (threshold, blur, max_size) -> (ink, rings,
+    medial graph before pruning) (the mode does not change them); front: `front_key` ->
+    the pruned (and in single-line mode bridged) graph with its ink.
+    """
 
     def __init__(self) -> None:
         self.loaded = None  # ((path, max_size), (image, frame)) of the last file read
+        self.paper: dict = {}
+        self.axis: dict = {}
         self.front: dict = {}
         self.simplified: dict = {}
         self.solved: dict = {}
         self._image = None
 
     def front_for(self, image, options, compute):
-        """Binarization to gap bridging for these options, computed once."""
+        """Binarization to gap bridging for these options, computed once; compute(cache)
+        may use `stage` for the parts that fewer options change."""
         if self._image is not image:
-            self.front.clear()
-            self.simplified.clear()
-            self.solved.clear()
+            for store in (self.paper, self.axis, self.front, self.simplified, self.solved):
+                store.clear()
             self._image = image
         key = front_key(options)
         if key not in self.front:
-            _bounded_put(self.front, key, compute())
+            _bounded_put(self.front, key, compute(self))
         return self.front[key]
+
+    def stage(self, name: str, key: tuple, compute):
+        """The cached result of stage `name` ("paper" or "axis") for `key`, computed once."""
+        store = getattr(self, name)
+        if key not in store:
+            _bounded_put(store, key, compute(), KEEP_IMAGES)
+        return store[key]
 
 
 def front_key(options) -> tuple:
     return (options.threshold, options.blur, options.multi, options.max_size)
 
 
-def _bounded_put(store: dict, key, value) -> None:
-    while len(store) >= KEEP:
+def _bounded_put(store: dict, key, value, keep: int = KEEP) -> None:
+    while len(store) >= keep:
         store.pop(next(iter(store)))
     store[key] = value
 

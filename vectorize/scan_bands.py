@@ -11,7 +11,9 @@ and its pages are handed back to the OS (madvise DONTNEED). Peak memory is then 
 To know exactly which rows the decoder has written, the compressed data is inflated here
 with zlib and forwarded to the decoder band by band re-wrapped as stored (level 0) deflate
 blocks: the decoder then has every row of a band the moment it is given it. Filtering,
-unpacking and bit depths stay Pillow's.
+unpacking and bit depths stay Pillow's. (A band-sized target per band is not possible:
+the decoder's row counter, previous row and inflate state live with the one target it is
+given, and calling `setimage` again would leak and undersize its row buffer.)
 
 Everything else (TIFF, whose compressed strips Pillow only decodes all at once through
 libtiff; interlaced PNG; BMP, GIF, WebP) is decoded whole in its native mode (one byte a

@@ -27,6 +27,31 @@ def _bezier_points(control: np.ndarray, t: np.ndarray) -> np.ndarray:
     return u * u * u * p0 + 3 * u * u * t * p1 + 3 * u * t * t * p2 + t * t * t * p3
 
 
+def curve_bounds(control: np.ndarray) -> tuple[float, float, float, float]:
+    """(xmin, ymin, xmax, ymax) of cubic segments `control` (K, 4, 2), of any number of
+    strokes at once (`Drawing.bounds` stacks them: one pass instead of one per stroke)."""
+    control = np.asarray(control, dtype=float)
+    p0, p1, p2, p3 = (control[:, i] for i in range(4))
+    a = -p0 + 3 * p1 - 3 * p2 + p3  # B'(t) / 3 = a t^2 + 2 b t + c, per segment and axis
+    b = p0 - 2 * p1 + p2
+    c = p1 - p0
+    disc = b * b - a * c
+    root = np.sqrt(np.maximum(disc, 0.0))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        linear = np.abs(a) < 1e-12
+        t = np.stack([np.where(linear, -c / (2 * b), (-b + root) / a),
+                      np.where(linear, np.nan, (-b - root) / a)], axis=-1)
+    inside = (t > 0) & (t < 1) & (disc[..., None] >= 0)
+    t = np.where(inside, t, 0.0)
+    u = 1 - t
+    values = (u**3 * p0[..., None] + 3 * u * u * t * p1[..., None]
+              + 3 * u * t * t * p2[..., None] + t**3 * p3[..., None])
+    values = np.where(inside, values, p0[..., None])
+    lo = np.minimum(np.minimum(p0, p3).min(axis=0), values.min(axis=(0, 2)))
+    hi = np.maximum(np.maximum(p0, p3).max(axis=0), values.max(axis=(0, 2)))
+    return float(lo[0]), float(lo[1]), float(hi[0]), float(hi[1])
+
+
 @dataclass(frozen=True, eq=False)
 class Stroke:
     """A cubic Bézier spline: `control` has shape (K, 4, 2), x right, y down.
@@ -45,10 +70,11 @@ class Stroke:
         control = np.array(self.control, dtype=float)
         if control.ndim != 3 or control.shape[1:] != (4, 2) or len(control) == 0:
             raise InputError(f"stroke control points must have shape (K, 4, 2), got {control.shape}")
-        if not np.all(np.isfinite(control)):
-            raise InputError("stroke control points must be finite numbers")
-        if np.abs(control).max() > MAX_COORDINATE:
-            raise InputError(f"stroke coordinate {np.abs(control).max():.3g} is beyond the limit of "
+        largest = np.abs(control).max()
+        if not largest <= MAX_COORDINATE:  # one pass: NaN and infinity fail this test too
+            if not np.all(np.isfinite(control)):
+                raise InputError("stroke control points must be finite numbers")
+            raise InputError(f"stroke coordinate {largest:.3g} is beyond the limit of "
                              f"{MAX_COORDINATE:.0e} (px or mm)")
         control.setflags(write=False)
         object.__setattr__(self, "control", control)
@@ -110,25 +136,7 @@ class Stroke:
         Exact: the end points of every segment and its interior extremes, where the
         derivative (a quadratic per axis) vanishes.
         """
-        p0, p1, p2, p3 = (self.control[:, i] for i in range(4))
-        a = -p0 + 3 * p1 - 3 * p2 + p3  # B'(t) / 3 = a t^2 + 2 b t + c, per segment and axis
-        b = p0 - 2 * p1 + p2
-        c = p1 - p0
-        disc = b * b - a * c
-        root = np.sqrt(np.maximum(disc, 0.0))
-        with np.errstate(divide="ignore", invalid="ignore"):
-            linear = np.abs(a) < 1e-12
-            t = np.stack([np.where(linear, -c / (2 * b), (-b + root) / a),
-                          np.where(linear, np.nan, (-b - root) / a)], axis=-1)
-        inside = (t > 0) & (t < 1) & (disc[..., None] >= 0)
-        t = np.where(inside, t, 0.0)
-        u = 1 - t
-        values = (u**3 * p0[..., None] + 3 * u * u * t * p1[..., None]
-                  + 3 * u * t * t * p2[..., None] + t**3 * p3[..., None])
-        values = np.where(inside, values, p0[..., None])
-        lo = np.minimum(np.minimum(p0, p3).min(axis=0), values.min(axis=(0, 2)))
-        hi = np.maximum(np.maximum(p0, p3).max(axis=0), values.max(axis=(0, 2)))
-        return float(lo[0]), float(lo[1]), float(hi[0]), float(hi[1])
+        return curve_bounds(self.control)
 
     # -- evaluation --------------------------------------------------------------------
     def _split_parameter(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

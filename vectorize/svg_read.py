@@ -25,6 +25,7 @@ import numpy as np
 import svgelements as se
 
 from onestroke.errors import InputError
+from onestroke.progress import ProgressCallback, Stage, counted
 from vectorize.drawing import Drawing
 from vectorize.stroke import MAX_COORDINATE, Stroke
 
@@ -58,42 +59,48 @@ class SvgContent:
         return Drawing(self.strokes, self.width, self.height, "px", self.stroke_width)
 
 
-def _segment_control(segment) -> np.ndarray | None:
-    """Control points (4, 2) of one svgelements segment as a cubic, or None for a move."""
+def _segment_row(segment) -> tuple[float, ...] | None:
+    """Control points of one svgelements segment as a cubic, flat (x0, y0, ..., x3, y3), or
+    None for a move. Plain floats: one array per path, not one per segment (a 20,000-path
+    file has 60,000 segments or more)."""
     if isinstance(segment, se.CubicBezier):
-        pts = [segment.start, segment.control1, segment.control2, segment.end]
-        return np.array([[p.x, p.y] for p in pts], dtype=float)
+        a, b, c, d = segment.start, segment.control1, segment.control2, segment.end
+        return (a.x, a.y, b.x, b.y, c.x, c.y, d.x, d.y)
     if isinstance(segment, se.QuadraticBezier):
         p0, q, p3 = (np.array([p.x, p.y], dtype=float) for p in (segment.start, segment.control, segment.end))
-        return np.array([p0, p0 + 2 / 3 * (q - p0), p3 + 2 / 3 * (q - p3), p3])
+        return tuple(np.array([p0, p0 + 2 / 3 * (q - p0), p3 + 2 / 3 * (q - p3), p3]).ravel())
     if isinstance(segment, (se.Line, se.Close)):
         if segment.start is None or segment.end is None:
             return None
         a = np.array([segment.start.x, segment.start.y], dtype=float)
         b = np.array([segment.end.x, segment.end.y], dtype=float)
-        return np.array([a, a + (b - a) / 3, a + 2 * (b - a) / 3, b])
+        return tuple(np.array([a, a + (b - a) / 3, a + 2 * (b - a) / 3, b]).ravel())
     return None
 
 
-def _subpaths(path: se.Path) -> list[np.ndarray]:
+def _subpaths(path) -> list[np.ndarray]:
     """Cubic control arrays (K, 4, 2), one per sub-path, zero-length pieces dropped."""
     result: list[np.ndarray] = []
-    current: list[np.ndarray] = []
+    current: list[tuple[float, ...]] = []
+
+    def close() -> None:
+        if current:
+            control = np.array(current, dtype=float).reshape(-1, 4, 2)
+            keep = np.ptp(control, axis=1).max(axis=1) > 1e-9
+            if keep.any():
+                result.append(control[keep])
+
     for segment in path:
         if isinstance(segment, se.Move):
-            if current:
-                result.append(np.array(current))
+            close()
             current = []
             continue
         if isinstance(segment, se.Arc):
-            pieces = [_segment_control(c) for c in segment.as_cubic_curves()]
+            rows = [_segment_row(c) for c in segment.as_cubic_curves()]
         else:
-            pieces = [_segment_control(segment)]
-        for piece in pieces:
-            if piece is not None and np.ptp(piece, axis=0).max() > 1e-9:
-                current.append(piece)
-    if current:
-        result.append(np.array(current))
+            rows = [_segment_row(segment)]
+        current.extend(row for row in rows if row is not None)
+    close()
     return result
 
 
@@ -164,14 +171,37 @@ def _rgb(paint) -> tuple[int, int, int] | None:
         return None
 
 
-def read_svg(path: str | os.PathLike) -> SvgContent:
-    """Parse an SVG file into strokes and outline rings (px at 96 dpi, transforms applied)."""
+class _CountingReader:
+    """A binary file that reports how much of it was read (svgelements parses as it reads)."""
+
+    def __init__(self, handle, report: Stage) -> None:
+        self.handle, self.report = handle, report
+
+    def read(self, size: int = -1) -> bytes:
+        data = self.handle.read(size)
+        self.report.advance(len(data))
+        return data
+
+
+def read_svg(path: str | os.PathLike, *, progress: ProgressCallback | None = None) -> SvgContent:
+    """Parse an SVG file into strokes and outline rings (px at 96 dpi, transforms applied).
+
+    progress: called with `onestroke.progress.Progress` reports (bytes parsed, then shapes read).
+    """
     path = str(path)
     if not os.path.isfile(path):
         raise InputError(f"input file {path!r} does not exist")
     source = _svg_source(path)
     try:
-        svg = se.SVG.parse(source, reify=True)
+        if progress is not None:
+            opened = open(source, "rb") if isinstance(source, str) else source
+            with opened:
+                size = os.fstat(opened.fileno()).st_size if isinstance(source, str) else len(source.getvalue())
+                parsing = Stage(progress, "parsing", size, "bytes")
+                svg = se.SVG.parse(_CountingReader(opened, parsing), reify=True)
+                parsing.finish()
+        else:
+            svg = se.SVG.parse(source, reify=True)
     except Exception as error:  # svgelements raises many kinds on malformed XML
         raise InputError(f"cannot read SVG {path!r}: {str(error).splitlines()[0] if str(error) else type(error).__name__}") from None
     if svg is None:
@@ -184,18 +214,23 @@ def read_svg(path: str | os.PathLike) -> SvgContent:
         elements = list(svg.elements())
     except (ValueError, ArithmeticError, AttributeError, TypeError) as error:
         raise InputError(f"cannot read SVG {path!r}: {error}") from None
-    for element in elements:
+    for element in counted(elements, progress, "reading shapes", len(elements), "elements"):
         if not isinstance(element, se.Shape) or isinstance(element, se.Text):
             continue
         if element.values.get("visibility") == "hidden" or element.values.get("display") == "none":
             continue
-        try:
-            bbox = element.bbox()
-        except (ValueError, ArithmeticError, TypeError):
-            bbox = None
-        if bbox is not None:
-            _check_coordinates(np.asarray(bbox, dtype=float), element, path)
-        path_obj = se.Path(element)
+        if isinstance(element, se.Path) and element.transform.is_identity():
+            # Its control points are checked below; they bound the curve (the exact bbox of
+            # svgelements costs more than reading the path).
+            path_obj = element
+        else:
+            try:
+                bbox = element.bbox()
+            except (ValueError, ArithmeticError, TypeError):
+                bbox = None
+            if bbox is not None:
+                _check_coordinates(np.asarray(bbox, dtype=float), element, path)
+            path_obj = se.Path(element)
         stroked = _has_paint(element.stroke)
         filled = _has_paint(element.fill)
         color = _rgb(element.stroke) if stroked else None

@@ -9,7 +9,7 @@ from typing import NamedTuple
 import numpy as np
 
 from onestroke.errors import InputError
-from vectorize.binarize import binarize
+from vectorize.binarize import ink_image, paper_gray
 from vectorize.drawing import Drawing
 from vectorize.edits import Edits
 from vectorize.fitting import TracedPoint, fit_stroke
@@ -24,6 +24,7 @@ from vectorize.outline import outline_rings
 from vectorize.options import InputFrame, VectorizeOptions, VectorizeReport, VectorizeResult
 from vectorize.pruning import prune, trim_free_ends
 from vectorize.refine import Refinement, StageCache
+from vectorize.retraces import Twin, foot_is_retraced, twin_spans
 from vectorize.route_inspection import connect_pairings, plan_routes
 from vectorize.simplify import Simplified, is_t_shape, directions, simplify, slots
 from vectorize.stroke import Stroke
@@ -43,14 +44,20 @@ SMOOTHER_TOUCH = 0.85
 
 
 class _Clock:
+    """Wall and CPU seconds per stage (CPU: on a shared machine the wall time includes
+    waiting for a core)."""
+
     def __init__(self) -> None:
         self.seconds: dict[str, float] = {}
+        self.cpu_seconds: dict[str, float] = {}
         self._last = time.perf_counter()
+        self._last_cpu = time.process_time()
 
     def lap(self, stage: str) -> None:
-        now = time.perf_counter()
+        now, cpu = time.perf_counter(), time.process_time()
         self.seconds[stage] = self.seconds.get(stage, 0.0) + now - self._last
-        self._last = now
+        self.cpu_seconds[stage] = self.cpu_seconds.get(stage, 0.0) + cpu - self._last_cpu
+        self._last, self._last_cpu = now, cpu
 
 
 def _junctions(graph: MedialGraph, nodes, stroke_width: float) -> list[Junction]:
@@ -95,12 +102,16 @@ def _pairing_costs(verdict: JunctionVerdict) -> tuple[float, float, float]:
 
 
 def _trace(graph: MedialGraph, simple: Simplified, ordering: Ordering, junctions: dict,
-           verdicts: dict, stroke_width: float) -> list[tuple[list[TracedPoint], bool]]:
-    """Turn branch passes into point lists flagged for filtering (paper 3.4)."""
+           verdicts: dict, stroke_width: float) -> list[tuple[list[TracedPoint], bool, list[Twin]]]:
+    """Turn branch passes into point lists flagged for filtering (paper 3.4), with the
+    stretches each stroke draws twice (`vectorize.retraces`)."""
     # V-spikes: the foot is where both sides' inks merge, its points are uncertain; the
     # sides run straight to the tip. Retraced (T) spikes: the foot is the spike itself,
     # its points are good, and the line turns sharply at both of its ends.
-    foot_branches = {slots(graph, n)[f][0] for n, f in simple.y_feet.items() if n not in simple.retraced}
+    # V-spikes whose foot runs on far beyond the corner are a line drawn down and back up:
+    # there the foot is the centre line both passes follow (`vectorize.retraces`).
+    foot_branches = {slots(graph, n)[f][0] for n, f in simple.y_feet.items()
+                     if n not in simple.retraced and not foot_is_retraced(graph, n, f, stroke_width)}
     sharp_points = [graph.positions[n] for n in simple.retraced]
     crossing_of = dict(zip(simple.crossings, ordering.choice))
     # Uncertain zone around each degree-4 node: where the two strokes' inks still overlap.
@@ -122,34 +133,44 @@ def _trace(graph: MedialGraph, simple: Simplified, ordering: Ordering, junctions
         reach = float(np.clip(graph.spans.get(node, 0.0) + stroke_width, graph.radii[node], 12.0 * stroke_width))
         zones.append((graph.positions[node], reach, True))
     result = []
+    # Not retraced stretches: a loop (its direction cannot be told from where it starts) and
+    # the foot of a V-spike (each side of the V runs to the tip on its own ink).
+    not_twins = {bid for bid, b in graph.branches.items() if b.a == b.b} | foot_branches
     for passes, closed in zip(ordering.strokes, ordering.closed):
-        traced: list[TracedPoint] = []
+        parts, keeps, tips, spans = [], [], [], []
+        count = 0  # traced points so far
         for index, step in enumerate(passes):
             branch = graph.branches[step.branch]
             # By end, not by node: a loop starts and ends at the same node.
             points = branch.points if step.start == "a" else branch.points[::-1]
             far_node = branch.b if step.start == "a" else branch.a
             points = points if index == 0 else points[1:]
+            spans.append((max(count - 1, 0), count + len(points) - 1))
+            if not len(points):
+                continue
+            count += len(points)
             on_foot = step.branch in foot_branches
             # The pen turns back on itself: a cusp (the fit splits there, never loops).
             turns_back = (index + 1 < len(passes) and passes[index + 1].branch == step.branch
                           and passes[index + 1].start != step.start)
-            for k, xy in enumerate(points):
-                last = k == len(points) - 1
-                tip = last and (far_node in simple.y_tips or turns_back)
-                keep = (not on_foot) or tip
-                traced.append(TracedPoint(xy, keep, tip))
-        xy = np.array([t.xy for t in traced])
+            tip = np.zeros(len(points), dtype=bool)
+            tip[-1] = far_node in simple.y_tips or turns_back
+            parts.append(points)
+            keeps.append(tip | (not on_foot))
+            tips.append(tip)
+        twins = twin_spans([p.branch for p in passes], [p.start for p in passes], spans, not_twins)
+        if not parts:
+            result.append(([], closed, twins))
+            continue
+        xy, keep, split = np.concatenate(parts), np.concatenate(keeps), np.concatenate(tips)
         for base in sharp_points:
-            for i in np.flatnonzero(np.all(xy == base, axis=1)):
-                traced[i] = TracedPoint(traced[i].xy, traced[i].keep, True, traced[i].corner)
+            split[np.all(xy == base, axis=1)] = True
         for center, reach, crossing in zones:
             dist = np.linalg.norm(xy - center, axis=1)
-            for i in np.flatnonzero(dist < reach):
-                at_node = dist[i] < 1e-6
-                traced[i] = TracedPoint(traced[i].xy, crossing and at_node and traced[i].keep, traced[i].split,
-                                        traced[i].corner)
-        result.append((traced, closed))
+            near = dist < reach
+            keep[near] &= crossing & (dist[near] < 1e-6)
+        traced = [TracedPoint(p, k, t) for p, k, t in zip(xy, keep.tolist(), split.tolist())]
+        result.append((traced, closed, twins))
     return result
 
 
@@ -259,12 +280,16 @@ def _refuse_noise(count: int, what: str, limit: int, threshold: float, given: bo
                          f"drawing; {hint}")
 
 
-def _front(image: np.ndarray, options: VectorizeOptions, clock: _Clock):
-    """Binarize, outline, medial axis, pruning and (single-line) gap bridging: the stages
-    that only threshold, blur and mode change. Returns (ink, rings, graph, bridged, dropped)."""
+def _axis(image: np.ndarray, options: VectorizeOptions, clock: _Clock, cache: StageCache | None = None):
+    """Binarize, outline and medial axis: the stages that threshold and blur change, and the
+    mode does not. Returns (ink, rings, graph before pruning)."""
     # Every piece of ink is kept here; in single-line mode the pieces of a line broken by
-    # pen gaps are bridged below, and only then is the largest kept.
-    ink = binarize(image, max_size=options.max_size, blur=options.blur, threshold=options.threshold)
+    # pen gaps are bridged later, and only then is the largest kept.
+    def paper():
+        return paper_gray(image, max_size=options.max_size, blur=options.blur)
+
+    gray, scale = paper() if cache is None else cache.stage("paper", (options.blur, options.max_size), paper)
+    ink = ink_image(gray, scale, threshold=options.threshold)
     clock.lap("binarize")
     w = ink.stroke_width
     spacing = float(np.clip(w / 8.0, 0.3, 1.0))
@@ -276,6 +301,22 @@ def _front(image: np.ndarray, options: VectorizeOptions, clock: _Clock):
                   options.threshold is not None)
     graph = medial_axis(rings, ink.gray, ink.threshold)
     clock.lap("medial axis")
+    return ink, rings, graph
+
+
+def _front(image: np.ndarray, options: VectorizeOptions, clock: _Clock, cache: StageCache | None = None):
+    """Binarize, outline, medial axis, pruning and (single-line) gap bridging: the stages
+    that only threshold, blur and mode change. Returns (ink, rings, graph, bridged, dropped).
+
+    With `cache`, the stages before pruning are shared between the modes (a copy of the
+    cached graph is pruned) and the paper-flattened gray between thresholds."""
+    if cache is None:
+        ink, rings, graph = _axis(image, options, clock)
+    else:
+        key = (options.threshold, options.blur, options.max_size)
+        ink, rings, graph = cache.stage("axis", key, lambda: _axis(image, options, clock, cache))
+        graph = graph.copy()
+    w = ink.stroke_width
     prune(graph, threshold=PRUNE_MULTI if options.multi else PRUNE_SINGLE, stroke_width=w)
     trim_free_ends(graph, stroke_width=w)
     clock.lap("pruning")
@@ -306,7 +347,7 @@ def run_pipeline(image: np.ndarray, options: VectorizeOptions, *,
         edits = edits if edits is not None else Edits()
         options = edits.applied_to(options)
         cache = cache if cache is not None else StageCache()
-        front = cache.front_for(image, options, lambda: _front(image, options, clock))
+        front = cache.front_for(image, options, lambda stages: _front(image, options, clock, stages))
     else:
         front = _front(image, options, clock)
     ink, rings, graph, bridged, dropped = front
@@ -337,10 +378,11 @@ def run_pipeline(image: np.ndarray, options: VectorizeOptions, *,
     sigma = float(np.clip(0.065 * w, 0.15, 0.8))
     guard = InkGuard(graph, ink.gray, ink.threshold) if solved is None else None
     strokes = list(solved[1]) if solved is not None else []
-    for traced, closed in _trace(graph, simple, ordering, junctions, verdicts, w) if solved is None else ():
+    for traced, closed, twins in _trace(graph, simple, ordering, junctions, verdicts, w) if solved is None else ():
         if len(traced) < 2:
             continue
-        strokes.append(_orient(fit_stroke(traced, closed=closed, sigma=sigma, stroke_width=w, guard=guard), closed))
+        strokes.append(_orient(fit_stroke(traced, closed=closed, sigma=sigma, stroke_width=w, guard=guard,
+                                          twins=tuple(twins)), closed))
     if refine is not None and solved is None:
         refine.keep_solved(best, strokes)
     strokes = [s for s in strokes if s.length > 0.5 * w or len(strokes) == 1]
@@ -371,7 +413,8 @@ def run_pipeline(image: np.ndarray, options: VectorizeOptions, *,
     report = VectorizeReport(
         strokes=len(strokes), intersections=len(simple.crossings), y_junctions=len(simple.y_feet),
         dropped_components=dropped, gaps_bridged=bridged, high_degree_junctions=len(simple.unresolved), retries=tried - 1,
-        scale=scale, stroke_width=w / scale, warnings=tuple(warnings), seconds=clock.seconds)
+        scale=scale, stroke_width=w / scale, warnings=tuple(warnings), seconds=clock.seconds,
+        cpu_seconds=clock.cpu_seconds)
     if stages is not None:
         stages.update(simplified=graph, simple=simple, junctions=junctions, verdicts=verdicts,
                       ordering=ordering, working_strokes=strokes)

@@ -14,10 +14,91 @@ def warn(message: str) -> None:
     console.print(f"[yellow]warning:[/yellow] {message}", soft_wrap=True)
 
 
-def step(description: str):
-    """A live status line (spinner, stage name) while a step runs, on a terminal only: in a
-    log or a pipe nothing but the final summary is printed."""
-    return console.status(description)
+# Seconds between plain progress lines when stderr is not a terminal (a log, a pipe), the
+# streamer's pace too; ONESTROKE_PROGRESS_SECONDS changes it (0: a line at every report).
+PROGRESS_EVERY = 5.0
+
+
+def progress_every() -> float:
+    """Seconds between plain progress lines: ONESTROKE_PROGRESS_SECONDS, else PROGRESS_EVERY."""
+    import math
+    import os
+
+    try:
+        value = float(os.environ.get("ONESTROKE_PROGRESS_SECONDS", PROGRESS_EVERY))
+    except ValueError:
+        return PROGRESS_EVERY
+    return value if math.isfinite(value) and value >= 0 else PROGRESS_EVERY
+
+
+class _StepProgress:
+    """The display of one step. On a terminal: a spinner and the step's name, then a bar
+    with percent and time remaining once the library reports how far it is (transient: it
+    goes when the step ends). Elsewhere: one plain line every `progress_every()` seconds,
+    so a step shorter than that prints nothing."""
+
+    def __init__(self, description: str) -> None:
+        self.description = description
+        self.every = progress_every()
+        self.bar = None
+        self.task = None
+        self.started = 0.0
+        self.next_line = 0.0
+        self.stage = None
+        self.stage_started = 0.0
+
+    def __enter__(self) -> "_StepProgress":
+        import time
+
+        self.started = time.monotonic()
+        self.next_line = self.started + self.every
+        if console.is_terminal:
+            from rich.progress import (BarColumn, Progress, SpinnerColumn, TaskProgressColumn, TextColumn,
+                                       TimeRemainingColumn)
+
+            self.bar = Progress(SpinnerColumn(), TextColumn("{task.description}"), BarColumn(),
+                                TaskProgressColumn(), TimeRemainingColumn(), console=console, transient=True)
+            self.bar.start()
+            self.task = self.bar.add_task(self.description, total=None)
+        return self
+
+    def __exit__(self, *exc) -> None:
+        if self.bar is not None:
+            self.bar.stop()
+
+    def __call__(self, report) -> None:
+        """Take one `onestroke.progress.Progress` report."""
+        import time
+
+        what = f"{self.description}: {report.stage}" if report.stage else self.description
+        if self.bar is not None:
+            self.bar.update(self.task, description=what, total=max(report.total, 1),
+                            completed=min(report.done, report.total) if report.total else 1)
+            return
+        now = time.monotonic()
+        if report.stage != self.stage:
+            self.stage, self.stage_started = report.stage, now
+        if now < self.next_line:
+            return
+        self.next_line = now + self.every
+        from machines.job_time import format_duration
+
+        elapsed = now - self.started
+        # the rate of this stage so far; its first report has none yet
+        spent = now - self.stage_started
+        remaining = (f", about {format_duration(spent * (1 - report.fraction) / report.fraction)} left"
+                     if 0 < report.fraction < 1 and spent > 0 else "")
+        unit = f" {report.unit}" if report.unit else ""
+        console.print(f"{what}: {100 * report.fraction:.0f} % ({report.done:,}/{report.total:,}{unit}), "
+                      f"elapsed {format_duration(elapsed)}{remaining}", highlight=False, soft_wrap=True)
+
+
+def step(description: str) -> _StepProgress:
+    """`with step("planning the stitches") as progress:` shows the step while it runs; pass
+    `progress` to the library call as its progress callback (see `onestroke.progress`).
+    On a terminal a transient spinner, then bar; in a log or a pipe a plain line every few
+    seconds; a short step leaves nothing but the command's final summary."""
+    return _StepProgress(description)
 
 
 def done(message: str) -> None:
@@ -26,17 +107,19 @@ def done(message: str) -> None:
 
 
 def read_drawing(path: str, *, multi: bool = False, threshold: float | None = None,
-                 blur: float = 0.0, classifier: str = "cnn", edits: str | None = None):
+                 blur: float = 0.0, classifier: str = "cnn", edits: str | None = None, progress=None):
     """Read a drawing from a raster image or SVG, printing the vectorizer's warnings.
 
-    edits: path of an edits file (the studio's corrections) to replay.
+    edits: path of an edits file (the studio's corrections) to replay; progress: a step's
+    progress callback (`step`).
     """
     from vectorize import VectorizeOptions, vectorize_file
     from vectorize.edits import read_edits
 
     replay = read_edits(edits) if edits is not None else None
     result = vectorize_file(path, VectorizeOptions(multi=multi, threshold=threshold, blur=blur,
-                                                   classifier=classifier), edits=replay)
+                                                   classifier=classifier), edits=replay,
+                             progress=progress)
     for message in result.report.warnings:
         warn(message)
     return result.drawing

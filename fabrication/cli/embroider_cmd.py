@@ -137,11 +137,11 @@ def embroider(source: str, output: str, style: str, size: float | None, width: f
     else:
         from fabrication.cli.common import read_drawing
 
-        with step(f"reading {os.path.basename(source)}"):
+        with step(f"reading {os.path.basename(source)}") as progress:
             drawing = read_drawing(source, multi=multi, threshold=threshold, blur=blur,
-                                   classifier=classifier, edits=edits)
-    with step("planning the stitches"):
-        result = embroider_drawing(drawing, job)
+                                   classifier=classifier, edits=edits, progress=progress)
+    with step("planning the stitches") as progress:
+        result = embroider_drawing(drawing, job, progress=progress)
     with step(f"writing {os.path.basename(output)}"):
         write_embroidery(result.plan, output, pes_version=pes_version)
     if preview_path is not None:

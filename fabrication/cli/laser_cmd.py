@@ -8,7 +8,7 @@ from pathlib import Path
 
 import click
 
-from fabrication.cli.common import console, done, edits_option, warn
+from fabrication.cli.common import console, done, edits_option, step, warn
 from fabrication.cli.options import (Integer, Length, Percent, Speed, drawing_input_options, input_argument,
                                      machine_options, output_option, placement_options)
 from onestroke.atomic import check_writable
@@ -89,11 +89,12 @@ def laser(source: str, output: str, size: float | None, width: float | None, hei
     for message in settings.warnings:
         warn(message)
 
-    with console.status(f"reading {os.path.basename(source)}"):
+    with step(f"reading {os.path.basename(source)}") as progress:
         drawing = read_drawing(source, multi=multi, threshold=threshold, blur=blur, classifier=classifier,
-                               edits=edits)
-    with console.status("planning the toolpath"):
-        program = laser_program(drawing, profile, settings.toolpath, settings.gcode, name=Path(source).name)
+                               edits=edits, progress=progress)
+    with step("planning the toolpath") as progress:
+        program = laser_program(drawing, profile, settings.toolpath, settings.gcode, name=Path(source).name,
+                                progress=progress)
     toolpath, job, lines = program.toolpath, program.time, list(program.lines)
     w, h = toolpath.size
     frame_lines = framing_lines(toolpath.bounds, power_s=frame_fraction * profile.max_power,
@@ -106,7 +107,8 @@ def laser(source: str, output: str, size: float | None, width: float | None, hei
     if preview_path is not None:
         from fabrication.laser.preview import render_gcode_preview
 
-        render_gcode_preview(output, preview_path, profile=profile)
+        with step("drawing the preview") as progress:
+            render_gcode_preview(output, preview_path, profile=profile, progress=progress)
 
     if toolpath.dropped:
         warn(f"{toolpath.dropped} stroke(s) of zero length left out")

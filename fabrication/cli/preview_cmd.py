@@ -52,8 +52,8 @@ def preview(source: str, output: str, width_px: int, hoop: str | None, spm: floa
     if suffix in GCODE_SUFFIXES:
         from fabrication.laser.preview import render_gcode_preview
 
-        with step(f"drawing {os.path.basename(source)}"):
-            job = render_gcode_preview(source, output)
+        with step(f"drawing {os.path.basename(source)}") as progress:
+            job = render_gcode_preview(source, output, progress=progress)
         minutes, seconds = divmod(int(round(job.total_seconds)), 60)
         done(f"wrote {output}: laser job about {minutes} min {seconds:02d} s")
         return
@@ -74,8 +74,8 @@ def preview(source: str, output: str, width_px: int, hoop: str | None, spm: floa
         else:
             from fabrication.cli.common import read_drawing
 
-            with step(f"reading {os.path.basename(source)}"):
-                drawing = read_drawing(source)
+            with step(f"reading {os.path.basename(source)}") as progress:
+                drawing = read_drawing(source, progress=progress)
         with step("drawing the preview"):
             render_drawing_preview(drawing, output, options)
         done(f"wrote {output}: {len(drawing.strokes)} stroke(s), length {drawing.length:.1f} {drawing.unit}")

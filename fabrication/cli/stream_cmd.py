@@ -17,6 +17,7 @@ import click
 from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
 
 from fabrication.cli.common import console, done, warn
+from fabrication.cli.common import progress_every as plain_progress_every
 from fabrication.cli.options import BAUD_RATES, Integer, Number, input_argument, machine_options, output_option
 from machines.framing import DEFAULT_FRAME_FEED, framing_lines
 from machines.gcode_program import Program, analyze_program, load_program, program_from_text
@@ -99,12 +100,9 @@ def _key_controls(streamer: GrblStreamer, enabled: bool):
         termios.tcsetattr(fd, termios.TCSADRAIN, saved)
 
 
-PROGRESS_EVERY = 5.0  # seconds between plain progress lines when not on a terminal
-
-
 def run_stream(gcode_path, *, port: str, baud: int = 115200, check: bool = False, frame: bool = False,
                profile: str | os.PathLike | None = None, from_line: int | None = None, reset: bool = True,
-               allow_settings: bool = False, progress_every: float = PROGRESS_EVERY) -> None:
+               allow_settings: bool = False, progress_every: float | None = None) -> None:
     """Connect to `port`, check the job against the machine, stream it with a progress bar
     and print a summary. `check` streams in GRBL's check mode ($C, nothing moves); `frame`
     only traces the job's bounding box with the beam off. `profile`: a laser profile TOML
@@ -112,9 +110,12 @@ def run_stream(gcode_path, *, port: str, baud: int = 115200, check: bool = False
     failure), moving there with the beam off first. `reset`: False attaches without a soft
     reset (refused while the controller runs a job). `allow_settings`: let `$` lines of the
     file through (otherwise the pre-check refuses them). `progress_every`: seconds between
-    plain progress lines when the output is not a terminal. Raises OnestrokeError on any
+    plain progress lines when the output is not a terminal (None: the CLI's pace, 5 s or
+    ONESTROKE_PROGRESS_SECONDS). Raises OnestrokeError on any
     failure."""
     path = Path(gcode_path)
+    if progress_every is None:
+        progress_every = plain_progress_every()
     program = load_program(path)
     if from_line is not None:
         # The job's own start is the machine origin unless it moves there itself.

@@ -7,7 +7,7 @@ import time
 
 import click
 
-from fabrication.cli.common import console, done, edits_option, warn
+from fabrication.cli.common import console, done, edits_option, step, warn
 from fabrication.cli.options import drawing_input_options, input_argument, output_option
 from onestroke.errors import InputError
 from onestroke.paths import check_distinct
@@ -37,8 +37,8 @@ def vectorize(source: str, output: str, multi: bool, threshold: float | None, bl
     started = time.perf_counter()
     options = VectorizeOptions(multi=multi, threshold=threshold, blur=blur, classifier=classifier,
                                keep_stages=debug_dir is not None)
-    with console.status(f"vectorizing {os.path.basename(source)}"):
-        result = vectorize_file(source, options, edits=replay)
+    with step(f"vectorizing {os.path.basename(source)}") as progress:
+        result = vectorize_file(source, options, edits=replay, progress=progress)
     for message in result.report.warnings:
         warn(message)
     write_drawing(result.drawing, output)

@@ -63,8 +63,9 @@ class EmbroideryResult:
     warnings: tuple[str, ...]
 
 
-def embroider(drawing: Drawing, job: EmbroideryJob = EmbroideryJob()) -> EmbroideryResult:
-    """Place `drawing`, fit it to the hoop, stitch it and measure the result."""
+def embroider(drawing: Drawing, job: EmbroideryJob = EmbroideryJob(), *, progress=None) -> EmbroideryResult:
+    """Place `drawing`, fit it to the hoop, stitch it and measure the result.
+    progress: an `onestroke.progress.ProgressCallback` (strokes stitched)."""
     warnings: list[str] = []
     placed = place(drawing, job.placement)
     hooped = fit_to_hoop(placed, job.hoop, reach=style_reach(job.plan.style), fit=job.fit)
@@ -80,7 +81,7 @@ def embroider(drawing: Drawing, job: EmbroideryJob = EmbroideryJob()) -> Embroid
     if isinstance(style, ZigzagOptions) and style.width > LOOSE_ZIGZAG:
         warnings.append(f"zigzag stitches {style.width:g} mm wide lie loose and snag (over "
                         f"{LOOSE_ZIGZAG:g} mm); use a narrower --stitch-width")
-    plan = plan_embroidery(hooped, job.plan)
+    plan = plan_embroidery(hooped, job.plan, progress=progress)
     check_plan_in_hoop(plan, job.hoop)
     warnings.extend(plan.dropped)
     if len(job.plan.colors) > len(drawing.strokes):

@@ -30,6 +30,7 @@ from fabrication.embroidery.thread import RGB, Thread, check_chart
 from fabrication.embroidery.triple import TripleOptions, triple_stitch
 from fabrication.embroidery.zigzag import ZigzagOptions, zigzag_stitch
 from onestroke.errors import FabricationError, InputError
+from onestroke.progress import ProgressCallback, Stage
 from vectorize.drawing import Drawing
 from vectorize.stroke import Stroke
 
@@ -278,9 +279,9 @@ def _chain_points(drawing: Drawing, chain: list[int], options: PlanOptions, offs
     return merged, np.concatenate(owners), offset
 
 
-def _assemble(drawing: Drawing, block: tuple[int, ...], options: PlanOptions):
+def _assemble(drawing: Drawing, block: tuple[int, ...], options: PlanOptions, progress=None):
     """Rows before cleanup: float points, kinds, roles, params, owners, blocks; and the
-    lines about dropped strokes."""
+    lines about dropped strokes. `progress`: reports per stroke stitched."""
     pts, kinds, roles, params, owners, blocks = [], [], [], [], [], []
     current: np.ndarray | None = None
     current_block = block[0] if block else 0
@@ -296,6 +297,7 @@ def _assemble(drawing: Drawing, block: tuple[int, ...], options: PlanOptions):
         blocks.append(np.full(len(p), current_block, dtype=np.int64))
 
     chains, dropped = _chains(drawing, block, options)
+    report = Stage(progress, "stitching", sum(len(chain) for chain in chains), "strokes")
     for chain in chains:
         body, owner, offset = _chain_points(drawing, chain, options, offset)
         path = body.points
@@ -321,6 +323,8 @@ def _assemble(drawing: Drawing, block: tuple[int, ...], options: PlanOptions):
         add(path, STITCH, body_roles, body.t, owner)
         add(lock_points(tail, options.lock), STITCH, LOCK, body.t[-1], last)
         current = path[-1]
+        report.advance(len(chain))
+    report.finish()
     if not pts:
         raise InputError("no stroke is long enough to stitch (all shorter than --min-stroke "
                          f"{options.min_stroke:g} mm and far from the others)")
@@ -414,9 +418,11 @@ def _split_long(units, kinds, roles, params, owners, blocks, max_units: int):
     return new_units, kinds[owner], roles[owner], new_params, owners[owner], blocks[owner]
 
 
-def plan_embroidery(drawing: Drawing, options: PlanOptions = PlanOptions()) -> StitchPlan:
+def plan_embroidery(drawing: Drawing, options: PlanOptions = PlanOptions(), *,
+                    progress: ProgressCallback | None = None) -> StitchPlan:
     """Stitch every stroke of `drawing` (mm, centred on (0, 0)) into one `StitchPlan`:
-    colour blocks in sewing order (see `order.sewing_order`), rows indexing `plan.sewn`."""
+    colour blocks in sewing order (see `order.sewing_order`), rows indexing `plan.sewn`.
+    progress: an `onestroke.progress.ProgressCallback` (strokes stitched)."""
     if drawing.unit != "mm":
         raise InputError(f"place the drawing in mm before stitching (it is in {drawing.unit})")
     if not drawing.strokes:
@@ -424,7 +430,7 @@ def plan_embroidery(drawing: Drawing, options: PlanOptions = PlanOptions()) -> S
     order = sewing_order(drawing, colors=options.colors, default=options.color,
                          start=options.start, thread_chart=options.thread_chart)
     sewn = order.drawing
-    points, kinds, roles, params, owners, blocks, dropped = _assemble(sewn, order.block, options)
+    points, kinds, roles, params, owners, blocks, dropped = _assemble(sewn, order.block, options, progress)
     # Source stroke numbers in the messages, not positions in the sewing order.
     dropped = tuple(_renumber(line, order.source) for line in dropped)
     units = np.rint(points / options.grid).astype(np.int64)

@@ -20,6 +20,7 @@ from fabrication.laser.arcs import LINE
 from fabrication.laser.toolpath import BurnPath, Toolpath
 from machines.laser_profile import LaserProfile
 from onestroke.atomic import atomic_write_text
+from onestroke.progress import ProgressCallback, Stage
 from onestroke.errors import InputError
 
 MAX_LINE = 80  # GRBL's line buffer; longer lines get error:11
@@ -103,8 +104,9 @@ def _path_lines(path: BurnPath, position: tuple[str, str], first_words: str) -> 
 
 
 def gcode_lines(toolpath: Toolpath, profile: LaserProfile, options: GcodeOptions = GcodeOptions(), *,
-                comments: tuple[str, ...] = ()) -> list[str]:
-    """The whole program as lines without line endings (each <= 80 characters)."""
+                comments: tuple[str, ...] = (), progress: ProgressCallback | None = None) -> list[str]:
+    """The whole program as lines without line endings (each <= 80 characters).
+    progress: an `onestroke.progress.ProgressCallback` (strokes written, over all passes)."""
     air = profile.air_assist if options.air_assist is None else options.air_assist
     s_value = fmt(options.power * profile.max_power)
     first_words = f"S{s_value}F{fmt(options.feed)}"
@@ -114,11 +116,14 @@ def gcode_lines(toolpath: Toolpath, profile: LaserProfile, options: GcodeOptions
         lines.append("M8")
     # the head's position is unknown before the job: the first stroke always gets its G0
     position = ("", "")
+    report = Stage(progress, "writing G-code", options.passes * len(toolpath.paths), "strokes")
     for index in range(options.passes):
         paths = toolpath.paths if index % 2 == 0 else tuple(p.reversed() for p in toolpath.paths[::-1])
         for path in paths:
             more, position = _path_lines(path, position, first_words)
             lines.extend(more)
+            report.advance()
+    report.finish()
     lines += ["M5", "M9"]
     if options.return_home and position != ("0", "0"):
         lines.append("G0X0Y0")

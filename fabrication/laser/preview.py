@@ -57,6 +57,37 @@ def _bound_text(job: JobTime) -> str:
     return "bound: GRBL planner"
 
 
+def _burn_runs(moves, seg, burn_mask, first, last, fraction):
+    """Burn polylines with per-point colours, travel moves and the first burn point, in one
+    array pass over all moves (a 500,000-move job would otherwise loop in Python).
+
+    A run is a stretch of consecutive burn moves: its polyline is the first move's start,
+    then each move's points as GRBL cuts it (its chord ends, or its end without segments),
+    each point coloured by its move's position along the job.
+    """
+    on = np.flatnonzero(burn_mask)
+    off = np.flatnonzero(~burn_mask)
+    moving = np.any(moves.start[off] != moves.end[off], axis=1)
+    travel = [np.array([a, b]) for a, b in zip(moves.start[off[moving]], moves.end[off[moving]])]
+    if not len(on):
+        return [], travel, None
+    has = last[on] > first[on]
+    count = np.where(has, last[on] - first[on], 1)
+    owner = np.repeat(np.arange(len(on)), count)
+    row = np.repeat(first[on], count) + np.arange(count.sum()) - np.repeat(np.cumsum(count) - count, count)
+    points = np.where(np.repeat(has, count)[:, None], seg.end[np.minimum(row, max(len(seg.end) - 1, 0)), :2]
+                      if len(seg.end) else 0.0, moves.end[on[owner]])
+    colours = order_colours(fraction[on])[owner]
+    # a run starts at a burn move whose predecessor does not burn
+    opens = np.flatnonzero(np.r_[True, np.diff(on) > 1])
+    cuts = np.r_[np.cumsum(count)[opens[1:] - 1], len(points)]
+    burn, begin = [], 0
+    for move, end in zip(on[opens].tolist(), cuts.tolist()):
+        burn.append((np.vstack([moves.start[move][None], points[begin:end]]), colours[begin:end]))
+        begin = end
+    return burn, travel, moves.start[on[0]]
+
+
 def _scene(stats: ProgramStats, job: JobTime, profile: LaserProfile, name: str, n_lines: int) -> _Scene:
     moves, seg = stats.moves, stats.segments
     burn_mask = moves.laser_on
@@ -66,27 +97,7 @@ def _scene(stats: ProgramStats, job: JobTime, profile: LaserProfile, name: str, 
     last = np.searchsorted(seg.move, np.arange(len(moves)), side="right")
     along = np.cumsum(np.where(burn_mask, lengths, 0.0))
     total = max(along[-1] if len(along) else 0.0, 1e-12)
-    burn, travel, current, colours = [], [], [], []
-    start = None
-    for k in range(len(moves)):
-        a, b = moves.start[k], moves.end[k]
-        if not burn_mask[k]:
-            if current:
-                burn.append((np.vstack(current), np.vstack(colours)))
-                current, colours = [], []
-            if np.any(a != b):
-                travel.append(np.array([a, b]))
-            continue
-        if start is None:
-            start = a
-        pts = seg.end[first[k]:last[k], :2] if last[k] > first[k] else b[None]
-        if not current:
-            current.append(a[None])
-        current.append(pts)
-        frac = (along[k] - lengths[k] / 2) / total
-        colours.append(np.repeat(order_colours(np.array([frac])), len(pts), axis=0))
-    if current:
-        burn.append((np.vstack(current), np.vstack(colours)))
+    burn, travel, start = _burn_runs(moves, seg, burn_mask, first, last, (along - lengths / 2) / total)
     # the view is zoomed on what is burned; travel leaving it is clipped at the edge
     shown = [p for p, _ in burn] or travel
     if shown:
@@ -169,9 +180,12 @@ def _render_png(scene: _Scene, path: Path) -> None:
         for p, q in _dashes(a, b, 6.0, 5.0):
             draw.line([tuple(p), tuple(q)], fill=(140, 140, 140), width=1)
     for pts, colours in scene.burn:
-        px = view(pts)
-        for k in range(len(px) - 1):
-            draw.line([tuple(px[k]), tuple(px[k + 1])], fill=tuple(int(c) for c in colours[k]), width=2)
+        px = view(pts).tolist()
+        # one call per run of equal colour: PIL draws a polyline segment by segment, so the
+        # pixels are those of one call per segment
+        change = np.flatnonzero(np.r_[True, np.any(colours[1:] != colours[:-1], axis=1), True])
+        for s, e in zip(change[:-1].tolist(), change[1:].tolist()):
+            draw.line([tuple(p) for p in px[s:e + 1]], fill=tuple(int(c) for c in colours[s]), width=2)
     o = view(np.zeros(2))[0]
     draw.line([(o[0] - 8, o[1]), (o[0] + 8, o[1])], fill="black", width=2)
     draw.line([(o[0], o[1] - 8), (o[0], o[1] + 8)], fill="black", width=2)
@@ -253,10 +267,11 @@ def _render_svg(scene: _Scene, path: Path) -> None:
 
 
 def render_gcode_preview(gcode_path: str | os.PathLike, out_path: str | os.PathLike, *,
-                         profile: LaserProfile | None = None) -> JobTime:
+                         profile: LaserProfile | None = None, progress=None) -> JobTime:
     """Draw `gcode_path` into `out_path` (.png or .svg) and return its `JobTime`.
 
     profile: the machine (bed outline, time model); None uses the default profile.
+    progress: an `onestroke.progress.ProgressCallback` (G-code lines read).
     """
     out_path = Path(out_path)
     suffix = out_path.suffix.lower()
@@ -265,7 +280,8 @@ def render_gcode_preview(gcode_path: str | os.PathLike, out_path: str | os.PathL
     check_writable(out_path)
     profile = profile or load_laser_profile()
     program = load_program(gcode_path)
-    stats = analyze_program(program, settings=settings_from_profile(profile), planner_blocks=profile.planner_blocks)
+    stats = analyze_program(program, settings=settings_from_profile(profile), planner_blocks=profile.planner_blocks,
+                             progress=progress)
     if len(stats.moves) == 0:
         raise InputError(f"G-code file {str(gcode_path)!r} holds no moves to preview")
     job = estimate_program_time(program, profile, stats=stats)

@@ -31,12 +31,13 @@ class LaserProgram:
 
 
 def laser_program(drawing: Drawing, profile, toolpath_options: ToolpathOptions,
-                  gcode_options: GcodeOptions, *, name: str) -> LaserProgram:
+                  gcode_options: GcodeOptions, *, name: str, progress=None) -> LaserProgram:
     """Plan `drawing` for the laser `profile` and write its program; `name` (the input's file
-    name) goes into the header comment."""
-    toolpath = plan_toolpath(drawing, profile, toolpath_options)
-    lines = gcode_lines(toolpath, profile, gcode_options)
-    job = estimate_job_time(lines, profile)  # machines/ reads the G-code as GRBL will
+    name) goes into the header comment. progress: an `onestroke.progress.ProgressCallback`
+    (strokes planned, then G-code lines read back for the time estimate)."""
+    toolpath = plan_toolpath(drawing, profile, toolpath_options, progress=progress)
+    lines = gcode_lines(toolpath, profile, gcode_options, progress=progress)
+    job = estimate_job_time(lines, profile, progress=progress)  # machines/ reads the G-code as GRBL will
     if job.errors:  # the writer's bug, not the user's input: say so before writing anything
         line, text = job.errors[0]
         raise OnestrokeError(f"internal error: GRBL would refuse generated line {line}: {text}")

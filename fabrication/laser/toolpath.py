@@ -23,6 +23,7 @@ from fabrication.laser.travel_order import order_strokes, travel_length
 from fabrication.placement import PlacementOptions, place
 from machines.laser_profile import LaserProfile
 from onestroke.errors import InputError
+from onestroke.progress import ProgressCallback, counted
 from vectorize.drawing import Drawing
 from vectorize.stroke import Stroke
 
@@ -220,8 +221,10 @@ def _plan_stroke(stroke: Stroke, tolerance: float, arcs: bool, box) -> BurnPath 
 
 
 def plan_toolpath(drawing: Drawing, profile: LaserProfile,
-                  options: ToolpathOptions = ToolpathOptions()) -> Toolpath:
-    """Place `drawing` on the bed of `profile` and plan its burn paths (see module doc)."""
+                  options: ToolpathOptions = ToolpathOptions(), *,
+                  progress: ProgressCallback | None = None) -> Toolpath:
+    """Place `drawing` on the bed of `profile` and plan its burn paths (see module doc).
+    progress: an `onestroke.progress.ProgressCallback` (strokes flattened)."""
     if not drawing.strokes:
         raise InputError("the drawing has no strokes to engrave")
     machine = _to_machine(drawing, profile, options)
@@ -234,7 +237,7 @@ def plan_toolpath(drawing: Drawing, profile: LaserProfile,
     box = (0.0, 0.0, profile.bed_width, profile.bed_height)  # no arc may bulge out of the bed
     planned: list[tuple[BurnPath, Stroke]] = []
     dropped = 0
-    for stroke in machine.strokes:
+    for stroke in counted(machine.strokes, progress, "flattening", len(machine.strokes), "strokes"):
         path = _plan_stroke(stroke, options.tolerance, options.arcs, box)
         if path is None:
             dropped += 1
@@ -249,7 +252,7 @@ def plan_toolpath(drawing: Drawing, profile: LaserProfile,
     starts = np.array([p.points[0] for p, _ in planned])
     ends = np.array([p.points[-1] for p, _ in planned])
     if options.optimize:
-        result = order_strokes(starts, ends, origin=(0.0, 0.0))
+        result = order_strokes(starts, ends, origin=(0.0, 0.0), progress=progress)
         order, flipped = result.order, result.flipped
         before, greedy, after = result.before, result.greedy, result.after
     else:
