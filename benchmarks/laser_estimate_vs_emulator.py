@@ -12,7 +12,8 @@ drawings, the examples) and for dense 4,000-line jobs of 0.1 mm segments, it pri
   the last `ok`, whichever is later); median of --repeat runs;
 - diff: estimate / emulator - 1.
 The machine clock does not depend on the host's speed or load (machines/emulator_clock.py):
-the figures are the same on a quiet and a loaded machine, only the wall time differs.
+the figures do not change with the load (measured at load averages 12-21), only the wall time does;
+a row whose "host timeouts" exceeds 1 had a host stall that may have cost machine time.
 `--scale` only sets how fast the emulator paces its replies in wall time.
 
     python benchmarks/laser_estimate_vs_emulator.py [--scale 2] [--repeat 1] [--only dense] [--count N] [--match TEXT]

@@ -100,7 +100,7 @@ def test_machine_time_is_the_estimate_s_whatever_the_host_s_load(emulator):
         times.append(emu.stats().job_time)
     print(f"\nmachine time {times[0]:.3f} s, with a busy host {times[1]:.3f} s; estimate "
           f"{estimate.total_seconds:.3f} s ({estimate.bound})")
-    assert times[1] == pytest.approx(times[0], rel=0.005)
+    assert times[1] == pytest.approx(times[0], rel=0.01)
     assert estimate.total_seconds == pytest.approx(times[0], rel=0.01)
 
 
