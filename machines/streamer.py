@@ -136,6 +136,8 @@ class GrblStreamer(StreamConnect, StreamStops):
     def _write(self, data: bytes) -> None:
         try:
             with self._write_lock:
+                if not self.port.is_open:  # closed by close() while the poller was on its way
+                    raise serial.PortNotOpenError()
                 self.port.write(data)
         except (serial.SerialException, OSError) as error:
             raise MachineError(f"lost the connection to {self.name}: {error}") from None
@@ -145,7 +147,8 @@ class GrblStreamer(StreamConnect, StreamStops):
         self._running = False
         self._polling = False
         try:
-            self.port.close()
+            with self._write_lock:  # no write can be half way through the port as it closes
+                self.port.close()
         except Exception:  # noqa: BLE001 - closing a dead port may fail in many ways
             pass
         for thread in (self._reader, self._poller):

@@ -199,37 +199,9 @@ def extract_ink(gray: np.ndarray, *, threshold: float | None) -> tuple[np.ndarra
     hole[0] = False  # ink
     hole[np.concatenate([paper[0], paper[-1], paper[:, 0], paper[:, -1]])] = False
     small = np.bincount(paper.ravel()) < max(2.0, 0.5 * width * width)
-    # Slivers: a hole nowhere wider than the stroke is not a loop the pen drew round (the
-    # two jittered passes of one retraced line drifting a little apart, `narrow_holes`).
-    small |= narrow_holes(hole[paper], paper, count, width)
     small &= hole
     ink |= small[paper]
     return ink, level, width, framed
-
-
-def narrow_holes(holes: np.ndarray, labels: np.ndarray, count: int, width: float) -> np.ndarray:
-    """(count + 1,) bool per label: the paper gap is at most `width` px everywhere (holes:
-    the mask of the holes; labels: (H, W) int, pieces numbered 1..count; only the pieces
-    inside `holes` are measured, the others come out True and are not holes).
-
-    Where the up and down passes of a retraced stroke wobble apart by a little more than
-    their width, the ink opens a sliver of paper between them, and the medial axis would
-    go round it: a loop, read as crossings or three strokes meeting, where the pen drew
-    one line twice. A loop the pen drew leaves a hole it went round; one narrower than the
-    pen itself cannot be told from such a sliver in the ink, and drawing its middle line
-    twice covers it. The gap is the widest inscribed circle: 2 max(distance to ink) - 1 px
-    (the distance runs between pixel centres).
-    """
-    result = np.zeros(count + 1, dtype=bool)
-    if count == 0 or not holes.any():
-        return result
-    # Holes never reach the image edge, so their bounding box grown by 1 px has non-hole
-    # pixels all round, and the distances inside it are those over the whole page.
-    box = ink_box(holes, 1)
-    inside = ndimage.distance_transform_edt(holes[box])
-    widest = ndimage.maximum(inside, labels[box], index=np.arange(1, count + 1))
-    result[1:] = 2.0 * np.asarray(widest) - 1.0 <= width
-    return result
 
 
 def paper_gray(image: np.ndarray, *, max_size: int, blur: float) -> tuple[np.ndarray, float]:

@@ -32,3 +32,13 @@ def _named(name: str) -> IntersectionClassifier:
 
         return CnnClassifier()
     raise InputError(f"unknown classifier {name!r}; use 'cnn' or 'geometric'")
+
+
+@functools.lru_cache(maxsize=None)
+def shipped_pass_scorer():
+    """The shipped pass scorer of triple points (`vectorize.pass_scorer`), or None when its
+    model is not installed: pairing then goes by continuation alone. Cached like the CNN;
+    its onnxruntime session starts only when a drawing has a triple point."""
+    from vectorize.pass_scorer import DEFAULT_MODEL, PassScorer
+
+    return PassScorer() if DEFAULT_MODEL.is_file() else None

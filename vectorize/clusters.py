@@ -18,7 +18,9 @@ from scipy.sparse.csgraph import connected_components
 from vectorize.graph import Branch, MedialGraph
 from vectorize.simplify import directions
 
-# Junctions joined by branches shorter than this many stroke widths are one cluster.
+# Junctions joined by branches shorter than this many stroke widths are one cluster; so are
+# junctions whose maximal discs overlap (the branch is shorter than their radii's sum): the
+# ink they sit in is one blob, however thin the drawing's lines are elsewhere.
 CLUSTER_REACH = 1.5
 # Each pass through a triple point bends by less than this (degrees from straight).
 MAX_BEND = 40.0
@@ -26,14 +28,14 @@ MAX_BEND = 40.0
 Pairs = tuple[tuple[int, int], ...]
 
 
-def _matchings(items: list[int]):
+def matchings(items: list[int]):
     """Every way to split `items` (even count) into pairs."""
     if not items:
         yield ()
         return
     first = items[0]
     for k in range(1, len(items)):
-        for rest in _matchings(items[1:k] + items[k + 1:]):
+        for rest in matchings(items[1:k] + items[k + 1:]):
             yield ((first, items[k]),) + rest
 
 
@@ -44,7 +46,7 @@ def straightest_pairs(dirs: np.ndarray) -> tuple[Pairs, float]:
     the angle between -dirs[a] and dirs[b].
     """
     best, best_cost = (), np.inf
-    for pairs in _matchings(list(range(len(dirs)))):
+    for pairs in matchings(list(range(len(dirs)))):
         cost = sum(1.0 + float(np.dot(dirs[a], dirs[b])) for a, b in pairs)
         if cost < best_cost:
             best, best_cost = pairs, cost
@@ -97,7 +99,8 @@ def merge_triple_points(graph: MedialGraph, *, stroke_width: float, may_merge=No
     junctions = [n for n in graph.incident if graph.degree(n) == 3]
     index = {n: i for i, n in enumerate(junctions)}
     short = [bid for bid, b in graph.branches.items()
-             if b.a != b.b and b.a in index and b.b in index and b.length < CLUSTER_REACH * stroke_width]
+             if b.a != b.b and b.a in index and b.b in index
+             and b.length < max(CLUSTER_REACH * stroke_width, graph.radii[b.a] + graph.radii[b.b])]
     if not short:
         return {}
     rows = [index[graph.branches[b].a] for b in short]
@@ -112,7 +115,8 @@ def merge_triple_points(graph: MedialGraph, *, stroke_width: float, may_merge=No
         if len(members) != 4:
             continue
         inside = set(members)
-        inner = [b for b in short if graph.branches[b].a in inside]
+        # (Branches of clusters merged before are gone: their ids are no longer in the graph.)
+        inner = [b for b in short if b in graph.branches and graph.branches[b].a in inside]
         # A tree of four junctions: six feet leave it.
         if len(inner) != 3 or (may_merge is not None and not all(may_merge(graph.branches[b]) for b in inner)):
             continue

@@ -29,6 +29,38 @@ _SESSIONS: dict[tuple[str, str], object] = {}
 _SESSIONS_LOCK = threading.Lock()
 
 
+def model_meta(model_path: Path, *, check_hash: bool = True) -> dict:
+    """The metadata (``<model>.json``) of a shipped ONNX model; with `check_hash`, the
+    file's sha256 must match it. Raises `VectorizeError` when the model is missing or damaged."""
+    if not model_path.is_file():
+        raise VectorizeError(f"classifier model {str(model_path)!r} is missing; "
+                             "reinstall onestroke or use --classifier geometric")
+    meta_path = model_path.with_suffix(".json")
+    meta = json.loads(meta_path.read_text()) if meta_path.is_file() else {}
+    if check_hash and meta.get("sha256"):
+        if hashlib.sha256(model_path.read_bytes()).hexdigest() != meta["sha256"]:
+            raise VectorizeError(f"classifier model {str(model_path)!r} does not match its "
+                                 "metadata (sha256 differs): the file is damaged")
+    return meta
+
+
+def onnx_session(model_path: Path, sha256: str):
+    """The process's onnxruntime session for a model file (CPU, one thread), made once."""
+    key = (str(Path(model_path).resolve()), sha256)
+    with _SESSIONS_LOCK:
+        if key not in _SESSIONS:
+            import onnxruntime
+
+            options = onnxruntime.SessionOptions()
+            # One thread: the same float sums in the same order on every run, and a batch
+            # of a few dozen crops gains little from more.
+            options.intra_op_num_threads = 1
+            options.inter_op_num_threads = 1
+            _SESSIONS[key] = onnxruntime.InferenceSession(str(model_path), options,
+                                                          providers=["CPUExecutionProvider"])
+        return _SESSIONS[key]
+
+
 class CnnClassifier:
     """Crossing-vs-touching classifier backed by an ONNX model (default: the shipped one).
 
@@ -40,36 +72,15 @@ class CnnClassifier:
 
     def __init__(self, model_path: str | os.PathLike | None = None, *, check_hash: bool = True) -> None:
         self.model_path = Path(model_path) if model_path is not None else DEFAULT_MODEL
-        if not self.model_path.is_file():
-            raise VectorizeError(f"classifier model {str(self.model_path)!r} is missing; "
-                                 "reinstall onestroke or use --classifier geometric")
-        meta_path = self.model_path.with_suffix(".json")
-        self.meta = json.loads(meta_path.read_text()) if meta_path.is_file() else {}
+        self.meta = model_meta(self.model_path, check_hash=check_hash)
         self.spec = CropSpec(**self.meta["crop"]) if "crop" in self.meta else CropSpec()
-        if check_hash and self.meta.get("sha256"):
-            digest = hashlib.sha256(self.model_path.read_bytes()).hexdigest()
-            if digest != self.meta["sha256"]:
-                raise VectorizeError(f"classifier model {str(self.model_path)!r} does not match its "
-                                     "metadata (sha256 differs): the file is damaged")
         self._session = None
 
     @property
     def session(self):
         """The onnxruntime session, created on first use (CPU, deterministic threads)."""
         if self._session is None:
-            key = (str(self.model_path.resolve()), self.meta.get("sha256", ""))
-            with _SESSIONS_LOCK:
-                if key not in _SESSIONS:
-                    import onnxruntime
-
-                    options = onnxruntime.SessionOptions()
-                    # One thread: the same float sums in the same order on every run, and
-                    # a batch of a few dozen crops gains little from more.
-                    options.intra_op_num_threads = 1
-                    options.inter_op_num_threads = 1
-                    _SESSIONS[key] = onnxruntime.InferenceSession(
-                        str(self.model_path), options, providers=["CPUExecutionProvider"])
-                self._session = _SESSIONS[key]
+            self._session = onnx_session(self.model_path, self.meta.get("sha256", ""))
         return self._session
 
     def predict_crops(self, crops: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

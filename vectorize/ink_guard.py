@@ -30,6 +30,10 @@ SPLIT_DEPTH = 4
 # two checked points it exceeds the larger of theirs by at most STEP / 2 + FLATNESS.
 FLATNESS = 0.1
 STEP = 0.4
+# The invariant: every point within half the local width + SLACK px of the centre line.
+# Checked points must keep the sampling error in hand: the guard's margin is what is left.
+SLACK = 1.0
+MARGIN = SLACK - STEP / 2 - FLATNESS
 
 
 def curve_points(control: np.ndarray) -> np.ndarray:
@@ -53,7 +57,7 @@ class InkGuard:
     point the balls miss is looked up in the image itself (with its `margin` around it).
     """
 
-    def __init__(self, graph: MedialGraph, gray: np.ndarray, level: float, *, margin: float = 1.0) -> None:
+    def __init__(self, graph: MedialGraph, gray: np.ndarray, level: float, *, margin: float = MARGIN) -> None:
         self.gray, self.level = gray, level
         points = [b.points for b in graph.branches.values()]
         radii = [b.radii for b in graph.branches.values()]

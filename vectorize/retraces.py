@@ -45,14 +45,27 @@ def foot_is_retraced(graph: MedialGraph, node: int, foot: int, stroke_width: flo
     Two lines of width w meeting at an angle a share their ink for w / (2 sin(a / 2))
     from the apex; that much of a foot is the corner itself, where the two sides merge
     and the pen turns (the sides are extended to the tip instead). A foot more than twice
-    as long runs on beyond what the corner explains: the pen went down and back up one
-    line (a stem, a cusp drawn as a retrace), and its centre line is the way both passes go.
+    as long runs on beyond what the corner explains. It is a line drawn down and back up
+    (a stem, a cusp drawn as a retrace), whose centre line both passes follow, when its
+    ink does not widen towards the junction: two lines parting at any angle widen their
+    shared ink from one width at the tip to two where they separate (the medial radius
+    grows by w / 2 along the foot), one line drawn twice keeps its width. The foot's
+    radius trend (least squares, a width clear of either end) is compared with both.
     """
     dirs = directions(graph, node, 2.5 * stroke_width)
     a, b = (i for i in range(3) if i != foot)
     half = 0.5 * float(np.arccos(np.clip(np.dot(dirs[a], dirs[b]), -1.0, 1.0)))
     merged = stroke_width / (2.0 * max(np.sin(half), 1e-3))
-    return graph.branches[slots(graph, node)[foot][0]].length > 2.0 * merged
+    branch = graph.branches[slots(graph, node)[foot][0]].oriented_from(node)
+    arc = np.concatenate([[0.0], np.cumsum(branch.edge_lengths)])
+    if arc[-1] <= 2.0 * merged:
+        return False
+    inner = (arc > stroke_width) & (arc < arc[-1] - stroke_width)
+    if inner.sum() < 3:
+        return False
+    # Radius lost from the junction to the tip: ~w / 2 for a V, ~0 for a retrace.
+    growth = -float(np.polyfit(arc[inner], branch.radii[inner], 1)[0]) * arc[-1]
+    return growth < stroke_width / 4.0
 
 
 def retraced_runs(branches: Sequence[int], starts: Sequence[str],

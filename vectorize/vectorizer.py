@@ -16,7 +16,7 @@ from vectorize.fitting import TracedPoint, fit_stroke
 from vectorize.gaps import bridge_gaps, keep_largest_piece
 from vectorize.graph import MedialGraph
 from vectorize.ink_guard import InkGuard
-from vectorize.classifiers import make_classifier
+from vectorize.classifiers import make_classifier, shipped_pass_scorer
 from vectorize.clusters import merge_triple_points, straightest_pairs
 from vectorize.intersections import Junction, JunctionVerdict, ranked_pairings
 from vectorize.medial_axis import medial_axis
@@ -91,6 +91,23 @@ def _with_geometry(image: JunctionVerdict, geometry: JunctionVerdict) -> Junctio
     p = float(1.0 / (1.0 + np.exp(-(logit(image.p_crossing) + logit(geometry.p_crossing)))))
     agree = (p >= 0.5) == image.is_crossing
     return JunctionVerdict(p_crossing=p, confidence=image.confidence if agree else max(p, 1 - p))
+
+
+def _pair_through(graph: MedialGraph, nodes, gray: np.ndarray, w: float, options: VectorizeOptions) -> dict:
+    """Pair the feet of each triple point: by continuation and the image (the pass scorer,
+    with the CNN classifier, when its model is installed), by continuation alone otherwise."""
+    if not nodes:
+        return {}
+    feet = {n: directions(graph, n, 2.5 * w) for n in nodes}
+    result = {n: straightest_pairs(d)[0] for n, d in feet.items()}
+    six = [n for n in nodes if len(feet[n]) == 6]
+    scorer = shipped_pass_scorer() if six and getattr(make_classifier(options.classifier), "name", "") == "cnn" else None
+    if six and scorer is not None:
+        from vectorize.pass_scorer import pair_feet
+
+        centers = np.array([graph.positions[n] for n in six])
+        result.update(zip(six, pair_feet(gray, centers, [feet[n] for n in six], w, scorer)))
+    return result
 
 
 def _pairing_costs(verdict: JunctionVerdict) -> tuple[float, float, float]:
@@ -207,8 +224,7 @@ def _order(graph: MedialGraph, ink, options: VectorizeOptions, ends: int, clock:
         through = merge_triple_points(graph, stroke_width=w, may_merge=hooks.get("may_merge"))
         simple = simplify(graph, stroke_width=w, multi=options.multi, ends=ends, through=through, **hooks)
         # Paired after simplification: merging crossings next to a triple point renumbers its slots.
-        simple = replace(simple, through={n: straightest_pairs(directions(graph, n, 2.5 * w))[0]
-                                          for n in simple.through})
+        simple = replace(simple, through=_pair_through(graph, simple.through, ink.gray, w, options))
         clock.lap("simplification")
         junction_list = _junctions(graph, simple.crossings, w)
         junctions = dict(zip(simple.crossings, junction_list))

@@ -111,6 +111,7 @@ COMMANDS = {
     "emulator": "fabrication.cli.stream_cmd:emulator",
     "train-classifier": "fabrication.cli.train_cmd:train_classifier",
     "validate-classifier": "fabrication.cli.train_cmd:validate_classifier",
+    "train-pass-scorer": "fabrication.cli.train_cmd:train_pass_scorer",
 }
 
 

@@ -1,4 +1,4 @@
-"""`onestroke train-classifier` and `onestroke validate-classifier`: the crossing CNN.
+"""`onestroke train-classifier`, `validate-classifier` and `train-pass-scorer`: the CNNs.
 
 Training needs the `train` extra (PyTorch); validation runs the exported model with
 onnxruntime only. Both print their figures as JSON on stdout.
@@ -19,21 +19,36 @@ WORKERS = os.cpu_count() or 1
 DEFAULT_NAME = "crossing_cnn.onnx"  # in the current folder: never the shipped model by default
 
 
+def _training_options(*, epochs: int, what: str, default_name: str):
+    """--seed, --epochs, --batch, --lr, --workers and --out, shared by both training commands."""
+    options = [
+        click.option("--seed", type=Integer(0, 2**32 - 1), default=0, show_default=True,
+                     help=f"Seed of {what}, initialisation and batch order."),
+        click.option("--epochs", type=Integer(1, 1000), default=epochs, show_default=True, help="Epochs, 1-1000."),
+        click.option("--batch", type=Integer(1, 65536), default=128, show_default=True,
+                     help="Batch size, 1-65536."),
+        click.option("--lr", type=Number(0.0, 10.0, low_open=True), default=4e-3, show_default=True,
+                     help="Learning rate, above 0 to 10."),
+        click.option("--workers", type=Integer(1, 256), default=WORKERS, show_default=True,
+                     help="Processes making crops."),
+        output_option(".onnx", flags=("--out",), required=False,
+                      help=f"ONNX file to write (its .json and .md beside it) [default: {default_name} in the "
+                           "current folder; the shipped model is replaced only when named explicitly]."),
+    ]
+
+    def apply(command):
+        for option in reversed(options):
+            command = option(command)
+        return command
+    return apply
+
+
 @click.command("train-classifier")
-@click.option("--seed", type=Integer(0, 2**32 - 1), default=0, show_default=True,
-              help="Seed of data, initialisation and batch order.")
+@_training_options(epochs=8, what="data", default_name=DEFAULT_NAME)
 @click.option("--samples", type=Integer(100, 10_000_000), default=36_000, show_default=True,
               help="Synthetic training crops, 100-10,000,000.")
-@click.option("--epochs", type=Integer(1, 1000), default=8, show_default=True, help="Epochs, 1-1000.")
-@click.option("--batch", type=Integer(1, 65536), default=128, show_default=True, help="Batch size, 1-65536.")
-@click.option("--lr", type=Number(0.0, 10.0, low_open=True), default=4e-3, show_default=True,
-              help="Learning rate, above 0 to 10.")
 @click.option("--validation", type=Integer(1, 10_000_000), default=5_000, show_default=True,
               help="Fresh crops (another seed) measured after export.")
-@click.option("--workers", type=Integer(1, 256), default=WORKERS, show_default=True, help="Processes making crops.")
-@output_option(".onnx", flags=("--out",), required=False,
-               help="ONNX file to write (its .json and .md beside it) [default: crossing_cnn.onnx in the current "
-                    "folder; the shipped model is replaced only when named explicitly].")
 def train_classifier(seed: int, samples: int, epochs: int, batch: int, lr: float, validation: int,
                      workers: int, out: str | None) -> None:
     """Train the crossing-vs-touching CNN on CPU, reproducibly from --seed, and export it."""
@@ -63,3 +78,28 @@ def validate_classifier(seed: int, count: int, workers: int, model: Path | None)
 
     click.echo(json.dumps(evaluate_onnx(model or DEFAULT_MODEL, count=count, seed=seed, workers=workers),
                           indent=2))
+
+
+@click.command("train-pass-scorer")
+@_training_options(epochs=4, what="scenes", default_name="pass_cnn.onnx")
+@click.option("--scenes", type=Integer(8, 1_000_000), default=1000, show_default=True,
+              help="Synthetic triple points to train on (15 candidate passes each), 8-1,000,000.")
+@click.option("--calibration", type=Integer(8, 1_000_000), default=200, show_default=True,
+              help="Fresh scenes (seed + 500) that fit the image/continuation weights.")
+@click.option("--validation", type=Integer(1, 1_000_000), default=200, show_default=True,
+              help="Fresh scenes (seed + 1000) whose pairing accuracy is measured after export.")
+def train_pass_scorer(seed: int, scenes: int, epochs: int, batch: int, lr: float, calibration: int,
+                      validation: int, workers: int, out: str | None) -> None:
+    """Train the pass scorer of triple points on CPU, reproducibly from --seed, and export it."""
+    from onestroke.atomic import check_writable
+
+    out_path = Path(out or "pass_cnn.onnx")
+    check_writable(out_path)
+    try:
+        from vectorize.training.train_pass import train_and_export_pass
+    except ImportError as error:
+        raise InputError(f"training needs PyTorch ({error.name} is missing): pip install -e '.[train]'") from None
+    meta = train_and_export_pass(seed=seed, scenes=scenes, epochs=epochs, batch=batch, lr=lr,
+                                 calibration=calibration, validation=validation, workers=workers, out=out_path,
+                                 log=lambda line: click.echo(line, err=True))
+    click.echo(json.dumps({"combine": meta["combine"], "validation": meta["validation"]}, indent=2))

@@ -23,11 +23,14 @@ def _block(cin: int, cout: int, *, stride: int = 1, pool: bool = True) -> list[n
 class CrossingNet(nn.Module):
     """A stride-2 stem (48 -> 24 px), three conv + pool blocks (-> 3 px), global average
     pooling, one logit. Small on purpose: 8 augmented copies of every junction of a
-    drawing run on a CPU in a few milliseconds."""
+    drawing run on a CPU in a few milliseconds.
 
-    def __init__(self, channels: tuple[int, ...] = (24, 32, 64, 64)) -> None:
+    The pass scorer of triple points is the same design on its 4-channel 32 px crops
+    (`vectorize.pass_crop`): `pass_net()`."""
+
+    def __init__(self, channels: tuple[int, ...] = (24, 32, 64, 64), inputs: int = 2) -> None:
         super().__init__()
-        layers = _block(2, channels[0], stride=2, pool=False)
+        layers = _block(inputs, channels[0], stride=2, pool=False)
         for cin, cout in zip(channels[:-1], channels[1:]):
             layers += _block(cin, cout)
         self.features = nn.Sequential(*layers)
@@ -39,6 +42,12 @@ class CrossingNet(nn.Module):
         return self.head(x.mean(dim=(2, 3))).squeeze(1)
 
 
+def pass_net() -> CrossingNet:
+    """The pass scorer (about 24k parameters): does the candidate pass drawn in the crop go
+    straight through the ink of a triple point? (N, 4, 32, 32) -> logits (N,)."""
+    return CrossingNet(channels=(12, 24, 32, 48), inputs=4)
+
+
 class Probability(nn.Module):
     """The network with a sigmoid on top: what the ONNX file computes."""
 
@@ -48,3 +57,4 @@ class Probability(nn.Module):
 
     def forward(self, crops: torch.Tensor) -> torch.Tensor:
         return torch.sigmoid(self.net(crops))
+

@@ -44,22 +44,16 @@ def _dihedral(x: torch.Tensor, code: torch.Tensor) -> torch.Tensor:
     return out
 
 
-def train(*, seed: int, samples: int, epochs: int, batch: int, lr: float, workers: int,
-          log: Callable[[str], None] = lambda line: None) -> tuple[CrossingNet, dict]:
-    """Generate data and train; returns the network (eval mode) and training facts.
-    `log` receives one progress line per stage and epoch."""
-    torch.manual_seed(seed)
-    torch.set_num_threads(max(1, os.cpu_count() or 1))
-    started = time.perf_counter()
-    data = generate(samples, seed=seed, workers=workers)
-    log(f"generated {samples} training crops in {time.perf_counter() - started:.0f} s")
-    x = torch.from_numpy(data.x.astype(np.float32) / 255.0)
-    y = torch.from_numpy(data.label.astype(np.float32))
-    net = CrossingNet()
+def fit(net: nn.Module, x: torch.Tensor, y: torch.Tensor, *, seed: int, epochs: int, batch: int, lr: float,
+        augment: Callable[[torch.Tensor, torch.Tensor], torch.Tensor], codes: int,
+        loss_fn: nn.Module, started: float, log: Callable[[str], None] = lambda line: None) -> None:
+    """Train `net` in place on crops x (N, C, S, S) and labels y (N,) in {0, 1}: AdamW with a
+    one-cycle learning rate; each sample of a batch gets `augment(crops, code)` with a code
+    drawn in 0..codes-1 (an exact symmetry). Batch order and codes derive from `seed`."""
+    samples = len(x)
     optimizer = torch.optim.AdamW(net.parameters(), lr=lr, weight_decay=1e-4)
     steps = epochs * ((samples + batch - 1) // batch)
     schedule = torch.optim.lr_scheduler.OneCycleLR(optimizer, max_lr=lr, total_steps=steps)
-    loss_fn = nn.BCEWithLogitsLoss()
     generator = torch.Generator().manual_seed(seed)
     for epoch in range(epochs):
         net.train()
@@ -67,8 +61,8 @@ def train(*, seed: int, samples: int, epochs: int, batch: int, lr: float, worker
         total, correct, loss_sum = 0, 0, 0.0
         for start in range(0, samples, batch):
             idx = order[start:start + batch]
-            code = torch.randint(0, 8, (len(idx),), generator=generator)
-            xb, yb = _dihedral(x[idx], code), y[idx]
+            code = torch.randint(0, codes, (len(idx),), generator=generator)
+            xb, yb = augment(x[idx], code), y[idx]
             optimizer.zero_grad()
             logits = net(xb)
             loss = loss_fn(logits, yb)
@@ -81,19 +75,36 @@ def train(*, seed: int, samples: int, epochs: int, batch: int, lr: float, worker
         log(f"epoch {epoch + 1}/{epochs}: loss {loss_sum / total:.4f}, train accuracy {correct / total:.4f}, "
             f"{time.perf_counter() - started:.0f} s")
     net.eval()
+
+
+def train(*, seed: int, samples: int, epochs: int, batch: int, lr: float, workers: int,
+          log: Callable[[str], None] = lambda line: None) -> tuple[CrossingNet, dict]:
+    """Generate data and train; returns the network (eval mode) and training facts.
+    `log` receives one progress line per stage and epoch."""
+    torch.manual_seed(seed)
+    torch.set_num_threads(max(1, os.cpu_count() or 1))
+    started = time.perf_counter()
+    data = generate(samples, seed=seed, workers=workers)
+    log(f"generated {samples} training crops in {time.perf_counter() - started:.0f} s")
+    x = torch.from_numpy(data.x.astype(np.float32) / 255.0)
+    y = torch.from_numpy(data.label.astype(np.float32))
+    net = CrossingNet()
+    fit(net, x, y, seed=seed, epochs=epochs, batch=batch, lr=lr, augment=_dihedral, codes=8,
+        loss_fn=nn.BCEWithLogitsLoss(), started=started, log=log)
     return net, {"train_samples": samples, "epochs": epochs, "batch": batch, "lr": lr,
                  "train_seconds": round(time.perf_counter() - started, 1)}
 
 
-def export_onnx(net: CrossingNet, path: Path, spec: CropSpec) -> bytes:
-    """Export (crops (N, 2, S, S) float32 -> p_crossing (N,)) and return the file's bytes."""
+def export_onnx(net: CrossingNet, path: Path, spec: CropSpec, *, channels: int = 2,
+                output: str = "p_crossing") -> bytes:
+    """Export (crops (N, channels, S, S) float32 -> `output` (N,)) and return the file's bytes."""
     import io
 
     model = Probability(net).eval()
-    example = torch.zeros(1, 2, spec.size, spec.size)
+    example = torch.zeros(1, channels, spec.size, spec.size)
     buffer = io.BytesIO()
-    torch.onnx.export(model, (example,), buffer, input_names=["crops"], output_names=["p_crossing"],
-                      dynamic_axes={"crops": {0: "n"}, "p_crossing": {0: "n"}}, opset_version=17,
+    torch.onnx.export(model, (example,), buffer, input_names=["crops"], output_names=[output],
+                      dynamic_axes={"crops": {0: "n"}, output: {0: "n"}}, opset_version=17,
                       dynamo=False)
     data = buffer.getvalue()
     atomic_write_bytes(path, data)
