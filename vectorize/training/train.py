@@ -111,6 +111,20 @@ def export_onnx(net: CrossingNet, path: Path, spec: CropSpec, *, channels: int =
     return data
 
 
+def base_meta(command: str, options: dict, spec, net: nn.Module, data: bytes, facts: dict) -> dict:
+    """Metadata of an exported model: the command and options that made it (seed first),
+    its crop geometry, size, hash and training facts."""
+    return {
+        "seed": options["seed"],
+        "command": f"onestroke {command} " + " ".join(f"--{k} {v}" for k, v in options.items()),
+        "crop": spec.to_dict(),
+        "parameters": sum(p.numel() for p in net.parameters()),
+        "bytes": len(data),
+        "sha256": hashlib.sha256(data).hexdigest(),
+        "training": facts,
+    }
+
+
 def model_card(meta: dict) -> str:
     """The Markdown model card from the metadata."""
     v = meta["validation"]
@@ -165,19 +179,9 @@ def train_and_export(*, seed: int = 0, samples: int = 36_000, epochs: int = 8, b
     facts["cpu"] = f"{os.cpu_count()} CPU cores"
     data = export_onnx(net, out, spec)
     measured = evaluate_onnx(out, count=validation, seed=seed + VALIDATION_SEED_OFFSET, workers=workers)
-    command = "onestroke train-classifier " + " ".join(
-        f"--{k} {v}" for k, v in (("seed", seed), ("samples", samples), ("epochs", epochs),
-                                  ("batch", batch), ("lr", lr), ("validation", validation)))
-    meta = {
-        "seed": seed,
-        "command": command,
-        "crop": spec.to_dict(),
-        "parameters": sum(p.numel() for p in net.parameters()),
-        "bytes": len(data),
-        "sha256": hashlib.sha256(data).hexdigest(),
-        "training": facts,
-        "validation": measured,
-    }
+    meta = base_meta("train-classifier", {"seed": seed, "samples": samples, "epochs": epochs, "batch": batch,
+                                          "lr": lr, "validation": validation}, spec, net, data, facts)
+    meta["validation"] = measured
     atomic_write_text(out.with_suffix(".json"), json.dumps(meta, indent=2) + "\n")
     atomic_write_text(out.with_suffix(".md"), model_card(meta))
     return meta

@@ -13,7 +13,6 @@ card (.md). Needs the `train` extra (PyTorch); the vectorizer only loads the ONN
 
 from __future__ import annotations
 
-import hashlib
 import json
 import os
 import time
@@ -28,7 +27,7 @@ from onestroke.atomic import atomic_write_text
 from vectorize.pass_crop import PassCropSpec
 from vectorize.training.model import pass_net
 from vectorize.training.pass_eval import evaluate_pairing, fit_combination
-from vectorize.training.train import export_onnx, fit
+from vectorize.training.train import base_meta, export_onnx, fit
 from vectorize.training.triple_synth import generate_passes
 
 CALIBRATION_SEED_OFFSET, VALIDATION_SEED_OFFSET = 500, 1000
@@ -118,18 +117,9 @@ def train_and_export_pass(*, seed: int = 0, scenes: int = 1000, epochs: int = 4,
     net, facts = train_pass(seed=seed, scenes=scenes, epochs=epochs, batch=batch, lr=lr, workers=workers, log=log)
     facts["cpu"] = f"{os.cpu_count()} CPU cores"
     data = export_onnx(net, out, spec, channels=4, output="p_pass")
-    command = "onestroke train-pass-scorer " + " ".join(
-        f"--{k} {v}" for k, v in (("seed", seed), ("scenes", scenes), ("epochs", epochs), ("batch", batch),
-                                  ("lr", lr), ("calibration", calibration), ("validation", validation)))
-    meta = {
-        "seed": seed,
-        "command": command,
-        "crop": spec.to_dict(),
-        "parameters": sum(p.numel() for p in net.parameters()),
-        "bytes": len(data),
-        "sha256": hashlib.sha256(data).hexdigest(),
-        "training": facts,
-    }
+    meta = base_meta("train-pass-scorer", {"seed": seed, "scenes": scenes, "epochs": epochs, "batch": batch,
+                                           "lr": lr, "calibration": calibration, "validation": validation},
+                     spec, net, data, facts)
     return calibrate_and_validate(out, meta, calibration=calibration, validation=validation, workers=workers,
                                   log=log)
 
