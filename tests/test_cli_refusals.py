@@ -156,8 +156,9 @@ def test_shared_options_are_spelled_and_checked_the_same_on_every_command(folder
 
 
 # 6. long work shows progress: (arguments, a progress line that must appear when stderr is
-# not a terminal). ONESTROKE_PROGRESS_SECONDS=0 prints every report instead of one line
-# every 5 s, so a small input shows what a large one shows over minutes.
+# not a terminal and plain lines are asked for). ONESTROKE_PROGRESS_SECONDS=0 prints every
+# report, so a small input shows what a large one shows over minutes; unset, a log or a pipe
+# gets only the final summary (a terminal gets the bar: test_progress_bar_on_a_terminal).
 PROGRESS = [
     (["vectorize", "{in}/many.svg", "-o", "{out}/a.svg"], "vectorizing many.svg: reading shapes: 100 %"),
     (["embroider", "{in}/many.svg", "-o", "{out}/a.pes", "--size", "180mm", "--hoop", "200x200"],
@@ -192,8 +193,12 @@ def test_progress_lines_when_not_on_a_terminal(folder, tmp_path, monkeypatch, ar
     assert line in result.stderr, result.stderr
     stages = _percentages(result.stderr)
     assert stages and all(p == sorted(p) and p[-1] == 100 for p in stages.values()), stages
-    # a short step stays quiet at the default pace (here: one line a minute at most)
+    # a step shorter than the pace asked for prints no line (here: one line a minute at most)
     monkeypatch.setenv("ONESTROKE_PROGRESS_SECONDS", "60")
+    quiet = CliRunner().invoke(main, argv)
+    assert quiet.exit_code == 0 and _percentages(quiet.stderr) == {}, quiet.stderr
+    # not asked for: quiet but for the final summary
+    monkeypatch.delenv("ONESTROKE_PROGRESS_SECONDS")
     quiet = CliRunner().invoke(main, argv)
     assert quiet.exit_code == 0 and _percentages(quiet.stderr) == {}, quiet.stderr
 
@@ -209,6 +214,44 @@ def test_progress_through_a_real_pipe(folder, tmp_path):
     assert stages["planning the stitches: stitching"][-1] == 100 and stages["reading many.svg: parsing"][-1] == 100
     assert "\x1b[" not in done.stderr  # no terminal codes in a pipe
     assert done.stdout.startswith(f"wrote {tmp_path / 'a.pes'}")
+
+
+def test_progress_bar_on_a_terminal(folder, tmp_path):
+    """On a real terminal (a pty) the step shows rich's bar with a percentage, then only the
+    summary stays."""
+    import pty
+    import select
+
+    env = {k: v for k, v in os.environ.items() if k != "ONESTROKE_PROGRESS_SECONDS"}
+    env |= {"PYTHONPATH": os.pathsep.join(sys.path), "TERM": "xterm", "COLUMNS": "120"}
+    leader, follower = pty.openpty()
+    process = subprocess.Popen([sys.executable, "-m", "fabrication.cli", "embroider", str(folder / "many.svg"),
+                                "-o", str(tmp_path / "a.pes"), "--size", "180mm", "--hoop", "200x200"],
+                               stdin=follower, stdout=follower, stderr=follower, env=env)
+    os.close(follower)
+    seen = b""
+    try:
+        while True:
+            ready, _, _ = select.select([leader], [], [], 600)
+            if not ready:
+                break
+            try:
+                chunk = os.read(leader, 65536)
+            except OSError:  # the other side closed
+                break
+            if not chunk:
+                break
+            seen += chunk
+    finally:
+        os.close(leader)
+        process.wait(timeout=60)
+    text = seen.decode("utf-8", "replace")
+    assert process.returncode == 0, text
+    import re
+
+    assert "\x1b[" in text and "planning the stitches" in text, text
+    assert re.search(r"stitching .*\d+%", text), text  # rich's bar with its percentage
+    assert f"wrote {tmp_path / 'a.pes'}" in text
 
 
 def test_laser_blur_exists_and_threshold_hint_does_not_chase_itself(folder, tmp_path):

@@ -14,32 +14,34 @@ def warn(message: str) -> None:
     console.print(f"[yellow]warning:[/yellow] {message}", soft_wrap=True)
 
 
-# Seconds between plain progress lines when stderr is not a terminal (a log, a pipe), the
-# streamer's pace too; ONESTROKE_PROGRESS_SECONDS changes it (0: a line at every report).
+# Seconds between plain progress lines when stderr is not a terminal (a log, a pipe):
+# the streamer's pace; ONESTROKE_PROGRESS_SECONDS changes it (0: a line at every report).
 PROGRESS_EVERY = 5.0
 
 
-def progress_every() -> float:
-    """Seconds between plain progress lines: ONESTROKE_PROGRESS_SECONDS, else PROGRESS_EVERY."""
+def progress_every(default: float | None = PROGRESS_EVERY) -> float | None:
+    """Seconds between plain progress lines: ONESTROKE_PROGRESS_SECONDS, else `default`
+    (None: no plain lines)."""
     import math
     import os
 
     try:
-        value = float(os.environ.get("ONESTROKE_PROGRESS_SECONDS", PROGRESS_EVERY))
-    except ValueError:
-        return PROGRESS_EVERY
-    return value if math.isfinite(value) and value >= 0 else PROGRESS_EVERY
+        value = float(os.environ["ONESTROKE_PROGRESS_SECONDS"])
+    except (KeyError, ValueError):
+        return default
+    return value if math.isfinite(value) and value >= 0 else default
 
 
 class _StepProgress:
     """The display of one step. On a terminal: a spinner and the step's name, then a bar
     with percent and time remaining once the library reports how far it is (transient: it
-    goes when the step ends). Elsewhere: one plain line every `progress_every()` seconds,
-    so a step shorter than that prints nothing."""
+    goes when the step ends). Elsewhere (a log, a pipe) quiet but for the command's final
+    summary, unless ONESTROKE_PROGRESS_SECONDS asks for one plain line every so many
+    seconds (then a step shorter than that prints nothing)."""
 
     def __init__(self, description: str) -> None:
         self.description = description
-        self.every = progress_every()
+        self.every = progress_every(default=None)
         self.bar = None
         self.task = None
         self.started = 0.0
@@ -51,7 +53,7 @@ class _StepProgress:
         import time
 
         self.started = time.monotonic()
-        self.next_line = self.started + self.every
+        self.next_line = self.started + (self.every or 0.0)
         if console.is_terminal:
             from rich.progress import (BarColumn, Progress, SpinnerColumn, TaskProgressColumn, TextColumn,
                                        TimeRemainingColumn)
@@ -78,7 +80,7 @@ class _StepProgress:
         now = time.monotonic()
         if report.stage != self.stage:
             self.stage, self.stage_started = report.stage, now
-        if now < self.next_line:
+        if self.every is None or now < self.next_line:
             return
         self.next_line = now + self.every
         from machines.job_time import format_duration
@@ -96,8 +98,8 @@ class _StepProgress:
 def step(description: str) -> _StepProgress:
     """`with step("planning the stitches") as progress:` shows the step while it runs; pass
     `progress` to the library call as its progress callback (see `onestroke.progress`).
-    On a terminal a transient spinner, then bar; in a log or a pipe a plain line every few
-    seconds; a short step leaves nothing but the command's final summary."""
+    On a terminal a transient spinner, then bar; in a log or a pipe nothing but the
+    command's final summary (plain lines on request: ONESTROKE_PROGRESS_SECONDS)."""
     return _StepProgress(description)
 
 
