@@ -127,6 +127,18 @@ def principal_angles(gray: np.ndarray, centers: np.ndarray, stroke_width: float,
     return 0.5 * np.arctan2(2.0 * sxy, sxx - syy)
 
 
+def checked_crop_input(gray, centers, stroke_width: float) -> tuple[np.ndarray, np.ndarray]:
+    """The image as float32 (H, W) and the crop centres as (N, 2); InputError for an empty
+    or non-2-D image or a stroke width that is not a positive number of px."""
+    gray = np.asarray(gray, dtype=np.float32)
+    centers = np.asarray(centers, dtype=float).reshape(-1, 2)
+    if gray.ndim != 2 or gray.size == 0:
+        raise InputError(f"gray image must be a non-empty 2-D array, got shape {gray.shape}")
+    if not (np.isfinite(stroke_width) and stroke_width > 0):
+        raise InputError(f"stroke width {stroke_width!r} must be a positive number of px")
+    return gray, centers
+
+
 def crop_junctions(gray: np.ndarray, centers: np.ndarray, stroke_width: float,
                    spec: CropSpec = CropSpec()) -> np.ndarray:
     """Near and far crops around each junction centre.
@@ -144,12 +156,7 @@ def crop_junctions(gray: np.ndarray, centers: np.ndarray, stroke_width: float,
     (N, 2, size, size) float32: channel 0 near crop, channel 1 far crop, ink strength
     normalised to 0 = paper, 1 = darkest ink near the junction.
     """
-    gray = np.asarray(gray, dtype=np.float32)
-    centers = np.asarray(centers, dtype=float).reshape(-1, 2)
-    if gray.ndim != 2 or gray.size == 0:
-        raise InputError(f"gray image must be a non-empty 2-D array, got shape {gray.shape}")
-    if not (np.isfinite(stroke_width) and stroke_width > 0):
-        raise InputError(f"stroke width {stroke_width!r} must be a positive number of px")
+    gray, centers = checked_crop_input(gray, centers, stroke_width)
     n, s = len(centers), spec.size
     out = np.zeros((n, 2, s, s), dtype=np.float32)
     if n == 0:

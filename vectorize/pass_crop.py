@@ -25,8 +25,7 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
-from onestroke.errors import InputError
-from vectorize.junction_crop import _sample_filtered, _unit_grid
+from vectorize.junction_crop import _sample_filtered, _unit_grid, checked_crop_input
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -68,14 +67,9 @@ def crop_passes(gray: np.ndarray, centers: np.ndarray, foot_a: np.ndarray, foot_
     -------
     (N, 4, size, size) float32: near ink, near pass, far ink, far pass.
     """
-    gray = np.asarray(gray, dtype=np.float32)
-    centers = np.asarray(centers, dtype=float).reshape(-1, 2)
+    gray, centers = checked_crop_input(gray, centers, stroke_width)
     foot_a = np.asarray(foot_a, dtype=float).reshape(-1, 2)
     foot_b = np.asarray(foot_b, dtype=float).reshape(-1, 2)
-    if gray.ndim != 2 or gray.size == 0:
-        raise InputError(f"gray image must be a non-empty 2-D array, got shape {gray.shape}")
-    if not (np.isfinite(stroke_width) and stroke_width > 0):
-        raise InputError(f"stroke width {stroke_width!r} must be a positive number of px")
     n, s = len(centers), spec.size
     out = np.zeros((n, 4, s, s), dtype=np.float32)
     if n == 0:

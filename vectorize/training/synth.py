@@ -232,15 +232,20 @@ def _chunk(args: tuple[int, int, int, CropSpec]) -> tuple[np.ndarray, ...]:
     return np.stack(xs), np.array(ys), np.array(st), np.array(an), np.array(wd)
 
 
+def seeded_chunks(make_chunk, n: int, chunk: int, *, seed: int, spec, workers: int) -> list:
+    """make_chunk((seed, index, count, spec)) over chunks of `chunk` items: a chunk's seed is
+    its own, so the parts do not depend on `workers` (processes used when > 1)."""
+    jobs = [(seed, i, min(chunk, n - i * chunk), spec) for i in range((n + chunk - 1) // chunk)]
+    if workers > 1 and len(jobs) > 1:
+        with ProcessPoolExecutor(max_workers=workers) as pool:
+            return list(pool.map(make_chunk, jobs))
+    return [make_chunk(j) for j in jobs]
+
+
 def generate(n: int, *, seed: int, spec: CropSpec = CropSpec(), workers: int = 1) -> SynthSet:
     """`n` samples, half crossings and half touchings in expectation; seeded and
     independent of `workers` (each chunk of CHUNK samples has its own seed)."""
-    jobs = [(seed, i, min(CHUNK, n - i * CHUNK), spec) for i in range((n + CHUNK - 1) // CHUNK)]
-    if workers > 1 and len(jobs) > 1:
-        with ProcessPoolExecutor(max_workers=workers) as pool:
-            parts = list(pool.map(_chunk, jobs))
-    else:
-        parts = [_chunk(j) for j in jobs]
+    parts = seeded_chunks(_chunk, n, CHUNK, seed=seed, spec=spec, workers=workers)
     x, y, st, an, wd = (np.concatenate([p[i] for p in parts]) for i in range(5))
     return SynthSet(x=x, label=y.astype(np.int64), subtype=st.astype(np.int64),
                     angle=an.astype(np.float64), width=wd.astype(np.float64))

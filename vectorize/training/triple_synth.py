@@ -15,7 +15,6 @@ label 1 for the three true passes, and each candidate's continuation cost.
 
 from __future__ import annotations
 
-from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass
 
 import numpy as np
@@ -23,7 +22,7 @@ from scipy import ndimage
 
 from vectorize.pass_crop import PassCropSpec, crop_passes
 from vectorize.pass_scorer import PAIRS
-from vectorize.training.synth import _coverage, _curve, _smooth_noise
+from vectorize.training.synth import _coverage, _curve, _smooth_noise, seeded_chunks
 
 CHUNK = 64  # scenes per independently seeded chunk: output does not depend on workers
 
@@ -140,12 +139,7 @@ def _chunk(args: tuple[int, int, int, PassCropSpec]) -> tuple[np.ndarray, ...]:
 def generate_passes(scenes: int, *, seed: int, spec: PassCropSpec = PassCropSpec(), workers: int = 1) -> PassSet:
     """The 15 candidate passes of each of `scenes` scenes; seeded and independent of
     `workers` (each chunk of CHUNK scenes has its own seed)."""
-    jobs = [(seed, i, min(CHUNK, scenes - i * CHUNK), spec) for i in range((scenes + CHUNK - 1) // CHUNK)]
-    if workers > 1 and len(jobs) > 1:
-        with ProcessPoolExecutor(max_workers=workers) as pool:
-            parts = list(pool.map(_chunk, jobs))
-    else:
-        parts = [_chunk(j) for j in jobs]
+    parts = seeded_chunks(_chunk, scenes, CHUNK, seed=seed, spec=spec, workers=workers)
     x, label, cost, scene, pair = (np.concatenate([p[i] for p in parts]) for i in range(5))
     return PassSet(x=x, label=label.astype(np.int64), cost=cost, scene=scene.astype(np.int64),
                    pair=pair.astype(np.int64))
