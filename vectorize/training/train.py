@@ -77,17 +77,27 @@ def fit(net: nn.Module, x: torch.Tensor, y: torch.Tensor, *, seed: int, epochs: 
     net.eval()
 
 
+def seeded_start(seed: int) -> float:
+    """Seed torch (initialisation, batch order) and use every core; returns the start time
+    (time.perf_counter) for the training log."""
+    torch.manual_seed(seed)
+    torch.set_num_threads(max(1, os.cpu_count() or 1))
+    return time.perf_counter()
+
+
+def crop_tensors(crops: np.ndarray, labels: np.ndarray) -> tuple[torch.Tensor, torch.Tensor]:
+    """uint8 crops (N, C, S, S) and 0/1 labels (N,) -> float32 tensors, ink scaled to 0..1."""
+    return torch.from_numpy(crops.astype(np.float32) / 255.0), torch.from_numpy(labels.astype(np.float32))
+
+
 def train(*, seed: int, samples: int, epochs: int, batch: int, lr: float, workers: int,
           log: Callable[[str], None] = lambda line: None) -> tuple[CrossingNet, dict]:
     """Generate data and train; returns the network (eval mode) and training facts.
     `log` receives one progress line per stage and epoch."""
-    torch.manual_seed(seed)
-    torch.set_num_threads(max(1, os.cpu_count() or 1))
-    started = time.perf_counter()
+    started = seeded_start(seed)
     data = generate(samples, seed=seed, workers=workers)
     log(f"generated {samples} training crops in {time.perf_counter() - started:.0f} s")
-    x = torch.from_numpy(data.x.astype(np.float32) / 255.0)
-    y = torch.from_numpy(data.label.astype(np.float32))
+    x, y = crop_tensors(data.x, data.label)
     net = CrossingNet()
     fit(net, x, y, seed=seed, epochs=epochs, batch=batch, lr=lr, augment=_dihedral, codes=8,
         loss_fn=nn.BCEWithLogitsLoss(), started=started, log=log)

@@ -19,7 +19,6 @@ import time
 from collections.abc import Callable
 from pathlib import Path
 
-import numpy as np
 import torch
 from torch import nn
 
@@ -27,7 +26,7 @@ from onestroke.atomic import atomic_write_text
 from vectorize.pass_crop import PassCropSpec
 from vectorize.training.model import pass_net
 from vectorize.training.pass_eval import evaluate_pairing, fit_combination
-from vectorize.training.train import base_meta, export_onnx, fit
+from vectorize.training.train import base_meta, crop_tensors, export_onnx, fit, seeded_start
 from vectorize.training.triple_synth import generate_passes
 
 CALIBRATION_SEED_OFFSET, VALIDATION_SEED_OFFSET = 500, 1000
@@ -48,13 +47,10 @@ def train_pass(*, seed: int, scenes: int, epochs: int, batch: int, lr: float, wo
                log: Callable[[str], None] = lambda line: None) -> tuple[nn.Module, dict]:
     """Generate `scenes` scenes (15 candidate passes each) and train; returns the network
     (eval mode) and training facts."""
-    torch.manual_seed(seed)
-    torch.set_num_threads(max(1, os.cpu_count() or 1))
-    started = time.perf_counter()
+    started = seeded_start(seed)
     data = generate_passes(scenes, seed=seed, workers=workers)
     log(f"generated {len(data.x)} training crops ({scenes} scenes) in {time.perf_counter() - started:.0f} s")
-    x = torch.from_numpy(data.x.astype(np.float32) / 255.0)
-    y = torch.from_numpy(data.label.astype(np.float32))
+    x, y = crop_tensors(data.x, data.label)
     net = pass_net()
     # 3 true passes of 15: weigh them up so that p = 0.5 means "as likely as not".
     loss_fn = nn.BCEWithLogitsLoss(pos_weight=torch.tensor(4.0))
