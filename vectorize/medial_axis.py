@@ -101,8 +101,8 @@ def voronoi_ridges(samples: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndar
     # One vertex per group of triangles with the same circumcentre: the ridges between them
     # have no length and go.
     span = np.max(np.ptp(samples, axis=0)) + 1.0
-    same = np.linalg.norm(centers[first] - centers[second], axis=1) <= SAME_CENTER * span
-    same &= np.isfinite(centers[first]).all(1)
+    with np.errstate(invalid="ignore"):  # flat triangles' centres are infinite
+        same = np.linalg.norm(centers[first] - centers[second], axis=1) <= SAME_CENTER * span
     if same.any():
         merged = coo_matrix((np.ones(int(same.sum())), (first[same], second[same])), shape=(count, count))
         _, label = connected_components(merged, directed=False)
