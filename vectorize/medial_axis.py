@@ -88,7 +88,8 @@ def voronoi_ridges(samples: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndar
     d = 2.0 * (b[:, 0] * c[:, 1] - b[:, 1] * c[:, 0])
     bb, cc = (b * b).sum(1), (c * c).sum(1)
     with np.errstate(divide="ignore", invalid="ignore"):
-        centers = corners[:, 0] + np.column_stack([c[:, 1] * bb - b[:, 1] * cc, b[:, 0] * cc - c[:, 0] * bb]) / d[:, None]
+        offset = np.column_stack([c[:, 1] * bb - b[:, 1] * cc, b[:, 0] * cc - c[:, 0] * bb]) / d[:, None]
+    centers = corners[:, 0] + offset
     # Each edge shared by two triangles once (hull edges, neighbour -1, are infinite ridges).
     count = len(simplices)
     first = np.repeat(np.arange(count), 3)
@@ -117,64 +118,81 @@ def voronoi_ridges(samples: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndar
 
 
 def _collapse_chains(xy: np.ndarray, radius: np.ndarray, edges: np.ndarray, sins: np.ndarray) -> MedialGraph:
-    """Build the branch graph: walk each chain of degree-2 vertices between junctions/ends."""
-    n = len(xy)
+    """Build the branch graph: each chain of degree-2 vertices between junctions or ends is
+    one branch, read from the end met first in vertex order (then adjacency order); closed
+    chains with no junction get a node of their own, in the order of their first edge."""
+    n, count = len(xy), len(edges)
     degree = np.bincount(edges.ravel(), minlength=n)
-    # CSR adjacency: for vertex i, neighbours nbr[start[i]:start[i+1]] via edge ids eid[...]
+    # Half-edges in CSR order (by source vertex, then edge id): j runs source[j] -> target[j]
+    # along edge edge_of[j]; reverse[j] is the same edge the other way.
     order = np.argsort(np.concatenate([edges[:, 0], edges[:, 1]]), kind="stable")
-    ends = np.concatenate([edges[:, 1], edges[:, 0]])[order]
-    edge_ids = np.concatenate([np.arange(len(edges)), np.arange(len(edges))])[order]
+    source = np.concatenate([edges[:, 0], edges[:, 1]])[order]
+    target = np.concatenate([edges[:, 1], edges[:, 0]])[order]
+    edge_of = np.concatenate([np.arange(count), np.arange(count)])[order]
     start = np.concatenate([[0], np.cumsum(degree)])
-    nbr, eid = ends.tolist(), edge_ids.tolist()
-    start_l, degree_l = start.tolist(), degree.tolist()
+    halves = 2 * count
+    by_edge = np.argsort(edge_of, kind="stable").reshape(-1, 2)
+    reverse = np.empty(halves, dtype=np.int64)
+    reverse[by_edge[:, 0]], reverse[by_edge[:, 1]] = by_edge[:, 1], by_edge[:, 0]
+    # A chain goes on through a degree-2 vertex by its other half-edge, and stops elsewhere.
+    slot = start[target]
+    succ = np.where(degree[target] == 2, np.where(slot == reverse, slot + 1, slot), -1)
+    pred = np.full(halves, -1, dtype=np.int64)
+    going = np.flatnonzero(succ >= 0)
+    pred[succ[going]] = going
+    # List ranking by pointer jumping: each half-edge's chain start and its rank in the chain.
+    index = np.arange(halves)
+    head = np.where(pred >= 0, pred, index)
+    rank = (pred >= 0).astype(np.int64)
+    for _ in range(max(1, int(halves).bit_length())):
+        ahead = head[head]
+        if np.array_equal(ahead, head):
+            break
+        rank += rank[head] * (ahead != head)
+        head = ahead
+    # Half-edges of closed chains never reach a start (a half-edge leaving a node).
+    opened = degree[source[head]] != 2
+    last = np.flatnonzero(opened & (succ < 0))
+    end_of = np.empty(halves, dtype=np.int64)
+    end_of[head[last]] = last
+    # Each chain was walked from the end whose half-edge comes first in CSR order.
+    walked = opened & (head < reverse[end_of[head]])
 
     graph = MedialGraph()
-    node_of: dict[int, int] = {}
-
-    def node_for(vertex: int) -> int:
-        if vertex not in node_of:
-            node_of[vertex] = graph.add_node(xy[vertex], radius[vertex])
-        return node_of[vertex]
-
-    visited = bytearray(len(edges))
-    # For a degree-2 vertex: its two (edge, neighbour) pairs, to step along a chain.
-    two = degree == 2
-    at = np.minimum(start[:-1], len(ends) - 2)
-    first_e, first_n = np.where(two, edge_ids[at], -1).tolist(), np.where(two, ends[at], -1).tolist()
-    second_e, second_n = np.where(two, edge_ids[at + 1], -1).tolist(), np.where(two, ends[at + 1], -1).tolist()
-
-    def walk(first: int, k: int) -> None:
-        path, path_edges = [first], []
-        e = eid[start_l[first] + k]
-        cur = nbr[start_l[first] + k]
-        while True:
-            visited[e] = 1
-            path.append(cur)
-            path_edges.append(e)
-            if degree_l[cur] != 2 or cur in node_of:
-                break
-            if first_e[cur] != e:
-                e2, nxt = first_e[cur], first_n[cur]
-            else:
-                e2, nxt = second_e[cur], second_n[cur]
-            if visited[e2]:
-                break
-            cur, e = nxt, e2
-        a, b = node_for(path[0]), node_for(path[-1])
-        graph.add_branch(Branch(a, b, xy[path], radius[path], sins[path_edges]))
-
-    for vertex in np.flatnonzero(degree != 2).tolist():
-        node_for(vertex)
-    for vertex in np.flatnonzero(degree != 2).tolist():
-        for k in range(degree_l[vertex]):
-            if not visited[eid[start_l[vertex] + k]]:
-                walk(vertex, k)
-    # What is left are closed chains of degree-2 vertices: give each one node and walk it.
-    for e in np.flatnonzero(np.frombuffer(visited, dtype=np.uint8) == 0).tolist():
-        if visited[e]:
+    ends = np.flatnonzero(degree != 2)
+    node_of = np.full(n, -1, dtype=np.int64)
+    for vertex in ends.tolist():
+        node_of[vertex] = graph.add_node(xy[vertex], radius[vertex])
+    chain = np.flatnonzero(walked)
+    chain = chain[np.lexsort((rank[chain], head[chain]))]
+    cuts = np.flatnonzero(np.diff(head[chain])) + 1
+    firsts = np.concatenate([[0], cuts]).tolist()
+    stops = np.concatenate([cuts, [len(chain)]]).tolist()
+    path_all = target[chain]
+    edges_all = edge_of[chain]
+    for lo, hi in zip(firsts, stops):
+        first = chain[lo]
+        path = np.concatenate([[source[first]], path_all[lo:hi]])
+        graph.add_branch(Branch(int(node_of[path[0]]), int(node_of[path[-1]]), xy[path], radius[path],
+                                sins[edges_all[lo:hi]]))
+    # What is left are closed chains of degree-2 vertices: each gets a node at the first
+    # vertex of its lowest edge and is read from there along that edge.
+    seen = np.zeros(count, dtype=bool)
+    seen[edge_of[walked]] = True
+    succ_l, target_l, edge_l = succ.tolist(), target.tolist(), edge_of.tolist()
+    for e in np.flatnonzero(~seen).tolist():
+        if seen[e]:
             continue
         vertex = int(edges[e, 0])
-        node_for(vertex)
-        k = eid[start_l[vertex]:start_l[vertex + 1]].index(e)
-        walk(vertex, k)
+        j = int(by_edge[e, 0] if source[by_edge[e, 0]] == vertex else by_edge[e, 1])
+        path, path_edges = [vertex], []
+        while True:
+            path.append(target_l[j])
+            path_edges.append(edge_l[j])
+            if target_l[j] == vertex:
+                break
+            j = succ_l[j]
+        seen[path_edges] = True
+        node = graph.add_node(xy[vertex], radius[vertex])
+        graph.add_branch(Branch(node, node, xy[path], radius[path], sins[path_edges]))
     return graph
