@@ -10,14 +10,15 @@ as a fresh run, so both give the same bytes.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
 from vectorize.drawing import Drawing
 from vectorize.edits import PAIRINGS, Edits
 from vectorize.intersections import crossing_pairing, touching_pairings
-from vectorize.simplify import _merge
+from vectorize.pass_choices import as_angles, chance_of, foot_angles, normal, pass_options, slots_of
+from vectorize.simplify import _merge, directions
 
 # Cached entries per stage: a session goes back and forth between a few states (undo).
 KEEP = 12
@@ -79,10 +80,14 @@ def _bounded_put(store: dict, key, value, keep: int = KEEP) -> None:
 @dataclass(frozen=True)
 class JunctionInfo:
     """A node the page shows. id: node id of this run (not stable across runs: edits use
-    `at`); at: (x, y) output px; degree; role: "crossing" (degree 4), "y" (a spike's
-    junction), "end" (a stroke ends on a line) or "unresolved"; for crossings: decision (one
-    of `PAIRINGS`), p_crossing and confidence of the classifier, fixed (by an edit) and
-    merged (made from two degree-3 nodes: can be split)."""
+    `at`); at: (x, y) output px; degree; role: "crossing" (degree 4), "triple" (three passes
+    through one point), "y" (a spike's junction), "end" (a stroke ends on a line) or
+    "unresolved"; for crossings: decision (one of `PAIRINGS`), p_crossing and confidence of
+    the classifier, fixed (by an edit) and merged (made from two degree-3 nodes: can be
+    split); for triple points: passes (the pairing drawn, as pairs of branch directions in
+    degrees, `vectorize.pass_choices`), confidence (the pass scorer's posterior, None when
+    continuation alone decided) and options (the pairings that keep the line one stroke,
+    likeliest first: each {"passes", "p"})."""
 
     id: int
     at: tuple[float, float]
@@ -93,6 +98,8 @@ class JunctionInfo:
     confidence: float | None = None
     fixed: bool = False
     merged: bool = False
+    passes: tuple | None = None
+    options: tuple | None = None
 
 
 @dataclass(frozen=True)
@@ -107,13 +114,17 @@ class BranchInfo:
 
 @dataclass(frozen=True)
 class GraphView:
-    """The simplified graph of the chosen reading, in output px."""
+    """The simplified graph of the chosen reading, in output px. retraces: the stretches the
+    line draws twice (route inspection's doubled branches, spikes out and back), each
+    {"at": middle point, "length": px, "points": (M, 2) its centre line}."""
 
     junctions: tuple[JunctionInfo, ...]
     branches: tuple[BranchInfo, ...]
+    retraces: tuple[dict, ...] = ()
 
     def to_dict(self) -> dict:
-        return {"junctions": [vars(j) for j in self.junctions], "branches": [vars(b) for b in self.branches]}
+        return {"junctions": [vars(j) for j in self.junctions], "branches": [vars(b) for b in self.branches],
+                "retraces": list(self.retraces)}
 
 
 def _pairings(directions: np.ndarray) -> tuple:
@@ -149,6 +160,7 @@ class Refinement:
         self.options = options
         self.scale = 1.0 / float(matrix[0, 0])  # working px per output px
         self.tol = edits.tolerance * self.scale
+        self.w = stroke_width
         self.hits: set[int] = set()
         self.fixed: dict[int, str] = {}
         self._index = {id(e): i for i, e in enumerate(edits.items)}
@@ -206,7 +218,7 @@ class Refinement:
 
     # -- traversal and fitting -------------------------------------------------------
     def _solved_key(self) -> tuple:
-        pairings = tuple((e.at, e.pairing) for e in self.edits.of("pairing"))
+        pairings = tuple((e.at, e.pairing, e.passes) for e in self.edits.of("pairing", "passes"))
         return (self.simplify_key(-1), pairings)
 
     def solved(self):
@@ -221,12 +233,30 @@ class Refinement:
         return best, strokes
 
     def keep_solved(self, best, strokes) -> None:
-        early = {self._index[id(e)] for e in self.edits.of("split", "merge", "pairing")} & self.hits
+        early = {self._index[id(e)] for e in self.edits.of("split", "merge", "pairing", "passes")} & self.hits
         _bounded_put(self.cache.solved, self._solved_key(), (best, tuple(strokes), frozenset(early), dict(self.fixed)))
+
+    def fix_passes(self, graph, simple):
+        """`simple` with the triple points' pairings the user chose (`passes` edits)."""
+        self.fixed = {}
+        edits = self.edits.of("passes")
+        if not edits or not simple.through:
+            return simple
+        through = dict(simple.through)
+        nodes = list(through)
+        centers = np.array([graph.positions[n] for n in nodes])
+        for edit in edits:
+            dist = np.linalg.norm(centers - self.to_working(edit.at), axis=1)
+            node = nodes[int(np.argmin(dist))]
+            pairs = slots_of(edit.passes, foot_angles(directions(graph, node, 2.5 * self.w)))
+            if dist.min() <= self.tol and pairs is not None:
+                through[node] = pairs
+                self.fixed[node] = "passes"
+                self.hits.add(self._index[id(edit)])
+        return replace(simple, through=through)
 
     def fix_pairings(self, junctions: dict, ranked: dict, costs: dict) -> None:
         """Pairings the user chose become the only choice at their node (in place)."""
-        self.fixed = {}
         nodes = list(junctions)
         if not nodes:
             return
@@ -279,7 +309,9 @@ class Refinement:
         nodes = []
         for node in sorted(graph.incident):
             degree = graph.degree(node)
-            if node in simple.crossings:
+            if node in simple.through:
+                nodes.append(self._triple_info(solution, node, choice))
+            elif node in simple.crossings:
                 junction, verdict = solution.junctions[node], solution.verdicts[node]
                 nodes.append(JunctionInfo(
                     node, self.to_output(graph.positions[node]), degree, "crossing",
@@ -295,7 +327,36 @@ class Refinement:
             if branch.a != branch.b and graph.degree(branch.a) == 3 and graph.degree(branch.b) == 3:
                 middle = branch.points[len(branch.points) // 2]
                 branches.append(BranchInfo(bid, self.to_output(middle), round(branch.length / self.scale, 3)))
-        return GraphView(tuple(nodes), tuple(branches))
+        return GraphView(tuple(nodes), tuple(branches), self._retraces(solution))
+
+    def _retraces(self, solution) -> tuple[dict, ...]:
+        graph = solution.graph
+        count: dict[int, int] = {}
+        for passes in solution.ordering.strokes:
+            for step in passes:
+                count[step.branch] = count.get(step.branch, 0) + 1
+        result = []
+        for bid in sorted(b for b, n in count.items() if n > 1):
+            points = graph.branches[bid].points
+            step = max(1, len(points) // 40)  # a few dozen points draw it on the page
+            line = np.vstack([points[::step], points[-1:]])
+            result.append({"at": self.to_output(points[len(points) // 2]),
+                           "length": round(graph.branches[bid].length / self.scale, 1),
+                           "points": [self.to_output(p) for p in line]})
+        return tuple(result)
+
+    def _triple_info(self, solution, node: int, choice: dict) -> JunctionInfo:
+        graph, simple = solution.graph, solution.simple
+        dirs = directions(graph, node, 2.5 * self.w)
+        angles = foot_angles(dirs)
+        decided = {**choice, **{n: p for n, p in simple.through.items() if n != node}}
+        options = pass_options(graph, node, dirs, simple.through_posterior.get(node), decided,
+                               one_piece=not self.options.multi)
+        drawn = normal(simple.through[node])
+        return JunctionInfo(node, self.to_output(graph.positions[node]), graph.degree(node), "triple",
+                            decision="passes", confidence=chance_of(drawn, simple.through_posterior.get(node)), fixed=node in self.fixed,
+                            merged=True, passes=tuple(map(tuple, as_angles(drawn, angles))),
+                            options=tuple({"passes": as_angles(p, angles), "p": q} for p, q in options))
 
 
 def _nearest_mergeable(graph, point: np.ndarray, tol: float):

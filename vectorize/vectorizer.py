@@ -93,21 +93,24 @@ def _with_geometry(image: JunctionVerdict, geometry: JunctionVerdict) -> Junctio
     return JunctionVerdict(p_crossing=p, confidence=image.confidence if agree else max(p, 1 - p))
 
 
-def _pair_through(graph: MedialGraph, nodes, gray: np.ndarray, w: float, options: VectorizeOptions) -> dict:
+def _pair_through(graph: MedialGraph, nodes, gray: np.ndarray, w: float, options: VectorizeOptions) -> tuple[dict, dict]:
     """Pair the feet of each triple point: by continuation and the image (the pass scorer,
-    with the CNN classifier, when its model is installed), by continuation alone otherwise."""
+    with the CNN classifier, when its model is installed), by continuation alone otherwise.
+    Returns (node -> slot pairs, six-foot node -> the scorer's posterior over its pairings)."""
     if not nodes:
-        return {}
+        return {}, {}
     feet = {n: directions(graph, n, 2.5 * w) for n in nodes}
     result = {n: straightest_pairs(d)[0] for n, d in feet.items()}
     six = [n for n in nodes if len(feet[n]) == 6]
     scorer = shipped_pass_scorer() if six and getattr(make_classifier(options.classifier), "name", "") == "cnn" else None
+    posterior = {}
     if six and scorer is not None:
-        from vectorize.pass_scorer import pair_feet
+        from vectorize.pass_scorer import scored_pairings
 
         centers = np.array([graph.positions[n] for n in six])
-        result.update(zip(six, pair_feet(gray, centers, [feet[n] for n in six], w, scorer)))
-    return result
+        for node, (pick, odds) in zip(six, scored_pairings(gray, centers, [feet[n] for n in six], w, scorer)):
+            result[node], posterior[node] = pick, odds
+    return result, posterior
 
 
 def _pairing_costs(verdict: JunctionVerdict) -> tuple[float, float, float]:
@@ -224,7 +227,8 @@ def _order(graph: MedialGraph, ink, options: VectorizeOptions, ends: int, clock:
         through = merge_triple_points(graph, stroke_width=w, may_merge=hooks.get("may_merge"))
         simple = simplify(graph, stroke_width=w, multi=options.multi, ends=ends, through=through, **hooks)
         # Paired after simplification: merging crossings next to a triple point renumbers its slots.
-        simple = replace(simple, through=_pair_through(graph, simple.through, ink.gray, w, options))
+        through, posterior = _pair_through(graph, simple.through, ink.gray, w, options)
+        simple = replace(simple, through=through, through_posterior=posterior)
         clock.lap("simplification")
         junction_list = _junctions(graph, simple.crossings, w)
         junctions = dict(zip(simple.crossings, junction_list))
@@ -236,6 +240,8 @@ def _order(graph: MedialGraph, ink, options: VectorizeOptions, ends: int, clock:
         if refine is not None:
             refine.store(ends, (graph, simple, junctions, verdicts))
     clock.lap("classification")
+    if refine is not None:
+        simple = refine.fix_passes(graph, simple)
     ranked = {n: ranked_pairings(junctions[n], verdicts[n]) for n in simple.crossings}
     costs = {n: _pairing_costs(verdicts[n]) for n in simple.crossings}
     if refine is not None:

@@ -5,7 +5,10 @@ import { $, busy, call, report } from "./api.js";
 import { refreshPanel, setupPanels } from "./panels.js";
 
 const PAIRINGS = ["crossing", "touching", "third"];
-const COLORS = { crossing: "#1565c0", touching: "#ef6c00", third: "#8e24aa", other: "#757575", start: "#2e7d32" };
+const COLORS = { crossing: "#1565c0", touching: "#ef6c00", third: "#8e24aa", other: "#757575", start: "#2e7d32",
+                 passes: "#00838f", retrace: "rgba(255, 179, 0, 0.55)" };
+// The three passes through a triple point, each in its own colour inside the marker.
+const PASS_COLORS = ["#d81b60", "#43a047", "#1e88e5", "#6d4c41"];
 
 const studio = {
   state: null,            // last answer of /api/state
@@ -137,6 +140,7 @@ function draw() {
     g.globalAlpha = 1;
   }
   g.restore();
+  retraces(g);
   const t = studio.line;
   const penAt = studio.pen * t.total;
   const width = Math.max(2, Math.min(6, s.stroke_width * v.scale * 0.45));
@@ -176,6 +180,48 @@ function arrows(g, t) {
   }
 }
 
+// Stretches the line draws twice (a stem down and back up, a path route inspection repeats):
+// a wide amber band under the curve, "×2" at its middle.
+function retraces(g) {
+  const s = studio.state;
+  g.save();
+  g.lineCap = "round"; g.lineJoin = "round";
+  g.lineWidth = Math.max(8, s.stroke_width * studio.view.scale * 1.6);
+  g.strokeStyle = COLORS.retrace;
+  for (const r of s.graph.retraces || []) {
+    g.beginPath();
+    r.points.forEach((p, i) => { const [x, y] = toScreen(...p); if (i) g.lineTo(x, y); else g.moveTo(x, y); });
+    g.stroke();
+  }
+  g.fillStyle = "#6d4c00"; g.font = "bold 11px sans-serif"; g.textAlign = "center"; g.textBaseline = "middle";
+  for (const r of s.graph.retraces || []) { const [x, y] = toScreen(...r.at); g.fillText("×2", x + 12, y - 12); }
+  g.restore();
+}
+
+function percent(p) { return p === null || p === undefined ? "" : p < 0.001 ? " <0.1%" : ` ${Math.round(100 * p)}%`; }
+
+// A triple point: its three passes drawn through the marker, each pair of branch directions
+// joined through the centre, so the pairing is seen, not read.
+function tripleMarker(g, j) {
+  const [x, y] = toScreen(...j.at), r = 16;
+  g.lineWidth = 3; g.strokeStyle = COLORS.passes; g.fillStyle = "rgba(255,255,255,0.9)";
+  g.beginPath();
+  if (j.fixed) g.rect(x - r - 2, y - r - 2, 2 * r + 4, 2 * r + 4); else g.arc(x, y, r + 2, 0, 2 * Math.PI);
+  g.fill(); g.stroke();
+  j.passes.forEach(([a, b], k) => {
+    const ra = (a * Math.PI) / 180, rb = (b * Math.PI) / 180;
+    g.strokeStyle = PASS_COLORS[k % PASS_COLORS.length]; g.lineWidth = 2.5;
+    g.beginPath(); g.moveTo(x + r * Math.cos(ra), y + r * Math.sin(ra));
+    g.quadraticCurveTo(x, y, x + r * Math.cos(rb), y + r * Math.sin(rb)); g.stroke();
+  });
+  const k = j.options.findIndex((o) => samePasses(o.passes, j.passes));
+  g.fillStyle = "#222"; g.font = "11px sans-serif"; g.textAlign = "left"; g.textBaseline = "middle";
+  g.fillText(`3 passes${j.confidence === null ? " (straightest)" : percent(j.confidence)} · ${k + 1}/${j.options.length}`,
+    x + r + 6, y);
+}
+
+function samePasses(a, b) { return JSON.stringify(a) === JSON.stringify(b); }
+
 function junctionMarkers(g) {
   const graph = studio.state.graph;
   if (studio.tool === "merge") {
@@ -187,6 +233,7 @@ function junctionMarkers(g) {
   }
   for (const j of graph.junctions) {
     const [x, y] = toScreen(...j.at);
+    if (j.role === "triple") { tripleMarker(g, j); continue; }
     if (j.role !== "crossing") {
       g.strokeStyle = COLORS.other; g.lineWidth = 2;
       g.beginPath(); g.arc(x, y, 5, 0, 2 * Math.PI); g.stroke();
@@ -227,11 +274,26 @@ function show(state) {
     ` · ${(state.answered ?? r.seconds).toFixed(2)} s`;
   $("summary").dataset.order = JSON.stringify(state.strokes.map((s) => s.points[0]));
   const list = $("junctions"); list.innerHTML = "";
-  for (const j of state.graph.junctions.filter((j) => j.role === "crossing")) {
+  for (const j of state.graph.junctions.filter((j) => j.role === "crossing" || j.role === "triple")) {
     const li = document.createElement("li");
-    li.textContent = `(${j.at[0].toFixed(0)}, ${j.at[1].toFixed(0)}) ${j.decision}` +
-      ` · CNN p(cross) ${(j.p_crossing * 100).toFixed(0)}%` + (j.fixed ? " · fixed by you" : "");
+    const where = `(${j.at[0].toFixed(0)}, ${j.at[1].toFixed(0)})`;
     li.style.color = COLORS[j.decision];
+    if (j.role === "triple") {
+      li.append(`${where} three passes · ${j.confidence === null ? "straightest" : "pass scorer" + percent(j.confidence)} `);
+      li.appendChild(passChoice(j));
+      if (j.fixed) li.append(" · fixed by you");
+    } else {
+      li.textContent = `${where} ${j.decision} · CNN p(cross) ${(j.p_crossing * 100).toFixed(0)}%` +
+        (j.fixed ? " · fixed by you" : "");
+    }
+    list.appendChild(li);
+  }
+  const twice = state.graph.retraces || [];
+  if (twice.length) {
+    const li = document.createElement("li");
+    li.className = "retraces";
+    li.textContent = `drawn twice (×2): ${twice.length} stretch${twice.length === 1 ? "" : "es"}, ` +
+      `${Math.round(twice.reduce((sum, r) => sum + r.length, 0))} px`;
     list.appendChild(li);
   }
   const warnings = $("warnings"); warnings.innerHTML = "";
@@ -250,6 +312,25 @@ function show(state) {
   refreshPanel();
 }
 
+// The pairings a triple point may take (each keeps the line one stroke), likeliest first.
+function passChoice(j) {
+  const select = document.createElement("select");
+  select.className = "passes"; select.title = "How the pen went through: the pairs of branch directions (degrees)";
+  j.options.forEach((o, k) => {
+    const option = document.createElement("option");
+    option.value = String(k);
+    option.textContent = `${k + 1}: ` + o.passes.map(([a, b]) => `${Math.round(a)}°–${Math.round(b)}°`).join(", ") + percent(o.p);
+    option.selected = samePasses(o.passes, j.passes);
+    select.appendChild(option);
+  });
+  select.onchange = () => choosePasses(j, j.options[Number(select.value)]);
+  return select;
+}
+
+function choosePasses(j, option) {
+  return apply(withEdit({ kind: "passes", at: j.at, passes: option.passes }, true));
+}
+
 // ---------------------------------------------------------------- clicks on the drawing
 function nearest(items, point, radius) {
   let best = null, bestD = radius / studio.view.scale;
@@ -265,12 +346,18 @@ function onClick(event) {
   if (!s || studio.dragged) return;
   const r = $("canvas").getBoundingClientRect();
   const p = toImage(event.clientX - r.left, event.clientY - r.top);
-  const crossings = s.graph.junctions.filter((j) => j.role === "crossing");
+  const crossings = s.graph.junctions.filter((j) => j.role === "crossing" || j.role === "triple");
   const tool = studio.tool;
   if (tool === "pairing" || tool === "split") {
-    const j = nearest(crossings, p, 16);
+    const j = nearest(crossings, p, 18);
     if (!j) return;
     if (tool === "split") return apply(withEdit({ kind: "split", at: j.at }, false));
+    if (j.role === "triple") {
+      // The next of the pairings that keep one stroke, in the order of their likelihood.
+      if (!j.options.length) return;
+      const k = j.options.findIndex((o) => samePasses(o.passes, j.passes));
+      return choosePasses(j, j.options[(k + 1) % j.options.length]);
+    }
     const next = PAIRINGS[(PAIRINGS.indexOf(j.decision) + 1) % 3];
     return apply(withEdit({ kind: "pairing", at: j.at, pairing: next }, true));
   }
