@@ -15,8 +15,10 @@ Kinds, and the stage each one re-runs from:
 - `passes` (how the pen went through a node where three passes meet, six branches: each
   pass as the directions of its two branches leaving the node, degrees, 0 = +x, 90 = +y
   down the image): from traversal, as a fixed decision;
-- `reverse` (the stroke through the position runs the other way), `start` (the stroke
-  with an end at the position starts there, and comes first): after fitting.
+- `reverse` (the stroke through the position runs the other way): after fitting;
+  `start` (the stroke with an end at the position starts there, and comes first; in
+  single-line mode a free end the line passes, the tip of a stroke drawn out and back,
+  becomes an end of the route, which then retraces other branches): from traversal.
 """
 
 from __future__ import annotations

@@ -2,8 +2,8 @@
 view of the graph they act on.
 
 `StageCache` keeps what earlier stages made for one image, keyed by what they depend on,
-so that an edit re-runs only the stages after it: a pairing re-runs traversal and
-fitting; a split or merge re-runs simplification and classification as well; threshold,
+so that an edit re-runs only the stages after it: a pairing or a start re-runs traversal
+and fitting; a split or merge re-runs simplification and classification as well; threshold,
 blur and mode re-run everything. The cached path makes the same calls on the same inputs
 as a fresh run, so both give the same bytes.
 """
@@ -121,10 +121,11 @@ class GraphView:
     junctions: tuple[JunctionInfo, ...]
     branches: tuple[BranchInfo, ...]
     retraces: tuple[dict, ...] = ()
+    ends: tuple[tuple[float, float], ...] = ()  # the free ends of the line (where it may start)
 
     def to_dict(self) -> dict:
         return {"junctions": [vars(j) for j in self.junctions], "branches": [vars(b) for b in self.branches],
-                "retraces": list(self.retraces)}
+                "retraces": list(self.retraces), "ends": [list(e) for e in self.ends]}
 
 
 def _pairings(directions: np.ndarray) -> tuple:
@@ -195,13 +196,25 @@ class Refinement:
         merges = [(self._index[id(e)], self.to_working(e.at)) for e in self.edits.of("merge")]
         hooks = {}
         if splits:
-            def may_merge(branch) -> bool:
+            # A split at a triple point keeps its cluster apart and is then spent: the
+            # cluster's junctions pair up as crossings, as anywhere else.
+            spent: set[int] = set()
+
+            def refuse(branch, exclude: set[int]) -> int | None:
                 for index, point in splits:
-                    if np.min(np.linalg.norm(branch.points - point, axis=1)) <= self.tol:
+                    if index not in exclude and np.min(np.linalg.norm(branch.points - point, axis=1)) <= self.tol:
                         self.hits.add(index)
-                        return False
-                return True
-            hooks["may_merge"] = may_merge
+                        return index
+                return None
+
+            def may_cluster(branch) -> bool:
+                index = refuse(branch, set())
+                if index is not None:
+                    spent.add(index)
+                return index is None
+
+            hooks["may_cluster"] = may_cluster
+            hooks["may_merge"] = lambda branch: refuse(branch, spent) is None
         if merges:
             def after_merging(graph) -> int:
                 done = 0
@@ -219,7 +232,24 @@ class Refinement:
     # -- traversal and fitting -------------------------------------------------------
     def _solved_key(self) -> tuple:
         pairings = tuple((e.at, e.pairing, e.passes) for e in self.edits.of("pairing", "passes"))
-        return (self.simplify_key(-1), pairings)
+        return (self.simplify_key(-1), pairings, self._start())
+
+    def _start(self):
+        """The last start edit's position: where the line begins (it may change the route)."""
+        starts = self.edits.of("start")
+        return starts[-1].at if starts else None
+
+    def start_ends(self, graph) -> dict:
+        """node -> end cost for the route: the free end at the last start edit (a tip the
+        line now passes, such as a stem's drawn down and back up) must be an end of it."""
+        at = self._start()
+        ends = [n for n, incident in graph.incident.items() if len(incident) == 1]
+        if at is None or not ends:
+            return {}
+        dist = np.linalg.norm(np.array([graph.positions[n] for n in ends]) - self.to_working(at), axis=1)
+        k = int(np.argmin(dist))
+        # Far below any retraced length: the matching leaves this node unpaired.
+        return {ends[k]: -1e9} if dist[k] <= self.tol + self.w else {}
 
     def solved(self):
         """(best solution, fitted working strokes) of an earlier run with the same edits up to
@@ -327,7 +357,8 @@ class Refinement:
             if branch.a != branch.b and graph.degree(branch.a) == 3 and graph.degree(branch.b) == 3:
                 middle = branch.points[len(branch.points) // 2]
                 branches.append(BranchInfo(bid, self.to_output(middle), round(branch.length / self.scale, 3)))
-        return GraphView(tuple(nodes), tuple(branches), self._retraces(solution))
+        ends = tuple(self.to_output(graph.positions[n]) for n in sorted(graph.incident) if graph.degree(n) == 1)
+        return GraphView(tuple(nodes), tuple(branches), self._retraces(solution), ends)
 
     def _retraces(self, solution) -> tuple[dict, ...]:
         graph = solution.graph

@@ -224,7 +224,7 @@ def _order(graph: MedialGraph, ink, options: VectorizeOptions, ends: int, clock:
         graph, simple, junctions, verdicts = cached
     else:
         hooks = refine.simplify_hooks() if refine is not None else {}
-        through = merge_triple_points(graph, stroke_width=w, may_merge=hooks.get("may_merge"))
+        through = merge_triple_points(graph, stroke_width=w, may_merge=hooks.pop("may_cluster", None))
         simple = simplify(graph, stroke_width=w, multi=options.multi, ends=ends, through=through, **hooks)
         # Paired after simplification: merging crossings next to a triple point renumbers its slots.
         through, posterior = _pair_through(graph, simple.through, ink.gray, w, options)
@@ -249,7 +249,8 @@ def _order(graph: MedialGraph, ink, options: VectorizeOptions, ends: int, clock:
     if options.multi:
         ordering, tried = order_strokes(graph, simple, ranked, costs, stroke_width=w)
     else:
-        ordering, tried = _single_route(graph, simple, ranked, costs, w)
+        ordering, tried = _single_route(graph, simple, ranked, costs, w,
+                                        refine.start_ends(graph) if refine is not None else None)
     clock.lap("traversal")
     return _Solution(graph, simple, junctions, verdicts, ordering, tried)
 
@@ -275,8 +276,9 @@ def _junction_end_cost(graph: MedialGraph, node: int, dirs: np.ndarray, w: float
 
 
 def _single_route(graph: MedialGraph, simple: Simplified, ranked: dict, costs: dict,
-                  w: float) -> tuple[Ordering, int]:
-    """Single-line mode: one stroke over the whole (connected) graph, retracing the least."""
+                  w: float, start_at: dict | None = None) -> tuple[Ordering, int]:
+    """Single-line mode: one stroke over the whole (connected) graph, retracing the least.
+    start_at: node -> end cost (px) that overrides the rule (a user's start edit)."""
     pairing, tried = connect_pairings(graph, ranked, costs, fixed=simple.through)
     dirs = {n: directions(graph, n, 2.5 * w) for n in graph.incident if graph.degree(n) >= 3}
     # The tip of a sharp corner's spur is not where a pen starts; a junction is a poorer
@@ -285,6 +287,7 @@ def _single_route(graph: MedialGraph, simple: Simplified, ranked: dict, costs: d
               if n not in simple.retraced}
     end_cost = {n: 3.0 * w for n in v_tips}
     end_cost.update({n: _junction_end_cost(graph, n, dirs[n], w) for n in dirs})
+    end_cost.update(start_at or {})
     routes = plan_routes(graph, {**simple.through, **pairing}, stroke_width=w, directions=dirs, end_cost=end_cost)
     choice = tuple(pairing.get(n, ranked[n][0]) for n in simple.crossings)
     return Ordering(tuple(r.passes for r in routes), tuple(r.closed for r in routes), choice), tried

@@ -153,14 +153,14 @@ function draw() {
     g.beginPath(); g.moveTo(a[0], a[1]); g.lineTo(b[0], b[1]); g.stroke();
   }
   arrows(g, t);
-  // Start markers: where each stroke begins.
+  junctionMarkers(g);
+  // Start markers: where each stroke begins (over a junction the line starts at).
   s.strokes.forEach((stroke, k) => {
     const [x, y] = toScreen(...stroke.points[0]);
     g.fillStyle = COLORS.start; g.beginPath(); g.arc(x, y, k === 0 ? 7 : 5, 0, 2 * Math.PI); g.fill();
     g.fillStyle = "#fff"; g.font = "bold 9px sans-serif"; g.textAlign = "center"; g.textBaseline = "middle";
     g.fillText(String(k + 1), x, y + 0.5);
   });
-  junctionMarkers(g);
   if (studio.pen < 1 || studio.playing) penMarker(g, t, penAt);
   else $("where").textContent = `${Math.round(t.total)} px, ${s.strokes.length} stroke${s.strokes.length === 1 ? "" : "s"}`;
 }
@@ -215,15 +215,28 @@ function tripleMarker(g, j) {
     g.quadraticCurveTo(x, y, x + r * Math.cos(rb), y + r * Math.sin(rb)); g.stroke();
   });
   const k = j.options.findIndex((o) => samePasses(o.passes, j.passes));
-  g.fillStyle = "#222"; g.font = "11px sans-serif"; g.textAlign = "left"; g.textBaseline = "middle";
-  g.fillText(`3 passes${j.confidence === null ? " (straightest)" : percent(j.confidence)} · ${k + 1}/${j.options.length}`,
+  label(g, `3 passes${j.confidence === null ? " (straightest)" : percent(j.confidence)} · ${k + 1}/${j.options.length}`,
     x + r + 6, y);
+}
+
+// A marker's text, on a white halo so that it reads over the curve.
+function label(g, text, x, y) {
+  g.font = "11px sans-serif"; g.textAlign = "left"; g.textBaseline = "middle";
+  g.strokeStyle = "rgba(255,255,255,0.9)"; g.lineWidth = 3; g.lineJoin = "round"; g.strokeText(text, x, y);
+  g.fillStyle = "#222"; g.fillText(text, x, y);
 }
 
 function samePasses(a, b) { return JSON.stringify(a) === JSON.stringify(b); }
 
 function junctionMarkers(g) {
   const graph = studio.state.graph;
+  if (studio.tool === "start") {
+    for (const at of graph.ends || []) {
+      const [x, y] = toScreen(...at);
+      g.strokeStyle = COLORS.start; g.lineWidth = 2; g.setLineDash([3, 2]);
+      g.beginPath(); g.arc(x, y, 9, 0, 2 * Math.PI); g.stroke(); g.setLineDash([]);
+    }
+  }
   if (studio.tool === "merge") {
     for (const b of graph.branches) {
       const [x, y] = toScreen(...b.at);
@@ -247,8 +260,7 @@ function junctionMarkers(g) {
     // Confidence as the filled share of an inner disc.
     g.fillStyle = color; g.beginPath(); g.moveTo(x, y);
     g.arc(x, y, 6, -Math.PI / 2, -Math.PI / 2 + 2 * Math.PI * (j.confidence || 0)); g.closePath(); g.fill();
-    g.fillStyle = "#222"; g.font = "11px sans-serif"; g.textAlign = "left"; g.textBaseline = "middle";
-    g.fillText(`${j.decision} ${Math.round(100 * (j.confidence || 0))}%`, x + 12, y);
+    label(g, `${j.decision} ${Math.round(100 * (j.confidence || 0))}%`, x + 12, y);
   }
 }
 
@@ -367,7 +379,9 @@ function onClick(event) {
     return;
   }
   if (tool === "start") {
-    const ends = [];
+    // A stroke's end, or a free end the line passes (the tip of a stem drawn down and back
+    // up): starting there, the line retraces other branches instead.
+    const ends = (s.graph.ends || []).map((at) => ({ at }));
     for (const stroke of s.strokes) if (!stroke.closed) {
       ends.push({ at: stroke.points[0] }, { at: stroke.points[stroke.points.length - 1] });
     }
