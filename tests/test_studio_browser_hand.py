@@ -1,8 +1,9 @@
 """The studio on hand drawings of the benchmark's generators, in a real browser: a triple
-point (six branches, three passes) clicked through its pairings and picked from its list,
-a cursive word whose stems are drawn down and back up (the stretches drawn twice shown;
-the line started at a stem's tip), and the page's exports against the CLI's bytes with
-those edits. Screenshots go to test-artifacts/."""
+point (six branches, three passes) clicked through its pairings, picked from its list and
+split into two crossings; a cursive word whose stems are drawn down and back up, with two
+pen gaps (the stretches drawn twice and the bridged gaps shown; the line started at the
+tip of its lead-in); and the page's exports against the CLI's bytes with those edits.
+Screenshots go to test-artifacts/."""
 
 from __future__ import annotations
 
@@ -104,7 +105,10 @@ def test_a_cursive_word_shows_its_retraces_and_starts_at_a_stems_tip(served, tmp
     # The stretches drawn twice are data and on the page.
     assert graph["retraces"] and all(r["length"] > 0 and len(r["points"]) >= 2 for r in graph["retraces"])
     assert "drawn twice" in page.inner_text("#junctions")
-    page.screenshot(path=str(ARTIFACTS / "studio-hand-3-retraces.png"))
+    # The two pen gaps were bridged: marked where they are.
+    assert len(graph["bridges"]) == 2 and "pen gaps bridged: 2" in page.inner_text("#junctions")
+    assert sorted(round(a[0], -2) for a, _ in graph["bridges"]) == [400, 700]
+    page.screenshot(path=str(ARTIFACTS / "studio-hand-3-retraces-gaps.png"))
 
     # The line should start at the word's lead-in (the leftmost free end), which the route
     # passes through, out and back: the start tool marks every free end, a click there

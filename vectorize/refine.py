@@ -122,10 +122,12 @@ class GraphView:
     branches: tuple[BranchInfo, ...]
     retraces: tuple[dict, ...] = ()
     ends: tuple[tuple[float, float], ...] = ()  # the free ends of the line (where it may start)
+    bridges: tuple[tuple[tuple[float, float], tuple[float, float]], ...] = ()  # pen gaps joined: their ends
 
     def to_dict(self) -> dict:
         return {"junctions": [vars(j) for j in self.junctions], "branches": [vars(b) for b in self.branches],
-                "retraces": list(self.retraces), "ends": [list(e) for e in self.ends]}
+                "retraces": list(self.retraces), "ends": [list(e) for e in self.ends],
+                "bridges": [[list(a), list(b)] for a, b in self.bridges]}
 
 
 def _pairings(directions: np.ndarray) -> tuple:
@@ -333,7 +335,8 @@ class Refinement:
                 for i, e in enumerate(self.edits.items) if i not in self.hits]
 
     # -- the page's view -------------------------------------------------------------
-    def graph_view(self, solution) -> GraphView:
+    def graph_view(self, solution, bridges=()) -> GraphView:
+        """What the page shows of `solution`; bridges: the pen gaps bridged (working px)."""
         graph, simple = solution.graph, solution.simple
         choice = dict(zip(simple.crossings, solution.ordering.choice))
         nodes = []
@@ -358,7 +361,8 @@ class Refinement:
                 middle = branch.points[len(branch.points) // 2]
                 branches.append(BranchInfo(bid, self.to_output(middle), round(branch.length / self.scale, 3)))
         ends = tuple(self.to_output(graph.positions[n]) for n in sorted(graph.incident) if graph.degree(n) == 1)
-        return GraphView(tuple(nodes), tuple(branches), self._retraces(solution), ends)
+        gaps = tuple((self.to_output(a), self.to_output(b)) for a, b in bridges)
+        return GraphView(tuple(nodes), tuple(branches), self._retraces(solution), ends, gaps)
 
     def _retraces(self, solution) -> tuple[dict, ...]:
         graph = solution.graph

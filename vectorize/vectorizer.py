@@ -331,7 +331,8 @@ def _axis(image: np.ndarray, options: VectorizeOptions, clock: _Clock, cache: St
 
 def _front(image: np.ndarray, options: VectorizeOptions, clock: _Clock, cache: StageCache | None = None):
     """Binarize, outline, medial axis, pruning and (single-line) gap bridging: the stages
-    that only threshold, blur and mode change. Returns (ink, rings, graph, bridged, dropped).
+    that only threshold, blur and mode change. Returns (ink, rings, graph, bridges, dropped),
+    bridges: the pen gaps bridged, each as its two ends (working px).
 
     With `cache`, the stages before pruning are shared between the modes (a copy of the
     cached graph is pruned) and the paper-flattened gray between thresholds."""
@@ -348,11 +349,12 @@ def _front(image: np.ndarray, options: VectorizeOptions, clock: _Clock, cache: S
     branch_points = sum(1 for incident in graph.incident.values() if len(incident) >= 3)
     _refuse_noise(branch_points, "branch points", MAX_BRANCH_POINTS, ink.threshold,
                   options.threshold is not None)
-    bridged = dropped = 0
+    bridges: list = []
+    dropped = 0
     if not options.multi:
-        bridged = bridge_gaps(graph, stroke_width=w)
+        bridge_gaps(graph, stroke_width=w, made=bridges)
         dropped = keep_largest_piece(graph)
-    return ink, rings, graph, bridged, dropped
+    return ink, rings, graph, tuple(bridges), dropped
 
 
 def run_pipeline(image: np.ndarray, options: VectorizeOptions, *,
@@ -375,7 +377,7 @@ def run_pipeline(image: np.ndarray, options: VectorizeOptions, *,
         front = cache.front_for(image, options, lambda stages: _front(image, options, clock, stages))
     else:
         front = _front(image, options, clock)
-    ink, rings, graph, bridged, dropped = front
+    ink, rings, graph, bridges, dropped = front
     w = ink.stroke_width
     scale = ink.scale * frame.scale  # working px per output unit
     # Working pixel centres sit at integers (scikit-image); in SVG and in the input's pixel
@@ -437,11 +439,11 @@ def run_pipeline(image: np.ndarray, options: VectorizeOptions, *,
         warnings.append(f"the line could not be followed in one stroke: {len(strokes)} strokes")
     report = VectorizeReport(
         strokes=len(strokes), intersections=len(simple.crossings), y_junctions=len(simple.y_feet),
-        dropped_components=dropped, gaps_bridged=bridged, high_degree_junctions=len(simple.unresolved), retries=tried - 1,
+        dropped_components=dropped, gaps_bridged=len(bridges), high_degree_junctions=len(simple.unresolved), retries=tried - 1,
         scale=scale, stroke_width=w / scale, warnings=tuple(warnings), seconds=clock.seconds,
         cpu_seconds=clock.cpu_seconds)
     if stages is not None:
         stages.update(simplified=graph, simple=simple, junctions=junctions, verdicts=verdicts,
                       ordering=ordering, working_strokes=strokes)
-    view = refine.graph_view(best) if refine is not None else None
+    view = refine.graph_view(best, bridges) if refine is not None else None
     return VectorizeResult(drawing, report, stages, view)

@@ -6,7 +6,7 @@ import { refreshPanel, setupPanels } from "./panels.js";
 
 const PAIRINGS = ["crossing", "touching", "third"];
 const COLORS = { crossing: "#1565c0", touching: "#ef6c00", third: "#8e24aa", other: "#757575", start: "#2e7d32",
-                 passes: "#00838f", retrace: "rgba(255, 179, 0, 0.55)" };
+                 passes: "#00838f", retrace: "rgba(255, 179, 0, 0.55)", gap: "#c2185b" };
 // The three passes through a triple point, each in its own colour inside the marker.
 const PASS_COLORS = ["#d81b60", "#43a047", "#1e88e5", "#6d4c41"];
 
@@ -154,6 +154,7 @@ function draw() {
   }
   arrows(g, t);
   junctionMarkers(g);
+  bridges(g);
   // Start markers: where each stroke begins (over a junction the line starts at).
   s.strokes.forEach((stroke, k) => {
     const [x, y] = toScreen(...stroke.points[0]);
@@ -195,6 +196,20 @@ function retraces(g) {
   }
   g.fillStyle = "#6d4c00"; g.font = "bold 11px sans-serif"; g.textAlign = "center"; g.textBaseline = "middle";
   for (const r of s.graph.retraces || []) { const [x, y] = toScreen(...r.at); g.fillText("×2", x + 12, y - 12); }
+  g.restore();
+}
+
+// Pen gaps the vectorizer bridged: the two ends joined, dashed, under the curve.
+function bridges(g) {
+  g.save();
+  for (const [a, b] of studio.state.graph.bridges || []) {
+    const [ax, ay] = toScreen(...a), [bx, by] = toScreen(...b);
+    const r = Math.max(9, Math.hypot(bx - ax, by - ay) / 2 + 5);
+    g.strokeStyle = COLORS.gap; g.lineWidth = 2; g.setLineDash([4, 3]);
+    g.beginPath(); g.arc((ax + bx) / 2, (ay + by) / 2, r, 0, 2 * Math.PI); g.stroke();
+    g.setLineDash([]);
+    label(g, "gap", (ax + bx) / 2 + r + 3, (ay + by) / 2);
+  }
   g.restore();
 }
 
@@ -298,6 +313,13 @@ function show(state) {
       li.textContent = `${where} ${j.decision} · CNN p(cross) ${(j.p_crossing * 100).toFixed(0)}%` +
         (j.fixed ? " · fixed by you" : "");
     }
+    list.appendChild(li);
+  }
+  const gaps = state.graph.bridges || [];
+  if (gaps.length) {
+    const li = document.createElement("li");
+    li.className = "gaps";
+    li.textContent = `pen gap${gaps.length === 1 ? "" : "s"} bridged: ${gaps.length} (dashed circles)`;
     list.appendChild(li);
   }
   const twice = state.graph.retraces || [];
