@@ -389,8 +389,8 @@ class Refinement:
                                one_piece=not self.options.multi)
         drawn = normal(simple.through[node])
         return JunctionInfo(node, self.to_output(graph.positions[node]), graph.degree(node), "triple",
-                            decision="passes", confidence=chance_of(drawn, simple.through_posterior.get(node)), fixed=node in self.fixed,
-                            merged=True, passes=tuple(map(tuple, as_angles(drawn, angles))),
+                            decision="passes", confidence=chance_of(drawn, simple.through_posterior.get(node)),
+                            fixed=node in self.fixed, merged=True, passes=tuple(map(tuple, as_angles(drawn, angles))),
                             options=tuple({"passes": as_angles(p, angles), "p": q} for p, q in options))
 
 

@@ -93,7 +93,8 @@ def _with_geometry(image: JunctionVerdict, geometry: JunctionVerdict) -> Junctio
     return JunctionVerdict(p_crossing=p, confidence=image.confidence if agree else max(p, 1 - p))
 
 
-def _pair_through(graph: MedialGraph, nodes, gray: np.ndarray, w: float, options: VectorizeOptions) -> tuple[dict, dict]:
+def _pair_through(graph: MedialGraph, nodes, gray: np.ndarray, w: float,
+                  options: VectorizeOptions) -> tuple[dict, dict]:
     """Pair the feet of each triple point: by continuation and the image (the pass scorer,
     with the CNN classifier, when its model is installed), by continuation alone otherwise.
     Returns (node -> slot pairs, six-foot node -> the scorer's posterior over its pairings)."""
@@ -439,7 +440,8 @@ def run_pipeline(image: np.ndarray, options: VectorizeOptions, *,
         warnings.append(f"the line could not be followed in one stroke: {len(strokes)} strokes")
     report = VectorizeReport(
         strokes=len(strokes), intersections=len(simple.crossings), y_junctions=len(simple.y_feet),
-        dropped_components=dropped, gaps_bridged=len(bridges), high_degree_junctions=len(simple.unresolved), retries=tried - 1,
+        dropped_components=dropped, gaps_bridged=len(bridges), high_degree_junctions=len(simple.unresolved),
+        retries=tried - 1,
         scale=scale, stroke_width=w / scale, warnings=tuple(warnings), seconds=clock.seconds,
         cpu_seconds=clock.cpu_seconds)
     if stages is not None:
