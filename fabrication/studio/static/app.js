@@ -263,8 +263,12 @@ function junctionMarkers(g) {
     const [x, y] = toScreen(...j.at);
     if (j.role === "triple") { tripleMarker(g, j); continue; }
     if (j.role !== "crossing") {
-      g.strokeStyle = COLORS.other; g.lineWidth = 2;
-      g.beginPath(); g.arc(x, y, 5, 0, 2 * Math.PI); g.stroke();
+      // An unresolved junction (the warning's "three or more strokes seem to meet") is
+      // named where it is: the order there is the walk's guess.
+      const open = j.role === "unresolved";
+      g.strokeStyle = open ? COLORS.gap : COLORS.other; g.lineWidth = 2;
+      g.beginPath(); g.arc(x, y, open ? 8 : 5, 0, 2 * Math.PI); g.stroke();
+      if (open) label(g, "unresolved ?", x + 11, y);
       continue;
     }
     const color = COLORS[j.decision] || COLORS.other;
