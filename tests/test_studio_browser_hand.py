@@ -89,14 +89,8 @@ def test_a_triple_point_cycles_through_the_pairings_that_keep_one_stroke(served,
     # The exports are the CLI's bytes for the page's edits (kind "passes" in the file).
     edits = page.evaluate(f"{STATE}.edits")
     assert [e["kind"] for e in edits["edits"]] == ["passes"]
-    _, svg = download(page, "[data-export=svg]")
-    assert svg == cli_bytes("vectorize", drawing, edits, tmp_path, ".svg")
-    page.click("nav .tab[data-tab=embroidery]")
-    settle(page, extra="document.getElementById('embroidery-stats').textContent.includes('stitches')")
-    _, pes = download(page, "[data-export=pes]")
-    assert pes == cli_bytes("embroider", drawing, edits, tmp_path, ".pes", "--size", "90mm", "--hoop", "100x100",
-                            "--color", "#1f3a93")
-    page.click("nav .tab[data-tab=refine]")
+    exports_match_the_cli(page, drawing, edits, tmp_path, "embroider", "pes",
+                          "--size", "90mm", "--hoop", "100x100", "--color", "#1f3a93")
 
 
 def test_a_cursive_word_shows_its_retraces_and_starts_at_a_stems_tip(served, tmp_path):
@@ -132,14 +126,23 @@ def test_a_cursive_word_shows_its_retraces_and_starts_at_a_stems_tip(served, tmp
     settle(page, 2)
     assert math.dist(page.evaluate(f"{STATE}.strokes[0].points.slice(-1)[0]"), tip) < 3
     edits = page.evaluate(f"{STATE}.edits")
+    exports_match_the_cli(page, drawing, edits, tmp_path, "laser", "gcode", "--size", "80mm", "--feed", "1500mm/min",
+                          "--power", "60%", "--passes", "1", "--origin", "lower-left")
+
+
+def exports_match_the_cli(page, drawing, edits, tmp_path, command: str, kind: str, *flags) -> None:
+    """The page's SVG, and its `kind` download from the `command` panel (the page's default
+    option values: `flags`), are the bytes the CLI writes with the same edits."""
     _, svg = download(page, "[data-export=svg]")
     assert svg == cli_bytes("vectorize", drawing, edits, tmp_path, ".svg")
-    page.click("nav .tab[data-tab=laser]")
-    settle(page, extra="document.getElementById('laser-time').textContent.includes('estimated')")
-    _, gcode = download(page, "[data-export=gcode]")
-    assert gcode == cli_bytes("laser", drawing, edits, tmp_path, ".gcode", "--size", "80mm", "--feed", "1500mm/min",
-                              "--power", "60%", "--passes", "1", "--origin", "lower-left")
-    page.screenshot(path=str(ARTIFACTS / "studio-hand-5-laser.png"))
+    # The panel's tab, and the text its preview shows once it is made.
+    tab, element, word = {"embroider": ("embroidery", "embroidery-stats", "stitches"),
+                          "laser": ("laser", "laser-time", "estimated")}[command]
+    page.click(f"nav .tab[data-tab={tab}]")
+    settle(page, extra=f"document.getElementById('{element}').textContent.includes('{word}')")
+    page.screenshot(path=str(ARTIFACTS / f"studio-hand-{tab}.png"))
+    _, data = download(page, f"[data-export={kind}]")
+    assert data == cli_bytes(command, drawing, edits, tmp_path, f".{kind}", *flags)
     page.click("nav .tab[data-tab=refine]")
 
 
