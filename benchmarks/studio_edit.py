@@ -9,9 +9,14 @@ vectorization, each edit kind is sent --repeats (7) times through Starlette's te
 way the page sends it, and the median answer time is printed per kind. Every answer is
 for an edit the cache has not seen in that form (a new threshold or blur value, a split
 or merge with the simplification cache emptied first), so the figures are for the stages
-each kind really re-runs: pairing -> traversal and fitting; start/reverse -> nothing but the
-orientation (the fitted curve of the same earlier edits is cached); split/merge ->
-simplification on; threshold/blur/multi -> everything from binarization.
+each kind really re-runs: pairing, passes (a triple point's pairing) and start -> traversal
+and fitting; reverse -> nothing but the orientation (the fitted curve of the same earlier
+edits is cached); split/merge -> simplification on; threshold/blur/multi -> everything
+from binarization.
+
+`--hand` adds two 1000 px hand drawings of the benchmark's generators (the "triple" set's
+second drawing: a triple point and three crossings; the cursive word "little", stems
+drawn down and back up), rendered to a temporary folder.
 
 The last columns are the slider steps of a session that precomputes (`onestroke studio`):
 after each threshold or blur answer the server computes the neighbouring slider values
@@ -62,6 +67,7 @@ def bench(path: Path, panels: bool = False, repeats: int = REPEATS) -> tuple[dic
     first = time.perf_counter() - first
     edits = base["edits"]
     crossings = [j for j in base["graph"]["junctions"] if j["role"] == "crossing"] or [None]
+    triples = [j for j in base["graph"]["junctions"] if j["role"] == "triple" and len(j["options"]) > 2]
     stroke = base["strokes"][0]["points"]
 
     cpu: dict[str, list[float]] = {}
@@ -106,6 +112,10 @@ def bench(path: Path, panels: bool = False, repeats: int = REPEATS) -> tuple[dic
             session.cache.simplified.clear()
             session.cache.solved.clear()
             times.add("merge", post({}, [{"kind": "split", "at": j["at"]}, {"kind": "merge", "at": branch["at"]}]))
+        for t in (triples[rep % len(triples)],) if triples else ():
+            session.cache.solved.clear()
+            option = t["options"][1 + rep % 2]["passes"]
+            times.add("passes", post({}, [{"kind": "passes", "at": t["at"], "passes": option}]))
         post({}, [])  # the page shows the automatic result before the user picks an end
         times.add("start", post({}, [{"kind": "start", "at": stroke[-1] if rep % 2 == 0 else stroke[0]}]))
         times.add("reverse", post({}, [{"kind": "reverse", "at": stroke[len(stroke) // 2]}]))
@@ -145,18 +155,40 @@ def stepped(path: Path, repeats: int = REPEATS) -> dict[str, tuple[float, float]
     return {kind: (median(w for w, _ in values), median(c for _, c in values)) for kind, values in found.items()}
 
 
+def hand_drawings() -> list[Path]:
+    """The triple set's second drawing and the cursive word "little", as PNGs in a temporary folder."""
+    import tempfile
+
+    from PIL import Image
+
+    from benchmarks.drawings import generate_set
+    from benchmarks.handwriting import handwriting_drawing
+    from benchmarks.render import render, to_uint8
+
+    folder = Path(tempfile.mkdtemp(prefix="studio-edit-"))
+    paths = []
+    for truth in (generate_set("triple", 2, 0)[1], handwriting_drawing(0, 3)):
+        paths.append(folder / f"{truth.name}.png")
+        Image.fromarray(to_uint8(render(truth.drawing))).save(paths[-1])
+    return paths
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description="Median answer time of each studio edit kind.")
     parser.add_argument("drawings", nargs="*", type=Path, help="raster drawings (default: three 1000 px examples)")
+    parser.add_argument("--hand", action="store_true",
+                        help="also two hand drawings of the benchmark's generators (triple point, cursive word)")
     parser.add_argument("--panels", action="store_true",
                         help="also time the embroidery and laser previews the page asks for after each edit")
     parser.add_argument("--repeats", type=int, default=REPEATS, help=f"answers timed per edit kind (default {REPEATS})")
     args = parser.parse_args()
     paths = args.drawings or [Path(p) for p in DEFAULT]
+    if args.hand:
+        paths = list(paths) + hand_drawings()
     print(f"load: {os.getloadavg()[0]:.2f} (1 min), {os.cpu_count()} cores; "
           f"median of {args.repeats} per edit kind, seconds")
-    kinds = ("first", "pairing", "start", "reverse", "split", "merge", "threshold", "blur", "multi", "thr step",
-             "blur step", "idle")
+    kinds = ("first", "pairing", "passes", "start", "reverse", "split", "merge", "threshold", "blur", "multi",
+             "thr step", "blur step", "idle")
     print(f"{'drawing':40s} " + " ".join(f"{k:>9s}" for k in kinds))
     for path in paths:
         from PIL import Image

@@ -258,11 +258,11 @@ class StudioSession:
     def laser_preview(self, edits: Edits, values: dict) -> dict:
         """The G-code's moves for the player on the planner's time axis, and the estimate."""
         from machines.job_time import format_duration
-        from fabrication.player import gcode_player_data
+        from fabrication.player import laser_program_player_data
 
         settings, program = self.laser(edits, values)
         time = program.time
-        data = gcode_player_data(program.lines, title=self.drawing_path.stem, profile=settings.profile)
+        data = laser_program_player_data(program, title=self.drawing_path.stem, profile=settings.profile)
         return {"player": data.to_dict(), "seconds": time.total_seconds,
                 "time": format_duration(time.total_seconds), "naive": format_duration(time.naive_seconds),
                 "burn_length": round(float(time.burn_length), 1), "travel_length": round(float(time.travel_length), 1),
