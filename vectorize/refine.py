@@ -21,13 +21,14 @@ from vectorize.intersections import crossing_pairing, touching_pairings
 from vectorize.pass_choices import as_angles, chance_of, foot_angles, normal, pass_options, slots_of
 from vectorize.simplify import _merge, directions
 
-# Cached entries per stage: a session goes back and forth between a few states (undo).
-KEEP = 12
+# Cached entries per stage: a session goes back and forth between a few states (undo), and
+# the studio adds the four neighbouring slider values of each state it answers.
+KEEP = 20
 
 
 # Entries of the image-sized stages (a working gray image, an ink image, ~4 MB each at
-# 1000 px): the last few slider positions.
-KEEP_IMAGES = 6
+# 1000 px): the last few slider positions and their neighbours.
+KEEP_IMAGES = 8
 
 
 class StageCache:
