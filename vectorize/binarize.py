@@ -8,7 +8,6 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import ndimage
 
-
 from onestroke.errors import InputError
 
 MIN_SIDE = 16
