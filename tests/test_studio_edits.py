@@ -156,3 +156,21 @@ def test_cli_bad_edits_file_exit_2(loop_png, tmp_path):
                                     "-o", str(tmp_path / "out.svg")])
     assert run.exit_code == 2 and "version" in run.output and "Traceback" not in run.output
     assert not (tmp_path / "out.svg").exists()
+
+
+def test_a_stopped_run_leaves_the_cache_as_a_finished_one(loop_png):
+    """A run stopped between stages (the studio: a newer edit arrived) raises `Cancelled`;
+    the next run on the same cache gives the bytes of a fresh run."""
+    from onestroke.errors import Cancelled
+
+    edits = Edits(threshold=0.43, blur=0.5)
+    fresh = drawing_to_svg(vectorize_file(loop_png, OPTIONS, edits=edits).drawing)
+    for stop_after in (1, 3, 5):
+        cache = StageCache()
+        asked = []
+        cache.cancel = lambda: asked.append(1) or len(asked) > stop_after
+        with pytest.raises(Cancelled):
+            vectorize_file(loop_png, OPTIONS, edits=edits, cache=cache)
+        assert len(asked) == stop_after + 1
+        cache.cancel = None
+        assert drawing_to_svg(vectorize_file(loop_png, OPTIONS, edits=edits, cache=cache).drawing) == fresh

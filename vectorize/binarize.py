@@ -191,7 +191,8 @@ def extract_ink(gray: np.ndarray, *, threshold: float | None) -> tuple[np.ndarra
     keep = areas >= speck
     if not keep.any():
         raise InputError("no ink found: only specks smaller than a stroke")
-    ink = np.isin(labels, np.flatnonzero(keep) + 1)
+    # A lookup by label (0: paper) is the same as np.isin and needs no sorting.
+    ink = np.concatenate([[False], keep])[labels]
     # Holes are the 4-connected pieces of paper that do not reach the image edge (what
     # `binary_fill_holes` fills), found with one labelling instead of its dilation loop.
     paper, count = ndimage.label(~ink)

@@ -14,6 +14,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
+from onestroke.errors import Cancelled
 from vectorize.drawing import Drawing
 from vectorize.edits import PAIRINGS, Edits
 from vectorize.intersections import crossing_pairing, touching_pairings
@@ -39,6 +40,10 @@ class StageCache:
     threshold does not change it); axis: (threshold, blur, max_size) -> (ink, rings,
     medial graph before pruning) (the mode does not change them); front: `front_key` ->
     the pruned (and in single-line mode bridged) graph with its ink.
+
+    cancel: None or a callable the pipeline asks between stages; when it says True the run
+    stops with `onestroke.errors.Cancelled`. Every entry is stored only once its stage has
+    finished, so a stopped run leaves the cache as a finished one would have up to there.
     """
 
     def __init__(self) -> None:
@@ -49,6 +54,12 @@ class StageCache:
         self.simplified: dict = {}
         self.solved: dict = {}
         self._image = None
+        self.cancel = None
+
+    def checkpoint(self) -> None:
+        """Raise `Cancelled` if the caller no longer wants this run (see `cancel`)."""
+        if self.cancel is not None and self.cancel():
+            raise Cancelled("a newer request replaced this one")
 
     def front_for(self, image, options, compute):
         """Binarization to gap bridging for these options, computed once; compute(cache)

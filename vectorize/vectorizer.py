@@ -45,9 +45,11 @@ SMOOTHER_TOUCH = 0.85
 
 class _Clock:
     """Wall and CPU seconds per stage (CPU: on a shared machine the wall time includes
-    waiting for a core)."""
+    waiting for a core); `checkpoint` (optional) is called at every stage boundary and may
+    raise to stop the run there (`StageCache.checkpoint`)."""
 
-    def __init__(self) -> None:
+    def __init__(self, checkpoint=None) -> None:
+        self.checkpoint = checkpoint
         self.seconds: dict[str, float] = {}
         self.cpu_seconds: dict[str, float] = {}
         self._last = time.perf_counter()
@@ -58,6 +60,8 @@ class _Clock:
         self.seconds[stage] = self.seconds.get(stage, 0.0) + now - self._last
         self.cpu_seconds[stage] = self.cpu_seconds.get(stage, 0.0) + cpu - self._last_cpu
         self._last, self._last_cpu = now, cpu
+        if self.checkpoint is not None:
+            self.checkpoint()
 
 
 def _junctions(graph: MedialGraph, nodes, stroke_width: float) -> list[Junction]:
@@ -369,7 +373,7 @@ def run_pipeline(image: np.ndarray, options: VectorizeOptions, *,
     edits: the user's corrections (`vectorize.edits`); cache: a `StageCache` kept between
     calls on the same image, so that an edit re-runs only the stages after it.
     """
-    clock = _Clock()
+    clock = _Clock(cache.checkpoint if cache is not None else None)
     shape = np.asarray(image).shape
     if frame is None:
         frame = InputFrame(1.0, (0.0, 0.0), float(shape[1]), float(shape[0]))
