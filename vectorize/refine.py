@@ -21,6 +21,9 @@ from vectorize.intersections import crossing_pairing, touching_pairings
 from vectorize.pass_choices import as_angles, chance_of, foot_angles, normal, pass_options, slots_of
 from vectorize.simplify import _merge, directions
 
+# Route inspection's factor on a branch's length where the user said the line goes back
+# over it ("twice": nearly free) or does not ("once": only if nothing else joins the ends).
+RETRACE_WEIGHT = {"twice": 1e-3, "once": 1e4}
 # Cached entries per stage: a session goes back and forth between a few states (undo), and
 # the studio adds the four neighbouring slider values of each state it answers.
 KEEP = 20
@@ -246,7 +249,8 @@ class Refinement:
     # -- traversal and fitting -------------------------------------------------------
     def _solved_key(self) -> tuple:
         pairings = tuple((e.at, e.pairing, e.passes) for e in self.edits.of("pairing", "passes"))
-        return (self.simplify_key(-1), pairings, self._start())
+        retraces = tuple((e.kind, e.at) for e in self.edits.of("twice", "once"))
+        return (self.simplify_key(-1), pairings, self._start(), retraces)
 
     def _start(self):
         """The last start edit's position: where the line begins (it may change the route)."""
@@ -265,6 +269,18 @@ class Refinement:
         # Far below any retraced length: the matching leaves this node unpaired.
         return {ends[k]: -1e9} if dist[k] <= self.tol + self.w else {}
 
+    def route_weights(self, graph) -> dict:
+        """branch id -> factor on its length for route inspection: small where the user wants
+        the line to go back over a branch ("twice"), large where not ("once"); the last edit
+        on a branch wins."""
+        weights = {}
+        for edit in self.edits.of("twice", "once"):
+            found = _nearest_branch(graph, self.to_working(edit.at), self.tol + self.w)
+            if found is not None:
+                weights[found] = RETRACE_WEIGHT[edit.kind]
+                self.hits.add(self._index[id(edit)])
+        return weights
+
     def solved(self):
         """(best solution, fitted working strokes) of an earlier run with the same edits up to
         traversal, or None."""
@@ -277,7 +293,8 @@ class Refinement:
         return best, strokes
 
     def keep_solved(self, best, strokes) -> None:
-        early = {self._index[id(e)] for e in self.edits.of("split", "merge", "pairing", "passes")} & self.hits
+        early = {self._index[id(e)] for e in self.edits.of("split", "merge", "pairing", "passes", "twice", "once")}
+        early &= self.hits
         _bounded_put(self.cache.solved, self._solved_key(), (best, tuple(strokes), frozenset(early), dict(self.fixed)))
 
     def fix_passes(self, graph, simple):
@@ -404,6 +421,16 @@ class Refinement:
                             decision="passes", confidence=chance_of(drawn, simple.through_posterior.get(node)),
                             fixed=node in self.fixed, merged=True, passes=tuple(map(tuple, as_angles(drawn, angles))),
                             options=tuple({"passes": as_angles(p, angles), "p": q} for p, q in options))
+
+
+def _nearest_branch(graph, point: np.ndarray, tol: float) -> int | None:
+    """The id of the branch passing nearest `point`, if within tol."""
+    best = None
+    for bid, branch in graph.branches.items():
+        d = float(np.min(np.linalg.norm(branch.points - point, axis=1)))
+        if d <= tol and (best is None or d < best[0]):
+            best = (d, bid)
+    return None if best is None else best[1]
 
 
 def _nearest_mergeable(graph, point: np.ndarray, tol: float):

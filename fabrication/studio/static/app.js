@@ -415,6 +415,20 @@ function onClick(event) {
     if (e) apply(withEdit({ kind: "start", at: e.at.slice(0, 2) }, false));
     return;
   }
+  if (tool === "retrace") {
+    // On a stretch drawn twice: draw it once; elsewhere on the line: go back over it here
+    // (route inspection then retraces this branch rather than another).
+    const twice = (s.graph.retraces || []).flatMap((r) => r.points.map((q) => ({ at: q })));
+    const onBand = nearest(twice, p, 14);
+    const q = onBand || nearest(studio.line.pts.map((q) => ({ at: q })), p, 16);
+    if (!q) return;
+    const edit = { kind: onBand ? "once" : "twice", at: q.at.slice(0, 2) };
+    const edits = JSON.parse(JSON.stringify(currentEdits()));
+    edits.edits = edits.edits.filter((e) => !((e.kind === "twice" || e.kind === "once") &&
+                                              dist(e.at, edit.at) <= edits.tolerance));
+    edits.edits.push(edit);
+    return apply(edits);
+  }
   if (tool === "reverse") {
     const points = studio.line.pts.map((q) => ({ at: q }));
     const q = nearest(points, p, 16);
