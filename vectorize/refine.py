@@ -24,13 +24,14 @@ from vectorize.simplify import _merge, directions
 # Route inspection's factor on a branch's length where the user said the line goes back
 # over it ("twice": nearly free) or does not ("once": only if nothing else joins the ends).
 RETRACE_WEIGHT = {"twice": 1e-3, "once": 1e4}
-# Cached entries per stage: a session goes back and forth between a few states (undo).
-KEEP = 12
+# Cached entries per stage: a session goes back and forth between a few states (undo), and
+# the studio adds the four neighbouring slider values of each state it answers.
+KEEP = 20
 
 
 # Entries of the image-sized stages (a working gray image, an ink image, ~4 MB each at
-# 1000 px): the last few slider positions.
-KEEP_IMAGES = 6
+# 1000 px): the last few slider positions and their neighbours.
+KEEP_IMAGES = 8
 
 
 class StageCache:
