@@ -48,6 +48,21 @@ def test_cached_answers_are_a_fresh_runs_bytes(drawings):
             assert not [w for w in cached.report.warnings if "matched nothing" in w], (which, items)
 
 
+def test_once_everywhere_is_said_where_it_cannot_be_kept(drawings):
+    """A line must go back over some stretch somewhere: marked "once" everywhere, the
+    stretches still drawn twice are named in the warnings, cached as fresh."""
+    path, cache = drawings["little"], StageCache()
+    base = vectorize_file(path, VectorizeOptions(), edits=Edits(), cache=cache)
+    edits = Edits(items=tuple(Edit(kind="once", at=r["at"]) for r in base.graph.retraces))
+    result = vectorize_file(path, VectorizeOptions(), edits=edits, cache=cache)
+    again = vectorize_file(path, VectorizeOptions(), edits=edits, cache=cache)  # from the solved cache
+    still = [w for w in result.report.warnings if "still drawn twice" in w]
+    assert still and again.report.warnings == result.report.warnings and result.report.strokes == 1
+    for warning in still:
+        x, y = (float(v) for v in warning.split(" at ")[1].split(" is ")[0].split(", "))
+        assert any(min(abs(x - p[0]) + abs(y - p[1]) for p in r["points"]) < 3 for r in result.graph.retraces)
+
+
 def _triple_edits(base):
     triple = next(j for j in base.graph.junctions if j.role == "triple")
     crossing = next(j for j in base.graph.junctions if j.role == "crossing")
