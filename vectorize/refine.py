@@ -357,6 +357,18 @@ class Refinement:
             self.hits.add(self._index[id(edit)])
         return drawing.with_strokes(strokes)
 
+    def unheeded(self, solution) -> list[str]:
+        """One warning per "once" edit whose branch the line still draws twice (every other
+        way to join the ends that retrace joins is marked "once" too, or there is none)."""
+        count = _pass_counts(solution)
+        result = []
+        for edit in self.edits.of("once"):
+            bid = _nearest_branch(solution.graph, self.to_working(edit.at), self.tol + self.w)
+            if bid is not None and count.get(bid, 0) > 1:
+                result.append(f"the stretch at {edit.at[0]:.0f}, {edit.at[1]:.0f} is still drawn twice: "
+                              "one line over the drawing found no way around it")
+        return result
+
     def unmatched(self) -> list[str]:
         """One warning per edit that found nothing to act on."""
         return [f"edit {i + 1} ({e.kind} at {e.at[0]:.0f}, {e.at[1]:.0f}) matched nothing within "
@@ -395,10 +407,7 @@ class Refinement:
 
     def _retraces(self, solution) -> tuple[dict, ...]:
         graph = solution.graph
-        count: dict[int, int] = {}
-        for passes in solution.ordering.strokes:
-            for step in passes:
-                count[step.branch] = count.get(step.branch, 0) + 1
+        count = _pass_counts(solution)
         result = []
         for bid in sorted(b for b, n in count.items() if n > 1):
             points = graph.branches[bid].points
@@ -421,6 +430,15 @@ class Refinement:
                             decision="passes", confidence=chance_of(drawn, simple.through_posterior.get(node)),
                             fixed=node in self.fixed, merged=True, passes=tuple(map(tuple, as_angles(drawn, angles))),
                             options=tuple({"passes": as_angles(p, angles), "p": q} for p, q in options))
+
+
+def _pass_counts(solution) -> dict[int, int]:
+    """branch id -> how many times the solution's strokes pass it."""
+    count: dict[int, int] = {}
+    for passes in solution.ordering.strokes:
+        for step in passes:
+            count[step.branch] = count.get(step.branch, 0) + 1
+    return count
 
 
 def _nearest_branch(graph, point: np.ndarray, tol: float) -> int | None:

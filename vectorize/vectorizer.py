@@ -442,7 +442,7 @@ def run_pipeline(image: np.ndarray, options: VectorizeOptions, *,
         warnings.append(f"{len(simple.unresolved)} junction(s) where three or more strokes seem to meet:"
                         " they are not resolved and the order there may be wrong")
     if refine is not None:
-        warnings.extend(refine.unmatched())
+        warnings.extend(refine.unmatched() + refine.unheeded(best))
     if not options.multi and len(strokes) > 1:
         warnings.append(f"the line could not be followed in one stroke: {len(strokes)} strokes")
     report = VectorizeReport(
