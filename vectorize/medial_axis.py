@@ -166,7 +166,7 @@ def _collapse_chains(xy: np.ndarray, radius: np.ndarray, edges: np.ndarray, sins
     chain = np.flatnonzero(walked)
     chain = chain[np.lexsort((rank[chain], head[chain]))]
     cuts = np.flatnonzero(np.diff(head[chain])) + 1
-    firsts = np.concatenate([[0], cuts]).tolist()
+    firsts = np.concatenate([[0], cuts]).tolist() if len(chain) else []  # no chain: all closed
     stops = np.concatenate([cuts, [len(chain)]]).tolist()
     path_all = target[chain]
     edges_all = edge_of[chain]
