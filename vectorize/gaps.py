@@ -23,6 +23,9 @@ from vectorize.graph import Branch, MedialGraph
 from vectorize.simplify import slot_direction, slots
 
 BRIDGE_WIDTHS = 4.0  # longest gap bridged, in stroke widths (centre to centre of the caps)
+# plus this many px: the threshold eats up to a pixel of each anti-aliased cap, which in
+# widths matters only for thin lines (at 2-3 px a 1.5-width gap would otherwise be missed)
+BRIDGE_SLACK = 2.0
 BRIDGE_ANGLE = math.radians(40.0)  # largest angle between an end's direction and the gap
 DIRECTION_REACH = 3.0  # an end's direction: from this many stroke widths inside it
 # A free end is bridged to the middle of another piece's line only where that line turns (a
@@ -59,7 +62,7 @@ def bridge_gaps(graph: MedialGraph, *, stroke_width: float) -> int:
     if len(ends) < 2:
         return 0
     piece = components(graph)
-    reach = BRIDGE_WIDTHS * stroke_width
+    reach = BRIDGE_WIDTHS * stroke_width + BRIDGE_SLACK
     position = {n: graph.positions[n] for n in ends}
     heading = {n: end_direction(graph, n, stroke_width) for n in ends}
     pairs = []
@@ -120,7 +123,7 @@ def _bridge_to_lines(graph: MedialGraph, stroke_width: float, heading: dict, pie
             p = root[p]
         return p
 
-    reach = BRIDGE_WIDTHS * stroke_width
+    reach = BRIDGE_WIDTHS * stroke_width + BRIDGE_SLACK
     length: dict[int, float] = {}
     for branch in graph.branches.values():
         length[find(piece[branch.a])] = length.get(find(piece[branch.a]), 0.0) + branch.length
