@@ -32,3 +32,7 @@ class MachineError(OnestrokeError):
 
 class OutputError(OnestrokeError):
     """A file could not be written: disk full, read-only, permission, a special folder."""
+
+
+class Cancelled(OnestrokeError):
+    """The caller stopped a computation it no longer wanted (the studio: a newer edit)."""

@@ -199,3 +199,28 @@ def test_gcode_dwell_is_a_pause_and_hoop_is_the_frame(tmp_path):
     out = tmp_path / "two.html"
     assert _preview(source, "-o", out, "--hoop", "100x100").exit_code == 0
     assert page_data(out.read_text(encoding="utf-8"))["frame"] == [-50.0, -50.0, 50.0, 50.0]
+
+
+def test_a_laser_programs_player_data_reuses_its_reading(tmp_path):
+    """The studio's laser preview plays the program from the reading its time estimate
+    made: the same data as reading the G-code lines again (line numbers past the header
+    comments, times, colours), and the estimate is that of the file as written."""
+    from fabrication.job_options import laser_settings
+    from fabrication.laser.program import laser_program
+    from fabrication.player import gcode_player_data, laser_program_player_data
+    from vectorize.drawing import Drawing
+    from vectorize.stroke import Stroke
+
+    t = np.linspace(0.0, 2.0 * np.pi, 200)
+    loop = Stroke.from_polyline(np.c_[100 + 60 * np.cos(t), 100 + 40 * np.sin(3 * t)])
+    line = Stroke.from_polyline(np.array([[20.0, 20.0], [180.0, 30.0]]))
+    drawing = Drawing((loop, line), 200.0, 200.0, "px", 4.0)
+    for arcs in (False, True):
+        settings = laser_settings(size="60mm", arcs=arcs)
+        program = laser_program(drawing, settings.profile, settings.toolpath, settings.gcode, name="loops.png")
+        again = gcode_player_data(program.lines, title="t", profile=settings.profile).to_dict()
+        reused = laser_program_player_data(program, title="t", profile=settings.profile).to_dict()
+        assert again.keys() == reused.keys()
+        for key in again:
+            assert np.array_equal(np.asarray(again[key]), np.asarray(reused[key])), key
+        assert program.time.total_seconds == estimate_gcode_time(list(program.lines), settings.profile).total_seconds

@@ -34,10 +34,29 @@ def crossing(result):
 def test_edits_json_round_trip():
     edits = Edits(threshold=0.4, blur=1.5, multi=False, tolerance=5.0,
                   items=(Edit(kind="pairing", at=(10.5, 20.25), pairing="third"), Edit(kind="split", at=(1, 2)),
-                         Edit(kind="merge", at=(3, 4)), Edit(kind="reverse", at=(5, 6)), Edit(kind="start", at=(7, 8))))
+                         Edit(kind="merge", at=(3, 4)), Edit(kind="reverse", at=(5, 6)), Edit(kind="start", at=(7, 8)),
+                         Edit(kind="twice", at=(11, 12)), Edit(kind="once", at=(13, 14)),
+                         Edit(kind="passes", at=(9, 10), passes=((10.5, 190.5), (70, 250), (130, 310)))))
     again = edits_from_json(edits.to_json())
     assert again == edits
     assert json.loads(edits.to_json())["edits"][0] == {"kind": "pairing", "at": [10.5, 20.25], "pairing": "third"}
+    assert json.loads(edits.to_json())["edits"][-1]["passes"] == [[10.5, 190.5], [70.0, 250.0], [130.0, 310.0]]
+
+
+def test_passes_name_a_triple_points_branches_by_direction():
+    """An edit's directions go to the nearest branches, one each, whatever the slot order;
+    a direction far from every branch, or a count that differs, matches nothing."""
+    import numpy as np
+
+    from vectorize.pass_choices import as_angles, foot_angles, slots_of
+
+    angles = foot_angles(np.array([[np.cos(a), np.sin(a)] for a in np.radians([200, 20, 265, 85, 330, 150])]))
+    assert angles.tolist() == [200.0, 20.0, 265.0, 85.0, 330.0, 150.0]
+    assert slots_of([[22, 198], [87, 262], [148, 331]], angles) == ((0, 1), (2, 3), (4, 5))
+    assert slots_of([[20, 85], [150, 200], [265, 330]], angles) == ((0, 5), (1, 3), (2, 4))
+    assert as_angles(((0, 5), (1, 3), (2, 4)), angles) == [[20.0, 85.0], [150.0, 200.0], [265.0, 330.0]]
+    assert slots_of([[20, 85], [150, 200], [265, 40]], angles) is None  # 40 would go to 330, 70 degrees off
+    assert slots_of([[20, 85], [150, 200]], angles) is None
 
 
 @pytest.mark.parametrize("text, message", [
@@ -45,6 +64,12 @@ def test_edits_json_round_trip():
     ('{"format": "onestroke-edits", "version": 1, "edits": [{"kind": "fold", "at": [1, 2]}]}', "unknown edit kind"),
     ('{"format": "onestroke-edits", "version": 1, "edits": [{"kind": "pairing", "at": [1, 2]}]}', "pairing"),
     ('{"format": "onestroke-edits", "version": 1, "threshold": 2, "edits": []}', "threshold"),
+    ('{"format": "onestroke-edits", "version": 1, "edits": [{"kind": "passes", "at": [1, 2], "passes": [[1, 2]]}]}',
+     "three or more pairs"),
+    ('{"format": "onestroke-edits", "version": 1, "edits": [{"kind": "passes", "at": [1, 2], "passes": "x"}]}',
+     "pairs of directions"),
+    ('{"format": "onestroke-edits", "version": 1, "edits": [{"kind": "split", "at": [1, 2], "passes": [[1, 2]]}]}',
+     "takes no passes"),
 ])
 def test_bad_edits_files_name_the_problem(text, message):
     from onestroke.errors import InputError
@@ -131,3 +156,21 @@ def test_cli_bad_edits_file_exit_2(loop_png, tmp_path):
                                     "-o", str(tmp_path / "out.svg")])
     assert run.exit_code == 2 and "version" in run.output and "Traceback" not in run.output
     assert not (tmp_path / "out.svg").exists()
+
+
+def test_a_stopped_run_leaves_the_cache_as_a_finished_one(loop_png):
+    """A run stopped between stages (the studio: a newer edit arrived) raises `Cancelled`;
+    the next run on the same cache gives the bytes of a fresh run."""
+    from onestroke.errors import Cancelled
+
+    edits = Edits(threshold=0.43, blur=0.5)
+    fresh = drawing_to_svg(vectorize_file(loop_png, OPTIONS, edits=edits).drawing)
+    for stop_after in (1, 3, 5):
+        cache = StageCache()
+        asked = []
+        cache.cancel = lambda: asked.append(1) or len(asked) > stop_after
+        with pytest.raises(Cancelled):
+            vectorize_file(loop_png, OPTIONS, edits=edits, cache=cache)
+        assert len(asked) == stop_after + 1
+        cache.cancel = None
+        assert drawing_to_svg(vectorize_file(loop_png, OPTIONS, edits=edits, cache=cache).drawing) == fresh

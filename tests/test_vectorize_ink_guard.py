@@ -7,6 +7,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from benchmarks.drawings import generate_drawing
 from benchmarks.hershey import glyph_ground_truth
 from benchmarks.ink_metrics import excursion, excursion_bound
 from benchmarks.relief import relief_glyphs
@@ -53,3 +54,19 @@ def test_relief_glyphs_with_acute_corners_stay_in_the_ink(name, width):
     result = vectorize_image(to_uint8(render(gt.drawing)), VectorizeOptions(multi=False, classifier="cnn", seed=0))
     assert len(result.drawing.strokes) == 1
     assert excursion(gt.drawing, result.drawing) <= excursion_bound(width)
+
+
+def test_the_curve_as_written_stays_in_the_ink_after_a_retraced_spike_is_shared():
+    # Plain-set drawing spike-0-41 (6.5 px wide, closed): the stroke goes down a retraced spike,
+    # round the drawing and back up the spike, and the way up is the way down's curve (a
+    # twin). Copying it moved the loop's last end 4.6 px onto the way down's joint after the
+    # guard had passed the loop, and the loop swung 1.2 px beyond the guard's margin: 4.67 px
+    # from the centre line against the bound of 4.25 px. The guard now checks the final curve.
+    gt = generate_drawing("spike", 0, 41)
+    options = VectorizeOptions(multi=False, classifier="cnn", seed=0, keep_stages=True)
+    result = vectorize_image(to_uint8(render(gt.drawing)), options)
+    assert len(result.drawing.strokes) == 1
+    assert excursion(gt.drawing, result.drawing) <= excursion_bound(gt.width)
+    stages = result.stages
+    guard = InkGuard(stages["simplified"], stages["ink"].gray, stages["ink"].threshold)
+    assert guard.stroke_excess(stages["working_strokes"][0]) <= 0.0

@@ -7,8 +7,6 @@ from dataclasses import dataclass
 
 import numpy as np
 from scipy import ndimage
-from skimage.filters import gaussian, threshold_li
-from skimage.transform import rescale
 
 from onestroke.errors import InputError
 
@@ -72,10 +70,16 @@ def working_gray(image: np.ndarray, *, max_size: int, blur: float) -> tuple[np.n
     if min(h, w) < MIN_SIDE:
         raise InputError(f"image is {w}x{h} px: too small for a drawing (need at least {MIN_SIDE} px a side)")
     scale = 1.0
+    # skimage.transform and skimage.filters are imported where used: most inputs need
+    # neither a downscale nor a blur, and a command pays for every import at start-up.
     if max(h, w) > max_size:
+        from skimage.transform import rescale
+
         scale = max_size / max(h, w)
         gray = rescale(gray, scale, anti_aliasing=True, preserve_range=True).astype(np.float32)
     if blur > 0:
+        from skimage.filters import gaussian
+
         gray = gaussian(gray, sigma=blur, preserve_range=True).astype(np.float32)
     return gray, scale
 
@@ -119,6 +123,8 @@ def ink_threshold(gray: np.ndarray, threshold: float | None) -> float:
         raise InputError("no ink found: the image is blank")
     if threshold is not None:
         return float(threshold)
+    from skimage.filters import threshold_li
+
     level = float(threshold_li(gray, tolerance=1e-4))
     floor = paper_noise_floor(gray)
     if floor is None:
@@ -191,7 +197,8 @@ def extract_ink(gray: np.ndarray, *, threshold: float | None) -> tuple[np.ndarra
     keep = areas >= speck
     if not keep.any():
         raise InputError("no ink found: only specks smaller than a stroke")
-    ink = np.isin(labels, np.flatnonzero(keep) + 1)
+    # A lookup by label (0: paper) is the same as np.isin and needs no sorting.
+    ink = np.concatenate([[False], keep])[labels]
     # Holes are the 4-connected pieces of paper that do not reach the image edge (what
     # `binary_fill_holes` fills), found with one labelling instead of its dilation loop.
     paper, count = ndimage.label(~ink)

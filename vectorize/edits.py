@@ -12,8 +12,16 @@ Kinds, and the stage each one re-runs from:
   joined by the branch at the position): from simplification;
 - `pairing` (how the pen went through a degree-4 node: "crossing", "touching" = the
   smoother touching pairing, "third" = the other one): from traversal, as a fixed decision;
-- `reverse` (the stroke through the position runs the other way), `start` (the stroke
-  with an end at the position starts there, and comes first): after fitting.
+- `passes` (how the pen went through a node where three passes meet, six branches: each
+  pass as the directions of its two branches leaving the node, degrees, 0 = +x, 90 = +y
+  down the image): from traversal, as a fixed decision;
+- `reverse` (the stroke through the position runs the other way): after fitting;
+  `start` (the stroke with an end at the position starts there, and comes first; in
+  single-line mode a free end the line passes, the tip of a stroke drawn out and back,
+  becomes an end of the route, which then retraces other branches): from traversal;
+- `twice` / `once` (single-line mode: the branch at the position is, or is not, where the
+  line goes back over itself when it must retrace something: route inspection then
+  prefers, or avoids, retracing it): from traversal.
 """
 
 from __future__ import annotations
@@ -26,7 +34,7 @@ from onestroke.errors import InputError
 
 FORMAT = "onestroke-edits"
 PAIRINGS = ("crossing", "touching", "third")
-KINDS = ("pairing", "split", "merge", "reverse", "start")
+KINDS = ("pairing", "passes", "split", "merge", "reverse", "start", "twice", "once")
 # Default match radius in output px: a click lands within a few pixels of a marker.
 TOLERANCE = 8.0
 
@@ -35,12 +43,14 @@ TOLERANCE = 8.0
 class Edit:
     """One correction at position `at` = (x, y) px of the input image.
 
-    kind: one of KINDS; pairing: for kind "pairing", one of PAIRINGS.
+    kind: one of KINDS; pairing: for kind "pairing", one of PAIRINGS; passes: for kind
+    "passes", the passes through the node as pairs of branch directions (degrees).
     """
 
     kind: str
     at: tuple[float, float]
     pairing: str | None = None
+    passes: tuple[tuple[float, float], ...] | None = None
 
     def __post_init__(self) -> None:
         if self.kind not in KINDS:
@@ -57,12 +67,29 @@ class Edit:
                 raise InputError(f"pairing {self.pairing!r} must be one of {', '.join(PAIRINGS)}")
         elif self.pairing is not None:
             raise InputError(f"a {self.kind!r} edit takes no pairing")
+        if self.kind == "passes":
+            object.__setattr__(self, "passes", _passes(self.passes))
+        elif self.passes is not None:
+            raise InputError(f"a {self.kind!r} edit takes no passes")
 
     def to_dict(self) -> dict:
         data = {"kind": self.kind, "at": [round(self.at[0], 3), round(self.at[1], 3)]}
         if self.pairing is not None:
             data["pairing"] = self.pairing
+        if self.passes is not None:
+            data["passes"] = [[round(a, 1), round(b, 1)] for a, b in self.passes]
         return data
+
+
+def _passes(value) -> tuple[tuple[float, float], ...]:
+    """Pairs of directions in degrees [0, 360), at least three pairs (six branches)."""
+    try:
+        pairs = tuple((float(a) % 360.0, float(b) % 360.0) for a, b in value)
+    except (TypeError, ValueError):
+        raise InputError(f"passes {value!r} must be pairs of directions in degrees, e.g. [[10, 190], ...]") from None
+    if len(pairs) < 3 or not all(math.isfinite(a) and math.isfinite(b) for a, b in pairs):
+        raise InputError(f"passes {value!r} must be three or more pairs of finite directions in degrees")
+    return pairs
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -115,7 +142,8 @@ def edits_from_dict(data) -> Edits:
     if not isinstance(items, list):
         raise InputError("\"edits\" must be a list")
     try:
-        edits = tuple(Edit(kind=e["kind"], at=tuple(e["at"]), pairing=e.get("pairing")) for e in items)
+        edits = tuple(Edit(kind=e["kind"], at=tuple(e["at"]), pairing=e.get("pairing"), passes=e.get("passes"))
+                      for e in items)
         multi = data.get("multi")
         return Edits(threshold=_number(data.get("threshold")), blur=_number(data.get("blur")),
                      multi=None if multi is None else bool(multi),

@@ -161,6 +161,33 @@ def _open_fit(points: np.ndarray, sigma: float) -> np.ndarray:
     return fit_piece(points, closed=False, sigma=sigma, anchor=True)
 
 
+def _settle(pieces: list[np.ndarray], cuts: list[int], xy: np.ndarray, twins: list[Twin],
+            guard: InkGuard, sigma: float) -> None:
+    """In place, last: every piece of the curve as written lies in the ink.
+
+    The joints move piece ends (to where two sides meet at a corner, to the middle of two
+    ends), and the later pass of a retraced stretch drags its neighbours' ends onto the
+    earlier pass's curve; either can swing a piece out that was checked when fitted (a
+    corner cut across the paper, a loop's end pulled onto a spike's other joint). Each piece
+    that strays now is refitted on all of its traced points between its final ends, so no
+    joint moves again; a later pass takes its earlier twin's settled curve (settled first:
+    it comes earlier) when their ends still agree.
+    """
+    index = {(lo, hi): k for k, (lo, hi) in enumerate(zip(cuts[:-1], cuts[1:]))}
+    for k, (lo, hi) in enumerate(zip(cuts[:-1], cuts[1:])):
+        source = twin_piece(twins, lo, hi)
+        j = index.get(source[:2]) if source is not None else None
+        if j is not None:
+            copy = pieces[j][::-1, ::-1] if source[2] else pieces[j]
+            if np.array_equal(copy[0, 0], pieces[k][0, 0]) and np.array_equal(copy[-1, 3], pieces[k][-1, 3]):
+                pieces[k] = np.array(copy)
+        if curve_excess(guard, pieces[k])[0] <= 0.0:
+            continue
+        whole = xy[lo:hi + 1].copy()
+        whole[0], whole[-1] = pieces[k][0, 0], pieces[k][-1, 3]
+        pieces[k] = keep_in_ink(whole, _open_fit(whole, sigma), guard, _open_fit, sigma)
+
+
 def fit_stroke(traced: list[TracedPoint], *, closed: bool, sigma: float, stroke_width: float,
                guard: InkGuard | None = None, twins: tuple[Twin, ...] = ()) -> Stroke:
     """Filter, split at sharp features (Y-feet tips, cusps, corners) and fit one traversed
@@ -251,17 +278,8 @@ def fit_stroke(traced: list[TracedPoint], *, closed: bool, sigma: float, stroke_
             after[0, 1] += point - after[0, 0]
         before[-1, 3] = point
         after[0, 0] = point
-    if guard is not None:
-        # Moving the ends to the joints can swing a piece out (a corner cut across the paper):
-        # refit those between their joints on all of their traced points.
-        for k, (lo, hi) in enumerate(zip(cuts[:-1], cuts[1:])):
-            if curve_excess(guard, pieces[k])[0] <= 0.0:
-                continue
-            whole = xy[lo:hi + 1].copy()
-            if len(pieces) == 1 and closed:
-                continue  # a closed piece has no joints: it was checked when fitted
-            whole[0], whole[-1] = pieces[k][0, 0], pieces[k][-1, 3]
-            pieces[k] = keep_in_ink(whole, _open_fit(whole, sigma), guard, _open_fit, sigma)
     share_pieces(twins, cuts, pieces)
+    if guard is not None and not (closed and len(pieces) == 1):  # a closed piece was checked when fitted
+        _settle(pieces, cuts, xy, twins, guard, sigma)
     control = np.concatenate(pieces, axis=0)
     return Stroke(control)

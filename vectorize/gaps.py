@@ -51,12 +51,13 @@ def end_direction(graph: MedialGraph, node: int, stroke_width: float) -> np.ndar
     return -slot_direction(graph, slots(graph, node)[0], DIRECTION_REACH * stroke_width)
 
 
-def bridge_gaps(graph: MedialGraph, *, stroke_width: float) -> int:
+def bridge_gaps(graph: MedialGraph, *, stroke_width: float, made: list | None = None) -> int:
     """Join free ends of different pieces across pen gaps, in place; returns the bridges made.
 
     Pairs are taken cheapest first (gap length in widths plus the two ends' angles off the
     gap, in radians). Ends of different pieces are always joined; ends of one piece only
-    while more than two free ends are left.
+    while more than two free ends are left. made: a list that receives each bridge's two
+    ends, ((x, y), (x, y)) px (the page shows them).
     """
     ends = [n for n, incident in graph.incident.items() if len(incident) == 1]
     if len(ends) < 2:
@@ -102,6 +103,8 @@ def bridge_gaps(graph: MedialGraph, *, stroke_width: float) -> int:
         points = np.linspace(position[a], position[b], count)
         radii = np.linspace(graph.radii[a], graph.radii[b], count)
         graph.add_branch(Branch(a, b, points, radii, np.ones(count - 1)))
+        if made is not None:
+            made.append((tuple(map(float, position[a])), tuple(map(float, position[b]))))
         bridges += 1
     bridges += _bridge_to_lines(graph, stroke_width, heading, piece, root)
     if bridges:

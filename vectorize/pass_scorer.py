@@ -101,14 +101,22 @@ def pair_feet(gray: np.ndarray, centers: np.ndarray, feet: list[np.ndarray], str
     """The pairing of each six-foot node: by continuation and image with a scorer, by
     continuation alone without one. centers (K, 2) px; feet: K arrays (6, 2) of unit
     tangents leaving the node."""
+    return [pick for pick, _ in scored_pairings(gray, centers, feet, stroke_width, scorer)]
+
+
+def scored_pairings(gray: np.ndarray, centers: np.ndarray, feet: list[np.ndarray], stroke_width: float,
+                    scorer: PassScorer | None) -> list[tuple[Pairs, np.ndarray | None]]:
+    """Per node, (its pairing as `pair_feet` picks it, (15,) posterior over PAIRINGS of the
+    combined model, or None without a scorer)."""
     if scorer is None:
-        return [best_pairing(-continuation_cost(f))[0] for f in feet]
+        return [(best_pairing(-continuation_cost(f))[0], None) for f in feet]
     p = scorer.pass_probabilities(gray, centers, feet, stroke_width)
     result = []
     for i, f in enumerate(feet):
         pick, totals = best_pairing(scorer.pass_scores(p[i], f))
         # The model's own posterior of its pick (softmax over the 15 pairings): below one
         # half it is unsure, and continuation decides alone.
-        posterior = 1.0 / float(np.sum(np.exp(totals - totals.max())))
-        result.append(pick if posterior >= UNSURE else best_pairing(-continuation_cost(f))[0])
+        posterior = np.exp(totals - totals.max())
+        posterior /= posterior.sum()
+        result.append((pick if posterior.max() >= UNSURE else best_pairing(-continuation_cost(f))[0], posterior))
     return result

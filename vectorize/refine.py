@@ -2,30 +2,36 @@
 view of the graph they act on.
 
 `StageCache` keeps what earlier stages made for one image, keyed by what they depend on,
-so that an edit re-runs only the stages after it: a pairing re-runs traversal and
-fitting; a split or merge re-runs simplification and classification as well; threshold,
+so that an edit re-runs only the stages after it: a pairing or a start re-runs traversal
+and fitting; a split or merge re-runs simplification and classification as well; threshold,
 blur and mode re-run everything. The cached path makes the same calls on the same inputs
 as a fresh run, so both give the same bytes.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
+from onestroke.errors import Cancelled
 from vectorize.drawing import Drawing
 from vectorize.edits import PAIRINGS, Edits
 from vectorize.intersections import crossing_pairing, touching_pairings
-from vectorize.simplify import _merge
+from vectorize.pass_choices import as_angles, chance_of, foot_angles, normal, pass_options, slots_of
+from vectorize.simplify import _merge, directions
 
-# Cached entries per stage: a session goes back and forth between a few states (undo).
-KEEP = 12
+# Route inspection's factor on a branch's length where the user said the line goes back
+# over it ("twice": nearly free) or does not ("once": only if nothing else joins the ends).
+RETRACE_WEIGHT = {"twice": 1e-3, "once": 1e4}
+# Cached entries per stage: a session goes back and forth between a few states (undo), and
+# the studio adds the four neighbouring slider values of each state it answers.
+KEEP = 20
 
 
 # Entries of the image-sized stages (a working gray image, an ink image, ~4 MB each at
-# 1000 px): the last few slider positions.
-KEEP_IMAGES = 6
+# 1000 px): the last few slider positions and their neighbours.
+KEEP_IMAGES = 8
 
 
 class StageCache:
@@ -35,6 +41,10 @@ class StageCache:
     threshold does not change it); axis: (threshold, blur, max_size) -> (ink, rings,
     medial graph before pruning) (the mode does not change them); front: `front_key` ->
     the pruned (and in single-line mode bridged) graph with its ink.
+
+    cancel: None or a callable the pipeline asks between stages; when it says True the run
+    stops with `onestroke.errors.Cancelled`. Every entry is stored only once its stage has
+    finished, so a stopped run leaves the cache as a finished one would have up to there.
     """
 
     def __init__(self) -> None:
@@ -45,6 +55,12 @@ class StageCache:
         self.simplified: dict = {}
         self.solved: dict = {}
         self._image = None
+        self.cancel = None
+
+    def checkpoint(self) -> None:
+        """Raise `Cancelled` if the caller no longer wants this run (see `cancel`)."""
+        if self.cancel is not None and self.cancel():
+            raise Cancelled("a newer request replaced this one")
 
     def front_for(self, image, options, compute):
         """Binarization to gap bridging for these options, computed once; compute(cache)
@@ -79,10 +95,14 @@ def _bounded_put(store: dict, key, value, keep: int = KEEP) -> None:
 @dataclass(frozen=True)
 class JunctionInfo:
     """A node the page shows. id: node id of this run (not stable across runs: edits use
-    `at`); at: (x, y) output px; degree; role: "crossing" (degree 4), "y" (a spike's
-    junction), "end" (a stroke ends on a line) or "unresolved"; for crossings: decision (one
-    of `PAIRINGS`), p_crossing and confidence of the classifier, fixed (by an edit) and
-    merged (made from two degree-3 nodes: can be split)."""
+    `at`); at: (x, y) output px; degree; role: "crossing" (degree 4), "triple" (three passes
+    through one point), "y" (a spike's junction), "end" (a stroke ends on a line) or
+    "unresolved"; for crossings: decision (one of `PAIRINGS`), p_crossing and confidence of
+    the classifier, fixed (by an edit) and merged (made from two degree-3 nodes: can be
+    split); for triple points: passes (the pairing drawn, as pairs of branch directions in
+    degrees, `vectorize.pass_choices`), confidence (the pass scorer's posterior, None when
+    continuation alone decided) and options (the pairings that keep the line one stroke,
+    likeliest first: each {"passes", "p"})."""
 
     id: int
     at: tuple[float, float]
@@ -93,6 +113,8 @@ class JunctionInfo:
     confidence: float | None = None
     fixed: bool = False
     merged: bool = False
+    passes: tuple | None = None
+    options: tuple | None = None
 
 
 @dataclass(frozen=True)
@@ -107,13 +129,20 @@ class BranchInfo:
 
 @dataclass(frozen=True)
 class GraphView:
-    """The simplified graph of the chosen reading, in output px."""
+    """The simplified graph of the chosen reading, in output px. retraces: the stretches the
+    line draws twice (route inspection's doubled branches, spikes out and back), each
+    {"at": middle point, "length": px, "points": (M, 2) its centre line}."""
 
     junctions: tuple[JunctionInfo, ...]
     branches: tuple[BranchInfo, ...]
+    retraces: tuple[dict, ...] = ()
+    ends: tuple[tuple[float, float], ...] = ()  # the free ends of the line (where it may start)
+    bridges: tuple[tuple[tuple[float, float], tuple[float, float]], ...] = ()  # pen gaps joined: their ends
 
     def to_dict(self) -> dict:
-        return {"junctions": [vars(j) for j in self.junctions], "branches": [vars(b) for b in self.branches]}
+        return {"junctions": [vars(j) for j in self.junctions], "branches": [vars(b) for b in self.branches],
+                "retraces": list(self.retraces), "ends": [list(e) for e in self.ends],
+                "bridges": [[list(a), list(b)] for a, b in self.bridges]}
 
 
 def _pairings(directions: np.ndarray) -> tuple:
@@ -149,6 +178,7 @@ class Refinement:
         self.options = options
         self.scale = 1.0 / float(matrix[0, 0])  # working px per output px
         self.tol = edits.tolerance * self.scale
+        self.w = stroke_width
         self.hits: set[int] = set()
         self.fixed: dict[int, str] = {}
         self._index = {id(e): i for i, e in enumerate(edits.items)}
@@ -183,13 +213,25 @@ class Refinement:
         merges = [(self._index[id(e)], self.to_working(e.at)) for e in self.edits.of("merge")]
         hooks = {}
         if splits:
-            def may_merge(branch) -> bool:
+            # A split at a triple point keeps its cluster apart and is then spent: the
+            # cluster's junctions pair up as crossings, as anywhere else.
+            spent: set[int] = set()
+
+            def refuse(branch, exclude: set[int]) -> int | None:
                 for index, point in splits:
-                    if np.min(np.linalg.norm(branch.points - point, axis=1)) <= self.tol:
+                    if index not in exclude and np.min(np.linalg.norm(branch.points - point, axis=1)) <= self.tol:
                         self.hits.add(index)
-                        return False
-                return True
-            hooks["may_merge"] = may_merge
+                        return index
+                return None
+
+            def may_cluster(branch) -> bool:
+                index = refuse(branch, set())
+                if index is not None:
+                    spent.add(index)
+                return index is None
+
+            hooks["may_cluster"] = may_cluster
+            hooks["may_merge"] = lambda branch: refuse(branch, spent) is None
         if merges:
             def after_merging(graph) -> int:
                 done = 0
@@ -206,8 +248,38 @@ class Refinement:
 
     # -- traversal and fitting -------------------------------------------------------
     def _solved_key(self) -> tuple:
-        pairings = tuple((e.at, e.pairing) for e in self.edits.of("pairing"))
-        return (self.simplify_key(-1), pairings)
+        pairings = tuple((e.at, e.pairing, e.passes) for e in self.edits.of("pairing", "passes"))
+        retraces = tuple((e.kind, e.at) for e in self.edits.of("twice", "once"))
+        return (self.simplify_key(-1), pairings, self._start(), retraces)
+
+    def _start(self):
+        """The last start edit's position: where the line begins (it may change the route)."""
+        starts = self.edits.of("start")
+        return starts[-1].at if starts else None
+
+    def start_ends(self, graph) -> dict:
+        """node -> end cost for the route: the free end at the last start edit (a tip the
+        line now passes, such as a stem's drawn down and back up) must be an end of it."""
+        at = self._start()
+        ends = [n for n, incident in graph.incident.items() if len(incident) == 1]
+        if at is None or not ends:
+            return {}
+        dist = np.linalg.norm(np.array([graph.positions[n] for n in ends]) - self.to_working(at), axis=1)
+        k = int(np.argmin(dist))
+        # Far below any retraced length: the matching leaves this node unpaired.
+        return {ends[k]: -1e9} if dist[k] <= self.tol + self.w else {}
+
+    def route_weights(self, graph) -> dict:
+        """branch id -> factor on its length for route inspection: small where the user wants
+        the line to go back over a branch ("twice"), large where not ("once"); the last edit
+        on a branch wins."""
+        weights = {}
+        for edit in self.edits.of("twice", "once"):
+            found = _nearest_branch(graph, self.to_working(edit.at), self.tol + self.w)
+            if found is not None:
+                weights[found] = RETRACE_WEIGHT[edit.kind]
+                self.hits.add(self._index[id(edit)])
+        return weights
 
     def solved(self):
         """(best solution, fitted working strokes) of an earlier run with the same edits up to
@@ -221,12 +293,31 @@ class Refinement:
         return best, strokes
 
     def keep_solved(self, best, strokes) -> None:
-        early = {self._index[id(e)] for e in self.edits.of("split", "merge", "pairing")} & self.hits
+        early = {self._index[id(e)] for e in self.edits.of("split", "merge", "pairing", "passes", "twice", "once")}
+        early &= self.hits
         _bounded_put(self.cache.solved, self._solved_key(), (best, tuple(strokes), frozenset(early), dict(self.fixed)))
+
+    def fix_passes(self, graph, simple):
+        """`simple` with the triple points' pairings the user chose (`passes` edits)."""
+        self.fixed = {}
+        edits = self.edits.of("passes")
+        if not edits or not simple.through:
+            return simple
+        through = dict(simple.through)
+        nodes = list(through)
+        centers = np.array([graph.positions[n] for n in nodes])
+        for edit in edits:
+            dist = np.linalg.norm(centers - self.to_working(edit.at), axis=1)
+            node = nodes[int(np.argmin(dist))]
+            pairs = slots_of(edit.passes, foot_angles(directions(graph, node, 2.5 * self.w)))
+            if dist.min() <= self.tol and pairs is not None:
+                through[node] = pairs
+                self.fixed[node] = "passes"
+                self.hits.add(self._index[id(edit)])
+        return replace(simple, through=through)
 
     def fix_pairings(self, junctions: dict, ranked: dict, costs: dict) -> None:
         """Pairings the user chose become the only choice at their node (in place)."""
-        self.fixed = {}
         nodes = list(junctions)
         if not nodes:
             return
@@ -266,6 +357,18 @@ class Refinement:
             self.hits.add(self._index[id(edit)])
         return drawing.with_strokes(strokes)
 
+    def unheeded(self, solution) -> list[str]:
+        """One warning per "once" edit whose branch the line still draws twice (every other
+        way to join the ends that retrace joins is marked "once" too, or there is none)."""
+        count = _pass_counts(solution)
+        result = []
+        for edit in self.edits.of("once"):
+            bid = _nearest_branch(solution.graph, self.to_working(edit.at), self.tol + self.w)
+            if bid is not None and count.get(bid, 0) > 1:
+                result.append(f"the stretch at {edit.at[0]:.0f}, {edit.at[1]:.0f} is still drawn twice: "
+                              "one line over the drawing found no way around it")
+        return result
+
     def unmatched(self) -> list[str]:
         """One warning per edit that found nothing to act on."""
         return [f"edit {i + 1} ({e.kind} at {e.at[0]:.0f}, {e.at[1]:.0f}) matched nothing within "
@@ -273,13 +376,16 @@ class Refinement:
                 for i, e in enumerate(self.edits.items) if i not in self.hits]
 
     # -- the page's view -------------------------------------------------------------
-    def graph_view(self, solution) -> GraphView:
+    def graph_view(self, solution, bridges=()) -> GraphView:
+        """What the page shows of `solution`; bridges: the pen gaps bridged (working px)."""
         graph, simple = solution.graph, solution.simple
         choice = dict(zip(simple.crossings, solution.ordering.choice))
         nodes = []
         for node in sorted(graph.incident):
             degree = graph.degree(node)
-            if node in simple.crossings:
+            if node in simple.through:
+                nodes.append(self._triple_info(solution, node, choice))
+            elif node in simple.crossings:
                 junction, verdict = solution.junctions[node], solution.verdicts[node]
                 nodes.append(JunctionInfo(
                     node, self.to_output(graph.positions[node]), degree, "crossing",
@@ -295,7 +401,54 @@ class Refinement:
             if branch.a != branch.b and graph.degree(branch.a) == 3 and graph.degree(branch.b) == 3:
                 middle = branch.points[len(branch.points) // 2]
                 branches.append(BranchInfo(bid, self.to_output(middle), round(branch.length / self.scale, 3)))
-        return GraphView(tuple(nodes), tuple(branches))
+        ends = tuple(self.to_output(graph.positions[n]) for n in sorted(graph.incident) if graph.degree(n) == 1)
+        gaps = tuple((self.to_output(a), self.to_output(b)) for a, b in bridges)
+        return GraphView(tuple(nodes), tuple(branches), self._retraces(solution), ends, gaps)
+
+    def _retraces(self, solution) -> tuple[dict, ...]:
+        graph = solution.graph
+        count = _pass_counts(solution)
+        result = []
+        for bid in sorted(b for b, n in count.items() if n > 1):
+            points = graph.branches[bid].points
+            step = max(1, len(points) // 40)  # a few dozen points draw it on the page
+            line = np.vstack([points[::step], points[-1:]])
+            result.append({"at": self.to_output(points[len(points) // 2]),
+                           "length": round(graph.branches[bid].length / self.scale, 1),
+                           "points": [self.to_output(p) for p in line]})
+        return tuple(result)
+
+    def _triple_info(self, solution, node: int, choice: dict) -> JunctionInfo:
+        graph, simple = solution.graph, solution.simple
+        dirs = directions(graph, node, 2.5 * self.w)
+        angles = foot_angles(dirs)
+        decided = {**choice, **{n: p for n, p in simple.through.items() if n != node}}
+        options = pass_options(graph, node, dirs, simple.through_posterior.get(node), decided,
+                               one_piece=not self.options.multi)
+        drawn = normal(simple.through[node])
+        return JunctionInfo(node, self.to_output(graph.positions[node]), graph.degree(node), "triple",
+                            decision="passes", confidence=chance_of(drawn, simple.through_posterior.get(node)),
+                            fixed=node in self.fixed, merged=True, passes=tuple(map(tuple, as_angles(drawn, angles))),
+                            options=tuple({"passes": as_angles(p, angles), "p": q} for p, q in options))
+
+
+def _pass_counts(solution) -> dict[int, int]:
+    """branch id -> how many times the solution's strokes pass it."""
+    count: dict[int, int] = {}
+    for passes in solution.ordering.strokes:
+        for step in passes:
+            count[step.branch] = count.get(step.branch, 0) + 1
+    return count
+
+
+def _nearest_branch(graph, point: np.ndarray, tol: float) -> int | None:
+    """The id of the branch passing nearest `point`, if within tol."""
+    best = None
+    for bid, branch in graph.branches.items():
+        d = float(np.min(np.linalg.norm(branch.points - point, axis=1)))
+        if d <= tol and (best is None or d < best[0]):
+            best = (d, bid)
+    return None if best is None else best[1]
 
 
 def _nearest_mergeable(graph, point: np.ndarray, tol: float):

@@ -97,6 +97,8 @@ class Simplified:
     t_ends: tuple
     retraced: frozenset = frozenset()
     through: dict = field(default_factory=dict)  # node where three passes cross -> slot pairs
+    # such a node -> (15,) posterior of the pass scorer over `pass_scorer.PAIRINGS` (slots)
+    through_posterior: dict = field(default_factory=dict)
 
 
 def _min_radius(branch: Branch) -> float:

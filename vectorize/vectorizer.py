@@ -45,9 +45,11 @@ SMOOTHER_TOUCH = 0.85
 
 class _Clock:
     """Wall and CPU seconds per stage (CPU: on a shared machine the wall time includes
-    waiting for a core)."""
+    waiting for a core); `checkpoint` (optional) is called at every stage boundary and may
+    raise to stop the run there (`StageCache.checkpoint`)."""
 
-    def __init__(self) -> None:
+    def __init__(self, checkpoint=None) -> None:
+        self.checkpoint = checkpoint
         self.seconds: dict[str, float] = {}
         self.cpu_seconds: dict[str, float] = {}
         self._last = time.perf_counter()
@@ -58,6 +60,8 @@ class _Clock:
         self.seconds[stage] = self.seconds.get(stage, 0.0) + now - self._last
         self.cpu_seconds[stage] = self.cpu_seconds.get(stage, 0.0) + cpu - self._last_cpu
         self._last, self._last_cpu = now, cpu
+        if self.checkpoint is not None:
+            self.checkpoint()
 
 
 def _junctions(graph: MedialGraph, nodes, stroke_width: float) -> list[Junction]:
@@ -93,21 +97,25 @@ def _with_geometry(image: JunctionVerdict, geometry: JunctionVerdict) -> Junctio
     return JunctionVerdict(p_crossing=p, confidence=image.confidence if agree else max(p, 1 - p))
 
 
-def _pair_through(graph: MedialGraph, nodes, gray: np.ndarray, w: float, options: VectorizeOptions) -> dict:
+def _pair_through(graph: MedialGraph, nodes, gray: np.ndarray, w: float,
+                  options: VectorizeOptions) -> tuple[dict, dict]:
     """Pair the feet of each triple point: by continuation and the image (the pass scorer,
-    with the CNN classifier, when its model is installed), by continuation alone otherwise."""
+    with the CNN classifier, when its model is installed), by continuation alone otherwise.
+    Returns (node -> slot pairs, six-foot node -> the scorer's posterior over its pairings)."""
     if not nodes:
-        return {}
+        return {}, {}
     feet = {n: directions(graph, n, 2.5 * w) for n in nodes}
     result = {n: straightest_pairs(d)[0] for n, d in feet.items()}
     six = [n for n in nodes if len(feet[n]) == 6]
     scorer = shipped_pass_scorer() if six and getattr(make_classifier(options.classifier), "name", "") == "cnn" else None
+    posterior = {}
     if six and scorer is not None:
-        from vectorize.pass_scorer import pair_feet
+        from vectorize.pass_scorer import scored_pairings
 
         centers = np.array([graph.positions[n] for n in six])
-        result.update(zip(six, pair_feet(gray, centers, [feet[n] for n in six], w, scorer)))
-    return result
+        for node, (pick, odds) in zip(six, scored_pairings(gray, centers, [feet[n] for n in six], w, scorer)):
+            result[node], posterior[node] = pick, odds
+    return result, posterior
 
 
 def _pairing_costs(verdict: JunctionVerdict) -> tuple[float, float, float]:
@@ -221,10 +229,11 @@ def _order(graph: MedialGraph, ink, options: VectorizeOptions, ends: int, clock:
         graph, simple, junctions, verdicts = cached
     else:
         hooks = refine.simplify_hooks() if refine is not None else {}
-        through = merge_triple_points(graph, stroke_width=w, may_merge=hooks.get("may_merge"))
+        through = merge_triple_points(graph, stroke_width=w, may_merge=hooks.pop("may_cluster", None))
         simple = simplify(graph, stroke_width=w, multi=options.multi, ends=ends, through=through, **hooks)
         # Paired after simplification: merging crossings next to a triple point renumbers its slots.
-        simple = replace(simple, through=_pair_through(graph, simple.through, ink.gray, w, options))
+        through, posterior = _pair_through(graph, simple.through, ink.gray, w, options)
+        simple = replace(simple, through=through, through_posterior=posterior)
         clock.lap("simplification")
         junction_list = _junctions(graph, simple.crossings, w)
         junctions = dict(zip(simple.crossings, junction_list))
@@ -236,6 +245,8 @@ def _order(graph: MedialGraph, ink, options: VectorizeOptions, ends: int, clock:
         if refine is not None:
             refine.store(ends, (graph, simple, junctions, verdicts))
     clock.lap("classification")
+    if refine is not None:
+        simple = refine.fix_passes(graph, simple)
     ranked = {n: ranked_pairings(junctions[n], verdicts[n]) for n in simple.crossings}
     costs = {n: _pairing_costs(verdicts[n]) for n in simple.crossings}
     if refine is not None:
@@ -243,7 +254,9 @@ def _order(graph: MedialGraph, ink, options: VectorizeOptions, ends: int, clock:
     if options.multi:
         ordering, tried = order_strokes(graph, simple, ranked, costs, stroke_width=w)
     else:
-        ordering, tried = _single_route(graph, simple, ranked, costs, w)
+        ordering, tried = _single_route(graph, simple, ranked, costs, w,
+                                        refine.start_ends(graph) if refine is not None else None,
+                                        refine.route_weights(graph) if refine is not None else None)
     clock.lap("traversal")
     return _Solution(graph, simple, junctions, verdicts, ordering, tried)
 
@@ -269,8 +282,10 @@ def _junction_end_cost(graph: MedialGraph, node: int, dirs: np.ndarray, w: float
 
 
 def _single_route(graph: MedialGraph, simple: Simplified, ranked: dict, costs: dict,
-                  w: float) -> tuple[Ordering, int]:
-    """Single-line mode: one stroke over the whole (connected) graph, retracing the least."""
+                  w: float, start_at: dict | None = None, weight: dict | None = None) -> tuple[Ordering, int]:
+    """Single-line mode: one stroke over the whole (connected) graph, retracing the least.
+    start_at: node -> end cost (px) that overrides the rule (a user's start edit); weight:
+    branch id -> factor on its retrace cost (a user's twice / once edits)."""
     pairing, tried = connect_pairings(graph, ranked, costs, fixed=simple.through)
     dirs = {n: directions(graph, n, 2.5 * w) for n in graph.incident if graph.degree(n) >= 3}
     # The tip of a sharp corner's spur is not where a pen starts; a junction is a poorer
@@ -279,7 +294,9 @@ def _single_route(graph: MedialGraph, simple: Simplified, ranked: dict, costs: d
               if n not in simple.retraced}
     end_cost = {n: 3.0 * w for n in v_tips}
     end_cost.update({n: _junction_end_cost(graph, n, dirs[n], w) for n in dirs})
-    routes = plan_routes(graph, {**simple.through, **pairing}, stroke_width=w, directions=dirs, end_cost=end_cost)
+    end_cost.update(start_at or {})
+    routes = plan_routes(graph, {**simple.through, **pairing}, stroke_width=w, directions=dirs, end_cost=end_cost,
+                         weight=weight)
     choice = tuple(pairing.get(n, ranked[n][0]) for n in simple.crossings)
     return Ordering(tuple(r.passes for r in routes), tuple(r.closed for r in routes), choice), tried
 
@@ -322,7 +339,8 @@ def _axis(image: np.ndarray, options: VectorizeOptions, clock: _Clock, cache: St
 
 def _front(image: np.ndarray, options: VectorizeOptions, clock: _Clock, cache: StageCache | None = None):
     """Binarize, outline, medial axis, pruning and (single-line) gap bridging: the stages
-    that only threshold, blur and mode change. Returns (ink, rings, graph, bridged, dropped).
+    that only threshold, blur and mode change. Returns (ink, rings, graph, bridges, dropped),
+    bridges: the pen gaps bridged, each as its two ends (working px).
 
     With `cache`, the stages before pruning are shared between the modes (a copy of the
     cached graph is pruned) and the paper-flattened gray between thresholds."""
@@ -339,11 +357,12 @@ def _front(image: np.ndarray, options: VectorizeOptions, clock: _Clock, cache: S
     branch_points = sum(1 for incident in graph.incident.values() if len(incident) >= 3)
     _refuse_noise(branch_points, "branch points", MAX_BRANCH_POINTS, ink.threshold,
                   options.threshold is not None)
-    bridged = dropped = 0
+    bridges: list = []
+    dropped = 0
     if not options.multi:
-        bridged = bridge_gaps(graph, stroke_width=w)
+        bridge_gaps(graph, stroke_width=w, made=bridges)
         dropped = keep_largest_piece(graph)
-    return ink, rings, graph, bridged, dropped
+    return ink, rings, graph, tuple(bridges), dropped
 
 
 def run_pipeline(image: np.ndarray, options: VectorizeOptions, *,
@@ -354,7 +373,7 @@ def run_pipeline(image: np.ndarray, options: VectorizeOptions, *,
     edits: the user's corrections (`vectorize.edits`); cache: a `StageCache` kept between
     calls on the same image, so that an edit re-runs only the stages after it.
     """
-    clock = _Clock()
+    clock = _Clock(cache.checkpoint if cache is not None else None)
     shape = np.asarray(image).shape
     if frame is None:
         frame = InputFrame(1.0, (0.0, 0.0), float(shape[1]), float(shape[0]))
@@ -366,7 +385,7 @@ def run_pipeline(image: np.ndarray, options: VectorizeOptions, *,
         front = cache.front_for(image, options, lambda stages: _front(image, options, clock, stages))
     else:
         front = _front(image, options, clock)
-    ink, rings, graph, bridged, dropped = front
+    ink, rings, graph, bridges, dropped = front
     w = ink.stroke_width
     scale = ink.scale * frame.scale  # working px per output unit
     # Working pixel centres sit at integers (scikit-image); in SVG and in the input's pixel
@@ -423,16 +442,17 @@ def run_pipeline(image: np.ndarray, options: VectorizeOptions, *,
         warnings.append(f"{len(simple.unresolved)} junction(s) where three or more strokes seem to meet:"
                         " they are not resolved and the order there may be wrong")
     if refine is not None:
-        warnings.extend(refine.unmatched())
+        warnings.extend(refine.unmatched() + refine.unheeded(best))
     if not options.multi and len(strokes) > 1:
         warnings.append(f"the line could not be followed in one stroke: {len(strokes)} strokes")
     report = VectorizeReport(
         strokes=len(strokes), intersections=len(simple.crossings), y_junctions=len(simple.y_feet),
-        dropped_components=dropped, gaps_bridged=bridged, high_degree_junctions=len(simple.unresolved), retries=tried - 1,
+        dropped_components=dropped, gaps_bridged=len(bridges), high_degree_junctions=len(simple.unresolved),
+        retries=tried - 1,
         scale=scale, stroke_width=w / scale, warnings=tuple(warnings), seconds=clock.seconds,
         cpu_seconds=clock.cpu_seconds)
     if stages is not None:
         stages.update(simplified=graph, simple=simple, junctions=junctions, verdicts=verdicts,
                       ordering=ordering, working_strokes=strokes)
-    view = refine.graph_view(best) if refine is not None else None
+    view = refine.graph_view(best, bridges) if refine is not None else None
     return VectorizeResult(drawing, report, stages, view)

@@ -61,7 +61,7 @@ def _progress():
             return Text(f"{speed:.2f} drawings/s" if speed else "-- drawings/s")
 
     return Progress(TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(), RateColumn(),
-                    TextColumn("left"), TimeRemainingColumn(), console=console, transient=True)
+                    TextColumn("left"), TimeRemainingColumn(), console=console.rich, transient=True)
 
 
 def _shared_options(command: click.Command, settings, what: str, renamed: dict | None = None) -> list:

@@ -2,11 +2,71 @@
 
 from __future__ import annotations
 
-import click
-from rich.console import Console
+import os
+import re
+import sys
 
-# Status goes to stderr so that stdout stays clean for piping.
-console = Console(stderr=True, highlight=False)
+import click
+
+# rich's console markup tags (rich.markup.RE_TAGS): plain output drops them as rich does
+# and keeps a tag escaped with a backslash, without the backslash.
+_MARKUP_TAG = re.compile(r"(\\*)\[([a-z#/@][^[]*?)]")
+
+
+def _plain_text(markup: str) -> str:
+    def tag(match: re.Match) -> str:
+        slashes, escaped = divmod(len(match.group(1)), 2)
+        return "\\" * slashes + (f"[{match.group(2)}]" if escaped else "")
+
+    return _MARKUP_TAG.sub(tag, markup)
+
+
+def _may_be_terminal() -> bool:
+    """False when rich's console could not see a terminal on stderr: stderr is not a tty and
+    neither FORCE_COLOR nor TTY_COMPATIBLE asks for one (rich's own rules)."""
+    if "FORCE_COLOR" in os.environ or os.environ.get("TTY_COMPATIBLE") == "1":
+        return True
+    isatty = getattr(sys.stderr, "isatty", None)
+    try:
+        return bool(isatty and isatty())
+    except ValueError:  # a closed stream
+        return False
+
+
+class _StatusConsole:
+    """Status output on stderr, so that stdout stays clean for piping. On a terminal it is
+    a rich console (colour, spinners, bars); in a log or a pipe plain lines, with the same
+    text as rich would write there but unwrapped, and rich is not imported at all: it
+    costs ~40 ms of every command's start-up. Anything beyond `print` and `is_terminal`
+    goes to the rich console, made on first use."""
+
+    def __init__(self) -> None:
+        self._rich = None
+
+    @property
+    def rich(self):
+        """The rich console (stderr, no highlighting), made on first use."""
+        if self._rich is None:
+            from rich.console import Console
+
+            self._rich = Console(stderr=True, highlight=False)
+        return self._rich
+
+    @property
+    def is_terminal(self) -> bool:
+        return _may_be_terminal() and self.rich.is_terminal
+
+    def print(self, *objects, soft_wrap: bool = False, highlight: bool | None = None, **options) -> None:
+        if self.is_terminal or options or not all(isinstance(o, str) for o in objects):
+            self.rich.print(*objects, soft_wrap=soft_wrap, highlight=highlight, **options)
+            return
+        click.echo(_plain_text(" ".join(objects)), err=True)
+
+    def __getattr__(self, name: str):
+        return getattr(self.rich, name)
+
+
+console = _StatusConsole()
 
 
 def warn(message: str) -> None:
@@ -59,7 +119,7 @@ class _StepProgress:
                                        TimeRemainingColumn)
 
             self.bar = Progress(SpinnerColumn(), TextColumn("{task.description}"), BarColumn(),
-                                TaskProgressColumn(), TimeRemainingColumn(), console=console, transient=True)
+                                TaskProgressColumn(), TimeRemainingColumn(), console=console.rich, transient=True)
             self.bar.start()
             self.task = self.bar.add_task(self.description, total=None)
         return self

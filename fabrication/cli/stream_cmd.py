@@ -165,7 +165,7 @@ def run_stream(gcode_path, *, port: str, baud: int = 115200, check: bool = False
                    TextColumn("{task.completed}/{task.total} lines"), TimeElapsedColumn(),
                    TextColumn("ETA {task.fields[eta]}"), TextColumn("{task.fields[state]}"))
         interactive = sys.stdin.isatty() and console.is_terminal
-        with Progress(*columns, console=console, transient=False, disable=not console.is_terminal) as bar:
+        with Progress(*columns, console=console.rich, transient=False, disable=not console.is_terminal) as bar:
             task = bar.add_task("check" if check else "stream", total=len(program), eta="-", state="")
             last = [0.0]
             plain_next = [time.monotonic() + progress_every]

@@ -32,7 +32,8 @@ def studio(source: str, port: int, no_browser: bool, edits_path: str | None, pro
     if not 0 <= port <= 65535:
         raise InputError(f"--port {port} must be between 0 and 65535")
     check_distinct(inputs=[("input", source), ("--profile", profile_path)], outputs=[("--edits file", edits_path)])
-    session = StudioSession(source, edits_path=edits_path, profile=profile_path, classifier=classifier)
+    session = StudioSession(source, edits_path=edits_path, profile=profile_path, classifier=classifier,
+                            precompute=True)
     if profile_path is not None:
         from machines.laser_profile import load_laser_profile
 

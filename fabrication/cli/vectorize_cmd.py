@@ -25,9 +25,11 @@ def vectorize(source: str, output: str, multi: bool, threshold: float | None, bl
     """Vectorize SOURCE into one ordered cubic Bézier curve (or several with --multi)."""
     if debug_dir is not None and os.path.exists(debug_dir) and not os.path.isdir(debug_dir):
         raise InputError(f"--debug {debug_dir!r} is a file; give a folder for the stage images")
-    from vectorize.debug_overlay import STAGE_IMAGES
+    stage_images = []
+    if debug_dir:  # the overlay module is imported only when --debug asks for it
+        from vectorize.debug_overlay import STAGE_IMAGES
 
-    stage_images = [("--debug image", os.path.join(debug_dir, name)) for name in STAGE_IMAGES] if debug_dir else []
+        stage_images = [("--debug image", os.path.join(debug_dir, name)) for name in STAGE_IMAGES]
     check_distinct(inputs=[("input", source), ("--edits file", edits)], outputs=[("output", output), *stage_images])
     from vectorize import VectorizeOptions, vectorize_file
     from vectorize.edits import read_edits

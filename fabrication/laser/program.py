@@ -10,19 +10,28 @@ from dataclasses import dataclass
 
 from fabrication.laser.gcode_write import GcodeOptions, comment_line, gcode_lines, gcode_text
 from fabrication.laser.toolpath import Toolpath, ToolpathOptions, plan_toolpath
-from machines.job_time import JobTime, estimate_job_time, format_duration
+from machines.gcode_program import Program, ProgramStats, analyze_program, program_from_lines
+from machines.grbl_settings import settings_from_profile
+from machines.job_time import JobTime, estimate_program_time, format_duration
 from onestroke.errors import OnestrokeError
 from vectorize.drawing import Drawing
+
+
+HEADER_LINES = 5  # comment lines before the G-code: name, size, settings, time, profile
 
 
 @dataclass(frozen=True, kw_only=True, eq=False)
 class LaserProgram:
     """toolpath: the planned burn (mm, machine frame); lines: the program without line
-    endings, header comments first; time: `machines.job_time` estimate of `lines`."""
+    endings, header comments first; time: `machines.job_time` estimate of `lines`;
+    program, stats: `lines` as GRBL reads them (what the estimate and a preview use, read
+    once)."""
 
     toolpath: Toolpath
     lines: tuple[str, ...]
     time: JobTime
+    program: Program
+    stats: ProgramStats
 
     @property
     def text(self) -> str:
@@ -37,7 +46,14 @@ def laser_program(drawing: Drawing, profile, toolpath_options: ToolpathOptions,
     (strokes planned, then G-code lines read back for the time estimate)."""
     toolpath = plan_toolpath(drawing, profile, toolpath_options, progress=progress)
     lines = gcode_lines(toolpath, profile, gcode_options, progress=progress)
-    job = estimate_job_time(lines, profile, progress=progress)  # machines/ reads the G-code as GRBL will
+    # machines/ reads the G-code as GRBL will, numbered as in the file: after the header's
+    # comment lines, which GRBL never sees (so they change no time, only line numbers).
+    body = program_from_lines(lines)
+    program = Program(body.source, tuple((n + HEADER_LINES, text) for n, text in body.lines),
+                      body.n_lines + HEADER_LINES)
+    stats = analyze_program(program, settings=settings_from_profile(profile), planner_blocks=profile.planner_blocks,
+                            allow_settings=False, progress=progress)
+    job = estimate_program_time(program, profile, stats=stats)
     if job.errors:  # the writer's bug, not the user's input: say so before writing anything
         line, text = job.errors[0]
         raise OnestrokeError(f"internal error: GRBL would refuse generated line {line}: {text}")
@@ -51,4 +67,4 @@ def laser_program(drawing: Drawing, profile, toolpath_options: ToolpathOptions,
         f"profile: {profile.name}",
     )
     return LaserProgram(toolpath=toolpath, lines=tuple(comment_line(c) for c in comments) + tuple(lines),
-                        time=job)
+                        time=job, program=program, stats=stats)

@@ -32,13 +32,21 @@ def gcode_player_data(lines, *, title: str = "G-code",
     return _player_data(program, title, profile)
 
 
-def _player_data(program, title: str, profile: LaserProfile | None) -> PlayerData:
+def laser_program_player_data(program, *, title: str, profile: LaserProfile) -> PlayerData:
+    """`PlayerData` of a `fabrication.laser.program.LaserProgram` made for `profile`: the
+    same as `gcode_player_data(program.lines)`, from the reading its estimate made."""
+    return _player_data(program.program, title, profile, stats=program.stats, job=program.time)
+
+
+def _player_data(program, title: str, profile: LaserProfile | None, *, stats=None, job=None) -> PlayerData:
     profile = profile or load_laser_profile()
-    stats = analyze_program(program, settings=settings_from_profile(profile), planner_blocks=profile.planner_blocks)
+    if stats is None:
+        stats = analyze_program(program, settings=settings_from_profile(profile), planner_blocks=profile.planner_blocks)
     moves, seg = stats.moves, stats.segments
     if len(moves) == 0 or len(seg) == 0:
         raise InputError(f"G-code {title!r} holds no moves to play")
-    job = estimate_program_time(program, profile, stats=stats)
+    if job is None:
+        job = estimate_program_time(program, profile, stats=stats)
     n_lines = len(job.line_seconds)
     segments = np.stack([seg.start[:, :2], seg.end[:, :2]], axis=1)
     owner = seg.move

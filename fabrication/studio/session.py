@@ -11,13 +11,14 @@ from __future__ import annotations
 
 import os
 import threading
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
 
 from fabrication.job_options import embroidery_settings, laser_settings
 from onestroke.atomic import atomic_write_text
-from onestroke.errors import InputError
+from onestroke.errors import Cancelled, InputError, OnestrokeError
 from vectorize import VectorizeOptions, vectorize_file
 from vectorize.edits import Edits, edits_from_dict, read_edits
 from vectorize.refine import StageCache
@@ -44,15 +45,24 @@ def _clean(values: dict, allowed: tuple[str, ...]) -> dict:
 
 
 class Superseded(Exception):
-    """A page asked for a newer state while this request waited for the vectorizer."""
+    """A page asked for a newer state while this request waited for or ran the vectorizer."""
+
+
+# The page's slider steps (static/index.html): the values a user reaches next from a
+# setting, which the session computes in the background while it is idle
+# (`warm_neighbours`).
+THRESHOLD_STEP, BLUR_STEP, MAX_BLUR = 0.01, 0.25, 4.0
 
 
 class StudioSession:
     """drawing: the input file; edits_path: where the page saves its edits; profile: an
-    optional laser profile TOML; classifier: the vectorizer's crossing classifier."""
+    optional laser profile TOML; classifier: the vectorizer's crossing classifier; precompute:
+    after each state, compute the neighbouring threshold and blur slider values in the
+    background while no request waits (see `warm_neighbours`)."""
 
     def __init__(self, drawing: str | os.PathLike, *, edits_path: str | os.PathLike | None = None,
-                 profile: str | os.PathLike | None = None, classifier: str = "cnn") -> None:
+                 profile: str | os.PathLike | None = None, classifier: str = "cnn",
+                 precompute: bool = False) -> None:
         self.drawing_path = Path(drawing)
         if not self.drawing_path.is_file():
             raise InputError(f"input file {str(drawing)!r} does not exist")
@@ -63,6 +73,13 @@ class StudioSession:
         self.lock = threading.Lock()  # one vectorization at a time: the cache is not shared-safe
         self.sender = None
         self._tickets: dict[str, int] = {}  # page id -> number of its latest state request
+        self.precompute = precompute
+        # Bumped by every request that needs the vectorizer: background work in progress
+        # stops at its next stage boundary and leaves the vectorizer to the request.
+        self._generation = 0
+        self._wanted: Edits | None = None  # the edits of the latest request
+        self._warmer: threading.Thread | None = None
+        self._shown: Edits | None = None  # the edits of the last state answered
 
     # -- edits -----------------------------------------------------------------------
     def saved_edits(self) -> Edits:
@@ -75,13 +92,81 @@ class StudioSession:
         return edits
 
     # -- vectorization ---------------------------------------------------------------
-    def vectorize(self, edits: Edits, *, superseded=None):
+    def vectorize(self, edits: Edits, *, superseded=None, generation: int | None = None):
         """The vectorization with these edits. superseded: a callable; when it says True
-        once the vectorizer is free, `Superseded` is raised instead of the work."""
-        with self.lock:
+        before or during the run (checked between stages), `Superseded` is raised instead
+        of the rest of the work. generation: background work (`warm_neighbours`) passes the
+        generation it was started in and stops as soon as a request arrives; a request
+        (None) stops background work first, unless that is computing these very edits."""
+        if generation is None:
+            self._wanted = edits
+            self._generation += 1
+
+        def stale() -> bool:
             if superseded is not None and superseded():
+                return True
+            # Background work goes on only while no request waits, or the one that waits
+            # wants what it is computing.
+            return generation is not None and generation != self._generation and self._wanted != edits
+
+        with self.lock:
+            if stale():
                 raise Superseded
-            return vectorize_file(self.drawing_path, self.options, edits=edits, cache=self.cache)
+            self.cache.cancel = stale
+            try:
+                return vectorize_file(self.drawing_path, self.options, edits=edits, cache=self.cache)
+            except Cancelled:
+                raise Superseded from None
+            finally:
+                self.cache.cancel = None
+
+    def neighbours(self, edits: Edits, previous: Edits | None = None) -> list[Edits]:
+        """The settings one slider step away from `edits` (threshold only when the user set
+        one; blur within the slider's range), the direction of the last move first."""
+        found = []
+        moved = {}
+        if previous is not None:
+            for name in ("threshold", "blur"):
+                old, new = getattr(previous, name), getattr(edits, name)
+                if old is not None and new is not None and new != old:
+                    moved[name] = 1 if new > old else -1
+        if edits.threshold is not None:
+            for sign in (moved.get("threshold", 1), -moved.get("threshold", 1)):
+                value = round(edits.threshold + sign * THRESHOLD_STEP, 2)
+                if 0.0 < value < 1.0:
+                    found.append(replace(edits, threshold=value))
+        blur = edits.blur if edits.blur is not None else self.options.blur
+        for sign in (moved.get("blur", 1), -moved.get("blur", 1)):
+            value = round(blur + sign * BLUR_STEP, 2)
+            if 0.0 <= value <= MAX_BLUR:
+                found.append(replace(edits, blur=value))
+        return found
+
+    def warm_neighbours(self, edits: Edits, previous: Edits | None = None) -> threading.Thread:
+        """Compute the neighbouring slider values of `edits` in a background thread, so that
+        the next step of a slider is answered from the cache. The answer is the same as
+        without it (the cache holds what a fresh run computes); any request stops it."""
+        generation = self._generation
+
+        def work() -> None:
+            for neighbour in self.neighbours(edits, previous):
+                if generation != self._generation:
+                    return
+                try:
+                    self.vectorize(neighbour, generation=generation)
+                except (Superseded, OnestrokeError):
+                    pass  # stopped by a request, or a setting that fails: asked for, it says why
+
+        self._warmer = threading.Thread(target=work, name="studio-warm", daemon=True)
+        self._warmer.start()
+        return self._warmer
+
+    def idle(self, timeout: float | None = None) -> bool:
+        """Wait for background work to finish; True if there is none left."""
+        warmer = self._warmer
+        if warmer is not None:
+            warmer.join(timeout)
+        return warmer is None or not warmer.is_alive()
 
     def ticket(self, page: str):
         """A state request of page `page`: a callable saying whether the page has asked for
@@ -103,7 +188,7 @@ class StudioSession:
             strokes.append({"points": np.round(points, 2).tolist(), "closed": bool(stroke.is_closed),
                             "length": round(float(stroke.length), 2)})
         settings = edits.applied_to(self.options)
-        return {
+        answer = {
             "name": self.drawing_path.name, "width": drawing.width, "height": drawing.height,
             "stroke_width": round(float(drawing.stroke_width), 3), "strokes": strokes,
             "graph": result.graph.to_dict() if result.graph is not None else {"junctions": [], "branches": []},
@@ -113,6 +198,10 @@ class StudioSession:
             "settings": {"threshold": settings.threshold, "blur": settings.blur, "multi": settings.multi},
             "edits": edits.to_dict(),
         }
+        if self.precompute:
+            self.warm_neighbours(edits, self._shown)
+        self._shown = edits
+        return answer
 
     # -- make it ---------------------------------------------------------------------
     PANEL_MODULES = ("fabrication.embroidery.pipeline", "fabrication.embroidery.export", "fabrication.player",
@@ -169,11 +258,11 @@ class StudioSession:
     def laser_preview(self, edits: Edits, values: dict) -> dict:
         """The G-code's moves for the player on the planner's time axis, and the estimate."""
         from machines.job_time import format_duration
-        from fabrication.player import gcode_player_data
+        from fabrication.player import laser_program_player_data
 
         settings, program = self.laser(edits, values)
         time = program.time
-        data = gcode_player_data(program.lines, title=self.drawing_path.stem, profile=settings.profile)
+        data = laser_program_player_data(program, title=self.drawing_path.stem, profile=settings.profile)
         return {"player": data.to_dict(), "seconds": time.total_seconds,
                 "time": format_duration(time.total_seconds), "naive": format_duration(time.naive_seconds),
                 "burn_length": round(float(time.burn_length), 1), "travel_length": round(float(time.travel_length), 1),

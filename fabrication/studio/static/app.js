@@ -5,7 +5,10 @@ import { $, busy, call, report } from "./api.js";
 import { refreshPanel, setupPanels } from "./panels.js";
 
 const PAIRINGS = ["crossing", "touching", "third"];
-const COLORS = { crossing: "#1565c0", touching: "#ef6c00", third: "#8e24aa", other: "#757575", start: "#2e7d32" };
+const COLORS = { crossing: "#1565c0", touching: "#ef6c00", third: "#8e24aa", other: "#757575", start: "#2e7d32",
+                 passes: "#00838f", retrace: "rgba(255, 179, 0, 0.55)", gap: "#c2185b" };
+// The three passes through a triple point, each in its own colour inside the marker.
+const PASS_COLORS = ["#d81b60", "#43a047", "#1e88e5", "#6d4c41"];
 
 const studio = {
   state: null,            // last answer of /api/state
@@ -126,6 +129,7 @@ function draw() {
   }
   const g = c.getContext("2d");
   g.setTransform(dpr, 0, 0, dpr, 0, 0);
+  studio.labels = [];  // the markers' texts, drawn after every marker
   g.clearRect(0, 0, c.clientWidth, c.clientHeight);
   if (!s) return;
   const v = studio.view;
@@ -137,6 +141,7 @@ function draw() {
     g.globalAlpha = 1;
   }
   g.restore();
+  retraces(g);
   const t = studio.line;
   const penAt = studio.pen * t.total;
   const width = Math.max(2, Math.min(6, s.stroke_width * v.scale * 0.45));
@@ -149,14 +154,16 @@ function draw() {
     g.beginPath(); g.moveTo(a[0], a[1]); g.lineTo(b[0], b[1]); g.stroke();
   }
   arrows(g, t);
-  // Start markers: where each stroke begins.
+  junctionMarkers(g);
+  bridges(g);
+  placeLabels(g);
+  // Start markers: where each stroke begins (over a junction the line starts at).
   s.strokes.forEach((stroke, k) => {
     const [x, y] = toScreen(...stroke.points[0]);
     g.fillStyle = COLORS.start; g.beginPath(); g.arc(x, y, k === 0 ? 7 : 5, 0, 2 * Math.PI); g.fill();
     g.fillStyle = "#fff"; g.font = "bold 9px sans-serif"; g.textAlign = "center"; g.textBaseline = "middle";
     g.fillText(String(k + 1), x, y + 0.5);
   });
-  junctionMarkers(g);
   if (studio.pen < 1 || studio.playing) penMarker(g, t, penAt);
   else $("where").textContent = `${Math.round(t.total)} px, ${s.strokes.length} stroke${s.strokes.length === 1 ? "" : "s"}`;
 }
@@ -176,8 +183,92 @@ function arrows(g, t) {
   }
 }
 
+// Stretches the line draws twice (a stem down and back up, a path route inspection repeats):
+// a wide amber band under the curve, "×2" at its middle.
+function retraces(g) {
+  const s = studio.state;
+  g.save();
+  g.lineCap = "round"; g.lineJoin = "round";
+  g.lineWidth = Math.max(8, s.stroke_width * studio.view.scale * 1.6);
+  g.strokeStyle = COLORS.retrace;
+  for (const r of s.graph.retraces || []) {
+    g.beginPath();
+    r.points.forEach((p, i) => { const [x, y] = toScreen(...p); if (i) g.lineTo(x, y); else g.moveTo(x, y); });
+    g.stroke();
+  }
+  g.fillStyle = "#6d4c00"; g.font = "bold 11px sans-serif"; g.textAlign = "center"; g.textBaseline = "middle";
+  for (const r of s.graph.retraces || []) { const [x, y] = toScreen(...r.at); g.fillText("×2", x + 12, y - 12); }
+  g.restore();
+}
+
+// Pen gaps the vectorizer bridged: the two ends joined, dashed, under the curve.
+function bridges(g) {
+  g.save();
+  for (const [a, b] of studio.state.graph.bridges || []) {
+    const [ax, ay] = toScreen(...a), [bx, by] = toScreen(...b);
+    const r = Math.max(9, Math.hypot(bx - ax, by - ay) / 2 + 5);
+    g.strokeStyle = COLORS.gap; g.lineWidth = 2; g.setLineDash([4, 3]);
+    g.beginPath(); g.arc((ax + bx) / 2, (ay + by) / 2, r, 0, 2 * Math.PI); g.stroke();
+    g.setLineDash([]);
+    label(g, "gap", (ax + bx) / 2, (ay + by) / 2, r + 3);
+  }
+  g.restore();
+}
+
+function percent(p) { return p === null || p === undefined ? "" : p < 0.001 ? " <0.1%" : ` ${Math.round(100 * p)}%`; }
+
+// A triple point: its three passes drawn through the marker, each pair of branch directions
+// joined through the centre, so the pairing is seen, not read.
+function tripleMarker(g, j) {
+  const [x, y] = toScreen(...j.at), r = 16;
+  g.lineWidth = 3; g.strokeStyle = COLORS.passes; g.fillStyle = "rgba(255,255,255,0.9)";
+  g.beginPath();
+  if (j.fixed) g.rect(x - r - 2, y - r - 2, 2 * r + 4, 2 * r + 4); else g.arc(x, y, r + 2, 0, 2 * Math.PI);
+  g.fill(); g.stroke();
+  j.passes.forEach(([a, b], k) => {
+    const ra = (a * Math.PI) / 180, rb = (b * Math.PI) / 180;
+    g.strokeStyle = PASS_COLORS[k % PASS_COLORS.length]; g.lineWidth = 2.5;
+    g.beginPath(); g.moveTo(x + r * Math.cos(ra), y + r * Math.sin(ra));
+    g.quadraticCurveTo(x, y, x + r * Math.cos(rb), y + r * Math.sin(rb)); g.stroke();
+  });
+  const k = j.options.findIndex((o) => samePasses(o.passes, j.passes));
+  label(g, `3 passes${j.confidence === null ? " (straightest)" : percent(j.confidence)} · ${k + 1}/${j.options.length}`,
+    x, y, r + 6);
+}
+
+// A marker's text, beside the marker at (x, y) of radius `gap`; drawn by `placeLabels`
+// once every marker is drawn.
+function label(g, text, x, y, gap) { studio.labels.push({ text, x, y, gap }); }
+
+// Each text on a white halo so that it reads over the curve, right of its marker, else
+// left, below or above, wherever it covers no marker and no text placed before (junctions
+// a few px apart would print over each other).
+function placeLabels(g) {
+  g.font = "11px sans-serif"; g.textAlign = "left"; g.textBaseline = "middle";
+  const boxes = studio.labels.map(({ x, y, gap }) => [x - gap, y - gap, 2 * gap, 2 * gap]);
+  const h = 13;
+  for (const { text, x, y, gap } of studio.labels) {
+    const w = g.measureText(text).width;
+    const spots = [[x + gap, y], [x - gap - w, y], [x - w / 2, y + gap + h / 2], [x - w / 2, y - gap - h / 2]];
+    const covers = (sx, sy, b) => sx < b[0] + b[2] && b[0] < sx + w && sy - h / 2 < b[1] + b[3] && b[1] < sy + h / 2;
+    const [lx, ly] = spots.find(([sx, sy]) => !boxes.some((b) => covers(sx, sy, b))) || spots[0];
+    boxes.push([lx, ly - h / 2, w, h]);
+    g.strokeStyle = "rgba(255,255,255,0.9)"; g.lineWidth = 3; g.lineJoin = "round"; g.strokeText(text, lx, ly);
+    g.fillStyle = "#222"; g.fillText(text, lx, ly);
+  }
+}
+
+function samePasses(a, b) { return JSON.stringify(a) === JSON.stringify(b); }
+
 function junctionMarkers(g) {
   const graph = studio.state.graph;
+  if (studio.tool === "start") {
+    for (const at of graph.ends || []) {
+      const [x, y] = toScreen(...at);
+      g.strokeStyle = COLORS.start; g.lineWidth = 2; g.setLineDash([3, 2]);
+      g.beginPath(); g.arc(x, y, 9, 0, 2 * Math.PI); g.stroke(); g.setLineDash([]);
+    }
+  }
   if (studio.tool === "merge") {
     for (const b of graph.branches) {
       const [x, y] = toScreen(...b.at);
@@ -187,9 +278,14 @@ function junctionMarkers(g) {
   }
   for (const j of graph.junctions) {
     const [x, y] = toScreen(...j.at);
+    if (j.role === "triple") { tripleMarker(g, j); continue; }
     if (j.role !== "crossing") {
-      g.strokeStyle = COLORS.other; g.lineWidth = 2;
-      g.beginPath(); g.arc(x, y, 5, 0, 2 * Math.PI); g.stroke();
+      // An unresolved junction (the warning's "three or more strokes seem to meet") is
+      // named where it is: the order there is the walk's guess.
+      const open = j.role === "unresolved";
+      g.strokeStyle = open ? COLORS.gap : COLORS.other; g.lineWidth = 2;
+      g.beginPath(); g.arc(x, y, open ? 8 : 5, 0, 2 * Math.PI); g.stroke();
+      if (open) label(g, "unresolved ?", x, y, 11);
       continue;
     }
     const color = COLORS[j.decision] || COLORS.other;
@@ -200,8 +296,7 @@ function junctionMarkers(g) {
     // Confidence as the filled share of an inner disc.
     g.fillStyle = color; g.beginPath(); g.moveTo(x, y);
     g.arc(x, y, 6, -Math.PI / 2, -Math.PI / 2 + 2 * Math.PI * (j.confidence || 0)); g.closePath(); g.fill();
-    g.fillStyle = "#222"; g.font = "11px sans-serif"; g.textAlign = "left"; g.textBaseline = "middle";
-    g.fillText(`${j.decision} ${Math.round(100 * (j.confidence || 0))}%`, x + 12, y);
+    label(g, `${j.decision} ${Math.round(100 * (j.confidence || 0))}%`, x, y, 12);
   }
 }
 
@@ -227,11 +322,33 @@ function show(state) {
     ` · ${(state.answered ?? r.seconds).toFixed(2)} s`;
   $("summary").dataset.order = JSON.stringify(state.strokes.map((s) => s.points[0]));
   const list = $("junctions"); list.innerHTML = "";
-  for (const j of state.graph.junctions.filter((j) => j.role === "crossing")) {
+  for (const j of state.graph.junctions.filter((j) => j.role === "crossing" || j.role === "triple")) {
     const li = document.createElement("li");
-    li.textContent = `(${j.at[0].toFixed(0)}, ${j.at[1].toFixed(0)}) ${j.decision}` +
-      ` · CNN p(cross) ${(j.p_crossing * 100).toFixed(0)}%` + (j.fixed ? " · fixed by you" : "");
+    const where = `(${j.at[0].toFixed(0)}, ${j.at[1].toFixed(0)})`;
     li.style.color = COLORS[j.decision];
+    if (j.role === "triple") {
+      li.append(`${where} three passes · ${j.confidence === null ? "straightest" : "pass scorer" + percent(j.confidence)} `);
+      li.appendChild(passChoice(j));
+      if (j.fixed) li.append(" · fixed by you");
+    } else {
+      li.textContent = `${where} ${j.decision} · CNN p(cross) ${(j.p_crossing * 100).toFixed(0)}%` +
+        (j.fixed ? " · fixed by you" : "");
+    }
+    list.appendChild(li);
+  }
+  const gaps = state.graph.bridges || [];
+  if (gaps.length) {
+    const li = document.createElement("li");
+    li.className = "gaps";
+    li.textContent = `pen gap${gaps.length === 1 ? "" : "s"} bridged: ${gaps.length} (dashed circles)`;
+    list.appendChild(li);
+  }
+  const twice = state.graph.retraces || [];
+  if (twice.length) {
+    const li = document.createElement("li");
+    li.className = "retraces";
+    li.textContent = `drawn twice (×2): ${twice.length} stretch${twice.length === 1 ? "" : "es"}, ` +
+      `${Math.round(twice.reduce((sum, r) => sum + r.length, 0))} px`;
     list.appendChild(li);
   }
   const warnings = $("warnings"); warnings.innerHTML = "";
@@ -250,6 +367,25 @@ function show(state) {
   refreshPanel();
 }
 
+// The pairings a triple point may take (each keeps the line one stroke), likeliest first.
+function passChoice(j) {
+  const select = document.createElement("select");
+  select.className = "passes"; select.title = "How the pen went through: the pairs of branch directions (degrees)";
+  j.options.forEach((o, k) => {
+    const option = document.createElement("option");
+    option.value = String(k);
+    option.textContent = `${k + 1}: ` + o.passes.map(([a, b]) => `${Math.round(a)}°–${Math.round(b)}°`).join(", ") + percent(o.p);
+    option.selected = samePasses(o.passes, j.passes);
+    select.appendChild(option);
+  });
+  select.onchange = () => choosePasses(j, j.options[Number(select.value)]);
+  return select;
+}
+
+function choosePasses(j, option) {
+  return apply(withEdit({ kind: "passes", at: j.at, passes: option.passes }, true));
+}
+
 // ---------------------------------------------------------------- clicks on the drawing
 function nearest(items, point, radius) {
   let best = null, bestD = radius / studio.view.scale;
@@ -265,12 +401,18 @@ function onClick(event) {
   if (!s || studio.dragged) return;
   const r = $("canvas").getBoundingClientRect();
   const p = toImage(event.clientX - r.left, event.clientY - r.top);
-  const crossings = s.graph.junctions.filter((j) => j.role === "crossing");
+  const crossings = s.graph.junctions.filter((j) => j.role === "crossing" || j.role === "triple");
   const tool = studio.tool;
   if (tool === "pairing" || tool === "split") {
-    const j = nearest(crossings, p, 16);
+    const j = nearest(crossings, p, 18);
     if (!j) return;
     if (tool === "split") return apply(withEdit({ kind: "split", at: j.at }, false));
+    if (j.role === "triple") {
+      // The next of the pairings that keep one stroke, in the order of their likelihood.
+      if (!j.options.length) return;
+      const k = j.options.findIndex((o) => samePasses(o.passes, j.passes));
+      return choosePasses(j, j.options[(k + 1) % j.options.length]);
+    }
     const next = PAIRINGS[(PAIRINGS.indexOf(j.decision) + 1) % 3];
     return apply(withEdit({ kind: "pairing", at: j.at, pairing: next }, true));
   }
@@ -280,13 +422,29 @@ function onClick(event) {
     return;
   }
   if (tool === "start") {
-    const ends = [];
+    // A stroke's end, or a free end the line passes (the tip of a stem drawn down and back
+    // up): starting there, the line retraces other branches instead.
+    const ends = (s.graph.ends || []).map((at) => ({ at }));
     for (const stroke of s.strokes) if (!stroke.closed) {
       ends.push({ at: stroke.points[0] }, { at: stroke.points[stroke.points.length - 1] });
     }
     const e = nearest(ends, p, 24);
     if (e) apply(withEdit({ kind: "start", at: e.at.slice(0, 2) }, false));
     return;
+  }
+  if (tool === "retrace") {
+    // On a stretch drawn twice: draw it once; elsewhere on the line: go back over it here
+    // (route inspection then retraces this branch rather than another).
+    const twice = (s.graph.retraces || []).flatMap((r) => r.points.map((q) => ({ at: q })));
+    const onBand = nearest(twice, p, 14);
+    const q = onBand || nearest(studio.line.pts.map((q) => ({ at: q })), p, 16);
+    if (!q) return;
+    const edit = { kind: onBand ? "once" : "twice", at: q.at.slice(0, 2) };
+    const edits = JSON.parse(JSON.stringify(currentEdits()));
+    edits.edits = edits.edits.filter((e) => !((e.kind === "twice" || e.kind === "once") &&
+                                              dist(e.at, edit.at) <= edits.tolerance));
+    edits.edits.push(edit);
+    return apply(edits);
   }
   if (tool === "reverse") {
     const points = studio.line.pts.map((q) => ({ at: q }));

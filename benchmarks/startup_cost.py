@@ -1,0 +1,184 @@
+#!/usr/bin/env python
+"""What a whole `onestroke vectorize IN.png -o OUT.svg` process spends, part by part.
+
+    python benchmarks/startup_cost.py              # the 9 drawings of `vectorize_bench.py --whole-process 9`
+    python benchmarks/startup_cost.py --count 5 --repeat 3
+
+For each drawing (rendered to a PNG, as `vectorize_bench.py --whole-process` does) this
+runs two kinds of fresh process, alternately:
+
+- the command itself, `onestroke vectorize IN.png -o OUT.svg`: its wall time, and its CPU
+  time (user + sys of the child, all its threads);
+- a process that does what the command does, step by step, and times each part with
+  `time.perf_counter` (wall) and `time.process_time` (CPU): the interpreter's own start
+  (CPU used before the first line runs; its wall share is the process's wall time less
+  the parts), the CLI's imports (click, the command's module), the vectorizer's imports
+  (numpy, scipy, scikit-image, shapely, PIL), the CNN's onnxruntime session (import and
+  session), reading the PNG, vectorizing it (the first call in the process), writing the
+  SVG; and then, for comparison, vectorizing the same image again (warm, as the in-process
+  benchmark measures it).
+
+The figures are medians over the runs. On a machine shared with other work the wall time
+includes waiting for a core; compare CPU time between versions (the load is printed).
+PYTHONDONTWRITEBYTECODE=1 in the environment makes every process compile the project's own
+modules from source (an installed package has them compiled); the line "bytecode" says
+which was measured, and --pycache DIR lets the children keep compiled modules in DIR.
+"""
+
+from __future__ import annotations
+
+import json
+import sys
+import time
+
+CHILD_FLAG = "--parts-child"
+
+
+def _parts_child(source: str, output: str) -> None:
+    """The command's work in the command's order, each part timed; prints one JSON line."""
+    marks = [("interpreter", 0.0, 0.0)]
+    wall0 = time.perf_counter()
+    marks[0] = ("interpreter", wall0, time.process_time())
+
+    def mark(name: str) -> None:
+        marks.append((name, time.perf_counter(), time.process_time()))
+
+    import importlib
+
+    importlib.import_module("fabrication.cli")
+    importlib.import_module("fabrication.cli.vectorize_cmd")
+    mark("CLI imports")
+    from vectorize import VectorizeOptions, vectorize_image
+    from vectorize.image_io import load_image
+    from vectorize.svg_write import write_drawing
+
+    importlib.import_module("vectorize.vectorizer")
+    mark("vectorizer imports")
+    from vectorize.classifiers import make_classifier
+
+    options = VectorizeOptions()
+    make_classifier(options.classifier).session  # noqa: B018 - onnxruntime import and session
+    mark("model session")
+    image, frame = load_image(source, max_size=options.max_size)
+    mark("read PNG")
+    result = vectorize_image(image, options, frame=frame)
+    mark("vectorize")
+    write_drawing(result.drawing, output)
+    mark("write SVG")
+    vectorize_image(image, options, frame=frame)
+    mark("vectorize again (warm)")
+    parts = {"interpreter": {"wall": None, "cpu": marks[0][2]}}
+    for (_, w0, c0), (name, w1, c1) in zip(marks, marks[1:]):
+        parts[name] = {"wall": w1 - w0, "cpu": c1 - c0}
+    print(json.dumps(parts))
+
+
+def _child_cpu() -> float:
+    import resource
+
+    usage = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return usage.ru_utime + usage.ru_stime
+
+
+def _timed(cmd: list[str], env: dict, timeout: float) -> tuple[float, float, str]:
+    """(wall s, CPU s of the child, stdout) of one process run to the end."""
+    import subprocess
+
+    cpu0, start = _child_cpu(), time.perf_counter()
+    proc = subprocess.run(cmd, capture_output=True, text=True, env=env, timeout=timeout)
+    wall, cpu = time.perf_counter() - start, _child_cpu() - cpu0
+    if proc.returncode != 0:
+        raise RuntimeError(f"{' '.join(cmd[:3])} ... exited {proc.returncode}: {proc.stderr.strip()[-300:]}")
+    return wall, cpu, proc.stdout
+
+
+def main(argv: list[str] | None = None) -> int:
+    import argparse
+    import os
+    import shutil
+    import statistics
+    import tempfile
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parents[1]
+    if str(root) not in sys.path:
+        sys.path.insert(0, str(root))
+    from PIL import Image
+
+    from benchmarks.render import render, to_uint8
+    from benchmarks.vectorize_bench import DEFAULT_COUNTS, SETS, build_set
+
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[1])
+    ap.add_argument("--count", type=int, default=9, help="drawings, picked across all sets as --whole-process picks")
+    ap.add_argument("--repeat", type=int, default=1, help="runs of each kind per drawing")
+    ap.add_argument("--seed", type=int, default=0)
+    ap.add_argument("--timeout", type=float, default=120.0)
+    ap.add_argument("--pycache", type=Path, default=None, metavar="DIR",
+                    help="let the children write and read compiled modules in DIR (PYTHONPYCACHEPREFIX), "
+                         "as an installed package has them; one unmeasured run first fills it")
+    args = ap.parse_args(argv)
+
+    tasks = [gt for name in SETS for gt in build_set(name, DEFAULT_COUNTS[name], args.seed)]
+    picks = tasks[:: max(1, len(tasks) // args.count)][: args.count]
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(root), os.environ.get("PYTHONPATH", "")]).rstrip(os.pathsep)}
+    if args.pycache is not None:
+        env.pop("PYTHONDONTWRITEBYTECODE", None)
+        env["PYTHONPYCACHEPREFIX"] = str(args.pycache.resolve())
+    exe = shutil.which("onestroke")
+    command = [exe] if exe else [sys.executable, "-m", "fabrication.cli"]
+    bytecode = ("not written (PYTHONDONTWRITEBYTECODE=1: the project's modules are compiled from source in "
+                "every process)" if env.get("PYTHONDONTWRITEBYTECODE") else
+                f"cached in {env.get('PYTHONPYCACHEPREFIX', 'the __pycache__ folders')}")
+
+    whole_wall, whole_cpu, parts = [], [], {}
+    with tempfile.TemporaryDirectory(prefix="onestroke-startup-") as tmp:
+        for gt in picks:
+            src, out = Path(tmp) / f"{gt.name}.png", Path(tmp) / f"{gt.name}.svg"
+            Image.fromarray(to_uint8(render(gt.drawing))).save(src)
+        if args.pycache is not None:  # fill the cache: not measured
+            _timed(command + ["vectorize", str(src), "-o", str(out)], env, args.timeout)
+        for _ in range(args.repeat):
+            for gt in picks:
+                src, out = Path(tmp) / f"{gt.name}.png", Path(tmp) / f"{gt.name}.svg"
+                wall, cpu, _ = _timed(command + ["vectorize", str(src), "-o", str(out)], env, args.timeout)
+                whole_wall.append(wall)
+                whole_cpu.append(cpu)
+                wall, cpu, stdout = _timed([sys.executable, __file__, CHILD_FLAG, str(src), str(out)], env,
+                                           args.timeout)
+                measured = json.loads(stdout.strip().splitlines()[-1])
+                inside = sum(p["wall"] for name, p in measured.items() if p["wall"] is not None)
+                measured["interpreter"]["wall"] = wall - inside
+                for name, p in measured.items():
+                    parts.setdefault(name, {"wall": [], "cpu": []})
+                    parts[name]["wall"].append(p["wall"])
+                    parts[name]["cpu"].append(p["cpu"])
+                warm = measured["vectorize again (warm)"]  # not part of what the command does
+                parts.setdefault("(process total)", {"wall": [], "cpu": []})
+                parts["(process total)"]["wall"].append(wall - warm["wall"])
+                parts["(process total)"]["cpu"].append(cpu - warm["cpu"])
+
+    load = " ".join(f"{x:.1f}" for x in os.getloadavg())
+    print(f"start-up cost of `onestroke vectorize IN.png -o OUT.svg`: {len(picks)} drawings x {args.repeat} runs, "
+          f"{os.cpu_count()} CPUs, load average {load}")
+    print(f"bytecode: {bytecode}")
+    print(f"the command:   wall median {statistics.median(whole_wall):.3f} s, max {max(whole_wall):.3f} s;  "
+          f"CPU (user+sys) median {statistics.median(whole_cpu):.3f} s")
+    print("its parts (a process doing the same steps), medians:")
+    print(f"  {'part':26s} {'wall s':>8s} {'CPU s':>8s}")
+    for name, values in parts.items():
+        if name == "(process total)" or name.startswith("vectorize again"):
+            continue
+        print(f"  {name:26s} {statistics.median(values['wall']):8.3f} {statistics.median(values['cpu']):8.3f}")
+    total = parts["(process total)"]
+    print(f"  {'(process total)':26s} {statistics.median(total['wall']):8.3f} {statistics.median(total['cpu']):8.3f}")
+    warm = parts["vectorize again (warm)"]
+    print(f"  {'vectorize again (warm)':26s} {statistics.median(warm['wall']):8.3f} {statistics.median(warm['cpu']):8.3f}"
+          "   (not in the total: the in-process figure, for comparison)")
+    return 0
+
+
+if __name__ == "__main__":
+    if len(sys.argv) == 4 and sys.argv[1] == CHILD_FLAG:
+        _parts_child(sys.argv[2], sys.argv[3])
+    else:
+        sys.exit(main())

@@ -1,0 +1,163 @@
+"""The studio on hand drawings of the benchmark's generators, in a real browser: a triple
+point (six branches, three passes) clicked through its pairings, picked from its list and
+split into two crossings; a cursive word whose stems are drawn down and back up, with two
+pen gaps (the stretches drawn twice and the bridged gaps shown; the line started at the
+tip of its lead-in; a stretch drawn twice made once); and the page's exports against the CLI's bytes with those edits.
+Screenshots go to test-artifacts/."""
+
+from __future__ import annotations
+
+import math
+
+import pytest
+
+from conftest import ARTIFACTS
+from fabrication.studio.server import StudioServer
+from fabrication.studio.session import StudioSession
+from studio_fixtures import bench_drawing, cli_bytes, click_at, download, open_page, settle
+
+pytestmark = pytest.mark.slow
+
+STATE = "window.studio.state"
+TRIPLE = f"{STATE}.graph.junctions.find(j => j.role === 'triple')"
+
+
+@pytest.fixture(scope="module")
+def served(tmp_path_factory, browser):
+    """name -> (page, drawing) for the two drawings, one studio server each."""
+    folder = tmp_path_factory.mktemp("studio-hand")
+    errors: list = []
+    opened, servers = {}, []
+    for which in ("triple", "little"):
+        drawing = bench_drawing(folder, which)
+        servers.append(StudioServer(StudioSession(drawing), port=0).start())
+        opened[which] = (open_page(browser, servers[-1].url, errors), drawing)
+    yield opened
+    for page, _ in opened.values():
+        page.context.close()
+    for server in servers:
+        server.stop()
+    assert not errors, errors
+
+
+def order(page):
+    return page.evaluate(f"{STATE}.strokes.map(s => s.points)")
+
+
+def test_a_triple_point_cycles_through_the_pairings_that_keep_one_stroke(served, tmp_path):
+    page, drawing = served["triple"]
+    triple = page.evaluate(TRIPLE)
+    # What was decided is on the page: three passes, the scorer's confidence, the choices.
+    assert triple["degree"] == 6 and len(triple["passes"]) == 3 and not triple["fixed"]
+    assert triple["confidence"] is not None and len(triple["options"]) >= 3
+    assert triple["options"][0]["passes"] == [list(p) for p in triple["passes"]]  # the likeliest is drawn
+    assert "three passes" in page.inner_text("#junctions")
+    page.screenshot(path=str(ARTIFACTS / "studio-hand-1-triple.png"))
+
+    # A click takes the next pairing in order of likelihood; the route, and with it the
+    # drawing order, changes; the line stays one stroke.
+    before = order(page)
+    seen = [triple["passes"]]
+    for click in (1, 2):
+        click_at(page, triple["at"])
+        settle(page, 1, f"{TRIPLE}.fixed && {STATE}.edits.edits.length === 1")
+        now = page.evaluate(TRIPLE)
+        assert [list(p) for p in now["passes"]] == triple["options"][click]["passes"]
+        assert page.evaluate(f"{STATE}.report.strokes") == 1 and not page.evaluate(f"{STATE}.report.warnings")
+        seen.append(now["passes"])
+        if click == 1:
+            assert order(page) != before
+            page.screenshot(path=str(ARTIFACTS / "studio-hand-2-triple-clicked.png"))
+    assert seen[0] != seen[1] != seen[2]
+    assert "fixed by you" in page.inner_text("#junctions")
+    # The list picks any of them: back to the first, fixed now, and the first order again.
+    page.select_option("#junctions select.passes", "0")
+    settle(page, 1, f"{TRIPLE}.fixed && JSON.stringify({TRIPLE}.passes) === '{_json(triple['passes'])}'")
+    assert order(page) == before
+
+    # Split: not three passes through one point but two crossings, each then cycled.
+    page.check("input[name=tool][value=split]")
+    click_at(page, triple["at"])
+    settle(page, 2, f"!{TRIPLE}")
+    assert page.evaluate(f"{STATE}.report.intersections") == 5 and page.evaluate(f"{STATE}.report.strokes") == 1
+    page.click("#undo")
+    settle(page, 1, f"!!{TRIPLE}")
+    page.check("input[name=tool][value=pairing]")
+    click_at(page, triple["at"])
+    settle(page, 1, f"JSON.stringify({TRIPLE}.passes) === '{_json(triple['options'][1]['passes'])}'")
+
+    # The exports are the CLI's bytes for the page's edits (kind "passes" in the file).
+    edits = page.evaluate(f"{STATE}.edits")
+    assert [e["kind"] for e in edits["edits"]] == ["passes"]
+    exports_match_the_cli(page, drawing, edits, tmp_path, "embroider", "pes",
+                          "--size", "90mm", "--hoop", "100x100", "--color", "#1f3a93")
+
+
+def test_a_cursive_word_shows_its_retraces_and_starts_at_a_stems_tip(served, tmp_path):
+    page, drawing = served["little"]
+    graph = page.evaluate(f"{STATE}.graph")
+    # The stretches drawn twice are data and on the page.
+    assert graph["retraces"] and all(r["length"] > 0 and len(r["points"]) >= 2 for r in graph["retraces"])
+    assert "drawn twice" in page.inner_text("#junctions")
+    # The two pen gaps were bridged: marked where they are.
+    assert len(graph["bridges"]) == 2 and "pen gaps bridged: 2" in page.inner_text("#junctions")
+    assert sorted(round(a[0], -2) for a, _ in graph["bridges"]) == [400, 700]
+    page.screenshot(path=str(ARTIFACTS / "studio-hand-3-retraces-gaps.png"))
+
+    # The line should start at the word's lead-in (the leftmost free end), which the route
+    # passes through, out and back: the start tool marks every free end, a click there
+    # starts the line there, and route inspection retraces a stem instead.
+    first, last = page.evaluate(f"[{STATE}.strokes[0].points[0], {STATE}.strokes[0].points.slice(-1)[0]]")
+    tip = min(graph["ends"])
+    assert math.dist(tip, first) > 50 and math.dist(tip, last) > 50
+    page.check("input[name=tool][value=start]")
+    click_at(page, tip)
+    settle(page, 1)
+    now = page.evaluate(f"{STATE}.strokes[0].points[0]")
+    assert math.dist(now, tip) < 3 and page.evaluate(f"{STATE}.report.strokes") == 1
+    retraced = page.evaluate(f"{STATE}.graph.retraces.map(r => r.at)")
+    assert sorted(retraced) != sorted(r["at"] for r in graph["retraces"])
+    assert not page.evaluate(f"{STATE}.report.warnings")
+    page.screenshot(path=str(ARTIFACTS / "studio-hand-4-start-at-tip.png"))
+
+    # The retrace tool on a stretch drawn twice: drawn once now, another one twice instead.
+    band = page.evaluate(f"{STATE}.graph.retraces.reduce((a, b) => a.length > b.length ? a : b)")
+    page.check("input[name=tool][value=retrace]")
+    click_at(page, band["at"])
+    settle(page, 2)
+    assert page.evaluate(f"{STATE}.edits.edits[1].kind") == "once"
+    after = page.evaluate(f"{STATE}.graph.retraces")
+    assert all(min(math.dist(p, band["at"]) for p in r["points"]) > 10 for r in after) and after
+    assert page.evaluate(f"{STATE}.report.strokes") == 1
+    page.screenshot(path=str(ARTIFACTS / "studio-hand-5-retrace-once.png"))
+    page.check("input[name=tool][value=pairing]")
+
+    # Reversed, the line ends there; the page's SVG and G-code are the CLI's bytes.
+    page.click("#reverse-all")
+    settle(page, 3)
+    assert math.dist(page.evaluate(f"{STATE}.strokes[0].points.slice(-1)[0]"), tip) < 3
+    edits = page.evaluate(f"{STATE}.edits")
+    exports_match_the_cli(page, drawing, edits, tmp_path, "laser", "gcode", "--size", "80mm", "--feed", "1500mm/min",
+                          "--power", "60%", "--passes", "1", "--origin", "lower-left")
+
+
+def exports_match_the_cli(page, drawing, edits, tmp_path, command: str, kind: str, *flags) -> None:
+    """The page's SVG, and its `kind` download from the `command` panel (the page's default
+    option values: `flags`), are the bytes the CLI writes with the same edits."""
+    _, svg = download(page, "[data-export=svg]")
+    assert svg == cli_bytes("vectorize", drawing, edits, tmp_path, ".svg")
+    # The panel's tab, and the text its preview shows once it is made.
+    tab, element, word = {"embroider": ("embroidery", "embroidery-stats", "stitches"),
+                          "laser": ("laser", "laser-time", "estimated")}[command]
+    page.click(f"nav .tab[data-tab={tab}]")
+    settle(page, extra=f"document.getElementById('{element}').textContent.includes('{word}')")
+    page.screenshot(path=str(ARTIFACTS / f"studio-hand-{tab}.png"))
+    _, data = download(page, f"[data-export={kind}]")
+    assert data == cli_bytes(command, drawing, edits, tmp_path, f".{kind}", *flags)
+    page.click("nav .tab[data-tab=refine]")
+
+
+def _json(passes) -> str:
+    import json
+
+    return json.dumps([list(p) for p in passes], separators=(",", ":"))

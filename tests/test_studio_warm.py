@@ -1,0 +1,86 @@
+"""The studio session's background work: the neighbouring slider values computed while
+idle give the answers of a fresh session, and a request stops that work."""
+
+from __future__ import annotations
+
+import os
+import threading
+from dataclasses import replace
+from pathlib import Path
+
+import pytest
+
+from fabrication.studio.session import StudioSession, Superseded
+from tests.conftest import alpha_loop, render_polylines
+from vectorize.edits import Edits
+
+
+@pytest.fixture(scope="module")
+def drawing(tmp_path_factory):
+    from PIL import Image
+
+    path = tmp_path_factory.mktemp("studio-warm") / "loop.png"
+    Image.fromarray(render_polylines([alpha_loop()])).save(path)
+    return path
+
+
+def test_neighbours_are_one_slider_step_away_in_the_direction_of_the_move(drawing):
+    session = StudioSession(drawing, edits_path=Path(os.devnull), classifier="geometric")
+    found = session.neighbours(Edits(threshold=0.45, blur=0.5), previous=Edits(threshold=0.46, blur=0.5))
+    assert [(e.threshold, e.blur) for e in found] == [(0.44, 0.5), (0.46, 0.5), (0.45, 0.75), (0.45, 0.25)]
+    # The automatic threshold has no slider position to step from; blur stays in 0..4.
+    assert [(e.threshold, e.blur) for e in session.neighbours(Edits())] == [(None, 0.25)]
+
+
+def test_warmed_neighbours_answer_from_the_cache_with_a_fresh_sessions_state(drawing):
+    session = StudioSession(drawing, edits_path=Path(os.devnull), classifier="geometric", precompute=True)
+    edits = Edits(threshold=0.45)
+    session.state(edits)
+    assert session.idle(120)
+    fronts = len(session.cache.front)
+    for neighbour in session.neighbours(edits):
+        warmed = session.state(neighbour)
+        fresh = StudioSession(drawing, edits_path=Path(os.devnull), classifier="geometric").state(neighbour)
+        for state in (warmed, fresh):
+            state["report"].pop("seconds")  # how long this answer took: ~0 from the cache
+        assert warmed == fresh, neighbour
+        assert session.idle(120)
+    # Each neighbour was computed once, in the background (then theirs were warmed too).
+    assert fronts == 1 + len(session.neighbours(edits))
+
+
+def test_a_request_stops_background_work_between_stages(drawing):
+    session = StudioSession(drawing, edits_path=Path(os.devnull), classifier="geometric")
+    started, release = threading.Event(), threading.Event()
+    checks = []
+
+    def slow_check():
+        checks.append(1)
+        if len(checks) == 2:  # the first stage boundary (after binarization) comes late
+            started.set()
+            release.wait(30)
+        return False
+
+    generation = session._generation
+    errors = []
+
+    def background():
+        try:
+            session.vectorize(Edits(threshold=0.41), generation=generation, superseded=slow_check)
+        except Superseded as error:
+            errors.append(error)
+
+    worker = threading.Thread(target=background)
+    worker.start()
+    assert started.wait(60)
+    answer = {}
+    request = threading.Thread(target=lambda: answer.update(state=session.state(Edits(threshold=0.47))))
+    request.start()
+    while session._generation == generation:
+        threading.Event().wait(0.01)
+    release.set()
+    worker.join(60)
+    request.join(120)
+    assert errors and len(checks) == 2  # stopped at the first stage boundary after the request
+    assert answer["state"]["settings"]["threshold"] == 0.47
+    assert not any(key[0] == 0.41 for key in session.cache.front)
