@@ -106,20 +106,22 @@ def bridge_gaps(graph: MedialGraph, *, stroke_width: float, made: list | None = 
         if made is not None:
             made.append((tuple(map(float, position[a])), tuple(map(float, position[b]))))
         bridges += 1
-    bridges += _bridge_to_lines(graph, stroke_width, heading, piece, root)
+    bridges += _bridge_to_lines(graph, stroke_width, heading, piece, root, made)
     if bridges:
         graph.dissolve_degree_two()
     return bridges
 
 
-def _bridge_to_lines(graph: MedialGraph, stroke_width: float, heading: dict, piece: dict, root: dict) -> int:
+def _bridge_to_lines(graph: MedialGraph, stroke_width: float, heading: dict, piece: dict, root: dict,
+                     made: list | None = None) -> int:
     """Join free ends of pieces that are still apart to the nearest centre-line point of
     another piece that each points at (within `BRIDGE_WIDTHS` and `BRIDGE_ANGLE`) where that
     line turns with its outside to the end (`_faces`), cheapest first, splitting the branch
     there; returns the bridges made.
 
     Pieces with less centre line than `BRIDGE_WIDTHS` widths (dust, a dot) are not joined.
-    piece: node -> piece index; root: the union-find over pieces of the end-to-end bridges."""
+    piece: node -> piece index; root: the union-find over pieces of the end-to-end bridges;
+    made: as in `bridge_gaps`."""
 
     def find(p: int) -> int:
         while root[p] != p:
@@ -169,6 +171,8 @@ def _bridge_to_lines(graph: MedialGraph, stroke_width: float, heading: dict, pie
         pts = np.linspace(graph.positions[end], graph.positions[target], count)
         radii = np.linspace(graph.radii[end], graph.radii[target], count)
         graph.add_branch(Branch(end, target, pts, radii, np.ones(count - 1)))
+        if made is not None:
+            made.append((tuple(map(float, graph.positions[end])), tuple(map(float, graph.positions[target]))))
         bridges += 1
     return bridges
 
