@@ -73,20 +73,29 @@ def _parts_child(source: str, output: str) -> None:
     print(json.dumps(parts))
 
 
-def _child_cpu() -> float:
+def child_cpu_seconds() -> float:
+    """User + sys seconds of this process's finished children so far (all their threads)."""
     import resource
 
     usage = resource.getrusage(resource.RUSAGE_CHILDREN)
     return usage.ru_utime + usage.ru_stime
 
 
+def bytecode_note(env) -> str:
+    """Whether processes with environment `env` keep the project's compiled modules."""
+    if env.get("PYTHONDONTWRITEBYTECODE"):
+        return ("not written (PYTHONDONTWRITEBYTECODE is set: each process compiles the project's own modules "
+                "from source; an installed package has them compiled)")
+    return f"cached in {env.get('PYTHONPYCACHEPREFIX') or 'the __pycache__ folders'}"
+
+
 def _timed(cmd: list[str], env: dict, timeout: float) -> tuple[float, float, str]:
     """(wall s, CPU s of the child, stdout) of one process run to the end."""
     import subprocess
 
-    cpu0, start = _child_cpu(), time.perf_counter()
+    cpu0, start = child_cpu_seconds(), time.perf_counter()
     proc = subprocess.run(cmd, capture_output=True, text=True, env=env, timeout=timeout)
-    wall, cpu = time.perf_counter() - start, _child_cpu() - cpu0
+    wall, cpu = time.perf_counter() - start, child_cpu_seconds() - cpu0
     if proc.returncode != 0:
         raise RuntimeError(f"{' '.join(cmd[:3])} ... exited {proc.returncode}: {proc.stderr.strip()[-300:]}")
     return wall, cpu, proc.stdout
@@ -126,9 +135,6 @@ def main(argv: list[str] | None = None) -> int:
         env["PYTHONPYCACHEPREFIX"] = str(args.pycache.resolve())
     exe = shutil.which("onestroke")
     command = [exe] if exe else [sys.executable, "-m", "fabrication.cli"]
-    bytecode = ("not written (PYTHONDONTWRITEBYTECODE=1: the project's modules are compiled from source in "
-                "every process)" if env.get("PYTHONDONTWRITEBYTECODE") else
-                f"cached in {env.get('PYTHONPYCACHEPREFIX', 'the __pycache__ folders')}")
 
     whole_wall, whole_cpu, parts = [], [], {}
     with tempfile.TemporaryDirectory(prefix="onestroke-startup-") as tmp:
@@ -160,7 +166,7 @@ def main(argv: list[str] | None = None) -> int:
     load = " ".join(f"{x:.1f}" for x in os.getloadavg())
     print(f"start-up cost of `onestroke vectorize IN.png -o OUT.svg`: {len(picks)} drawings x {args.repeat} runs, "
           f"{os.cpu_count()} CPUs, load average {load}")
-    print(f"bytecode: {bytecode}")
+    print(f"bytecode: {bytecode_note(env)}")
     print(f"the command:   wall median {statistics.median(whole_wall):.3f} s, max {max(whole_wall):.3f} s;  "
           f"CPU (user+sys) median {statistics.median(whole_cpu):.3f} s")
     print("its parts (a process doing the same steps), medians:")
