@@ -2,7 +2,7 @@
 point (six branches, three passes) clicked through its pairings, picked from its list and
 split into two crossings; a cursive word whose stems are drawn down and back up, with two
 pen gaps (the stretches drawn twice and the bridged gaps shown; the line started at the
-tip of its lead-in); and the page's exports against the CLI's bytes with those edits.
+tip of its lead-in; a stretch drawn twice made once); and the page's exports against the CLI's bytes with those edits.
 Screenshots go to test-artifacts/."""
 
 from __future__ import annotations
@@ -119,11 +119,22 @@ def test_a_cursive_word_shows_its_retraces_and_starts_at_a_stems_tip(served, tmp
     assert sorted(retraced) != sorted(r["at"] for r in graph["retraces"])
     assert not page.evaluate(f"{STATE}.report.warnings")
     page.screenshot(path=str(ARTIFACTS / "studio-hand-4-start-at-tip.png"))
+
+    # The retrace tool on a stretch drawn twice: drawn once now, another one twice instead.
+    band = page.evaluate(f"{STATE}.graph.retraces.reduce((a, b) => a.length > b.length ? a : b)")
+    page.check("input[name=tool][value=retrace]")
+    click_at(page, band["at"])
+    settle(page, 2)
+    assert page.evaluate(f"{STATE}.edits.edits[1].kind") == "once"
+    after = page.evaluate(f"{STATE}.graph.retraces")
+    assert all(min(math.dist(p, band["at"]) for p in r["points"]) > 10 for r in after) and after
+    assert page.evaluate(f"{STATE}.report.strokes") == 1
+    page.screenshot(path=str(ARTIFACTS / "studio-hand-5-retrace-once.png"))
     page.check("input[name=tool][value=pairing]")
 
     # Reversed, the line ends there; the page's SVG and G-code are the CLI's bytes.
     page.click("#reverse-all")
-    settle(page, 2)
+    settle(page, 3)
     assert math.dist(page.evaluate(f"{STATE}.strokes[0].points.slice(-1)[0]"), tip) < 3
     edits = page.evaluate(f"{STATE}.edits")
     exports_match_the_cli(page, drawing, edits, tmp_path, "laser", "gcode", "--size", "80mm", "--feed", "1500mm/min",

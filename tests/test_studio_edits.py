@@ -35,6 +35,7 @@ def test_edits_json_round_trip():
     edits = Edits(threshold=0.4, blur=1.5, multi=False, tolerance=5.0,
                   items=(Edit(kind="pairing", at=(10.5, 20.25), pairing="third"), Edit(kind="split", at=(1, 2)),
                          Edit(kind="merge", at=(3, 4)), Edit(kind="reverse", at=(5, 6)), Edit(kind="start", at=(7, 8)),
+                         Edit(kind="twice", at=(11, 12)), Edit(kind="once", at=(13, 14)),
                          Edit(kind="passes", at=(9, 10), passes=((10.5, 190.5), (70, 250), (130, 310)))))
     again = edits_from_json(edits.to_json())
     assert again == edits

@@ -85,3 +85,14 @@ def test_chains_become_branches_and_a_closed_chain_is_one_loop():
     assert found == [(0.0, [0, 1, 2], [0.0, 0.1]), (0.0, [0, 4, 5, 6], [0.3, 0.4, 0.5]), (0.0, [0, 3], [0.2]),
                      (8.0, [8, 7, 11, 10, 9, 8], [0.6, 1.0, 0.9, 0.8, 0.7])]
     assert [graph.degree(n) for n in graph.incident] == [3, 1, 1, 1, 2]
+
+
+def test_an_axis_of_closed_chains_only_is_one_loop_each():
+    """A clean ring's axis has no junction and no end: one node and one loop branch."""
+    from vectorize.medial_axis import _collapse_chains
+
+    edges = np.array([[0, 1], [1, 2], [2, 3], [3, 0], [5, 4], [6, 5], [4, 6]])
+    xy = np.column_stack([np.arange(7.0), np.zeros(7)])
+    graph = _collapse_chains(xy, np.ones(7), edges, np.ones(len(edges)))
+    assert [b.points[:, 0].tolist() for b in graph.branches.values()] == [[0, 1, 2, 3, 0], [5, 4, 6, 5]]
+    assert [graph.degree(n) for n in graph.incident] == [2, 2]

@@ -18,7 +18,10 @@ Kinds, and the stage each one re-runs from:
 - `reverse` (the stroke through the position runs the other way): after fitting;
   `start` (the stroke with an end at the position starts there, and comes first; in
   single-line mode a free end the line passes, the tip of a stroke drawn out and back,
-  becomes an end of the route, which then retraces other branches): from traversal.
+  becomes an end of the route, which then retraces other branches): from traversal;
+- `twice` / `once` (single-line mode: the branch at the position is, or is not, where the
+  line goes back over itself when it must retrace something: route inspection then
+  prefers, or avoids, retracing it): from traversal.
 """
 
 from __future__ import annotations
@@ -31,7 +34,7 @@ from onestroke.errors import InputError
 
 FORMAT = "onestroke-edits"
 PAIRINGS = ("crossing", "touching", "third")
-KINDS = ("pairing", "passes", "split", "merge", "reverse", "start")
+KINDS = ("pairing", "passes", "split", "merge", "reverse", "start", "twice", "once")
 # Default match radius in output px: a click lands within a few pixels of a marker.
 TOLERANCE = 8.0
 

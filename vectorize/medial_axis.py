@@ -153,7 +153,7 @@ def _collapse_chains(xy: np.ndarray, radius: np.ndarray, edges: np.ndarray, sins
     # Half-edges of closed chains never reach a start (a half-edge leaving a node).
     opened = degree[source[head]] != 2
     last = np.flatnonzero(opened & (succ < 0))
-    end_of = np.empty(halves, dtype=np.int64)
+    end_of = np.zeros(halves, dtype=np.int64)  # (read for closed chains too, then masked)
     end_of[head[last]] = last
     # Each chain was walked from the end whose half-edge comes first in CSR order.
     walked = opened & (head < reverse[end_of[head]])
@@ -166,7 +166,7 @@ def _collapse_chains(xy: np.ndarray, radius: np.ndarray, edges: np.ndarray, sins
     chain = np.flatnonzero(walked)
     chain = chain[np.lexsort((rank[chain], head[chain]))]
     cuts = np.flatnonzero(np.diff(head[chain])) + 1
-    firsts = np.concatenate([[0], cuts]).tolist()
+    firsts = np.concatenate([[0], cuts]).tolist() if len(chain) else []  # no chain: all closed
     stops = np.concatenate([cuts, [len(chain)]]).tolist()
     path_all = target[chain]
     edges_all = edge_of[chain]

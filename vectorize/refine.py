@@ -21,13 +21,17 @@ from vectorize.intersections import crossing_pairing, touching_pairings
 from vectorize.pass_choices import as_angles, chance_of, foot_angles, normal, pass_options, slots_of
 from vectorize.simplify import _merge, directions
 
-# Cached entries per stage: a session goes back and forth between a few states (undo).
-KEEP = 12
+# Route inspection's factor on a branch's length where the user said the line goes back
+# over it ("twice": nearly free) or does not ("once": only if nothing else joins the ends).
+RETRACE_WEIGHT = {"twice": 1e-3, "once": 1e4}
+# Cached entries per stage: a session goes back and forth between a few states (undo), and
+# the studio adds the four neighbouring slider values of each state it answers.
+KEEP = 20
 
 
 # Entries of the image-sized stages (a working gray image, an ink image, ~4 MB each at
-# 1000 px): the last few slider positions.
-KEEP_IMAGES = 6
+# 1000 px): the last few slider positions and their neighbours.
+KEEP_IMAGES = 8
 
 
 class StageCache:
@@ -245,7 +249,8 @@ class Refinement:
     # -- traversal and fitting -------------------------------------------------------
     def _solved_key(self) -> tuple:
         pairings = tuple((e.at, e.pairing, e.passes) for e in self.edits.of("pairing", "passes"))
-        return (self.simplify_key(-1), pairings, self._start())
+        retraces = tuple((e.kind, e.at) for e in self.edits.of("twice", "once"))
+        return (self.simplify_key(-1), pairings, self._start(), retraces)
 
     def _start(self):
         """The last start edit's position: where the line begins (it may change the route)."""
@@ -264,6 +269,18 @@ class Refinement:
         # Far below any retraced length: the matching leaves this node unpaired.
         return {ends[k]: -1e9} if dist[k] <= self.tol + self.w else {}
 
+    def route_weights(self, graph) -> dict:
+        """branch id -> factor on its length for route inspection: small where the user wants
+        the line to go back over a branch ("twice"), large where not ("once"); the last edit
+        on a branch wins."""
+        weights = {}
+        for edit in self.edits.of("twice", "once"):
+            found = _nearest_branch(graph, self.to_working(edit.at), self.tol + self.w)
+            if found is not None:
+                weights[found] = RETRACE_WEIGHT[edit.kind]
+                self.hits.add(self._index[id(edit)])
+        return weights
+
     def solved(self):
         """(best solution, fitted working strokes) of an earlier run with the same edits up to
         traversal, or None."""
@@ -276,7 +293,8 @@ class Refinement:
         return best, strokes
 
     def keep_solved(self, best, strokes) -> None:
-        early = {self._index[id(e)] for e in self.edits.of("split", "merge", "pairing", "passes")} & self.hits
+        early = {self._index[id(e)] for e in self.edits.of("split", "merge", "pairing", "passes", "twice", "once")}
+        early &= self.hits
         _bounded_put(self.cache.solved, self._solved_key(), (best, tuple(strokes), frozenset(early), dict(self.fixed)))
 
     def fix_passes(self, graph, simple):
@@ -339,6 +357,18 @@ class Refinement:
             self.hits.add(self._index[id(edit)])
         return drawing.with_strokes(strokes)
 
+    def unheeded(self, solution) -> list[str]:
+        """One warning per "once" edit whose branch the line still draws twice (every other
+        way to join the ends that retrace joins is marked "once" too, or there is none)."""
+        count = _pass_counts(solution)
+        result = []
+        for edit in self.edits.of("once"):
+            bid = _nearest_branch(solution.graph, self.to_working(edit.at), self.tol + self.w)
+            if bid is not None and count.get(bid, 0) > 1:
+                result.append(f"the stretch at {edit.at[0]:.0f}, {edit.at[1]:.0f} is still drawn twice: "
+                              "one line over the drawing found no way around it")
+        return result
+
     def unmatched(self) -> list[str]:
         """One warning per edit that found nothing to act on."""
         return [f"edit {i + 1} ({e.kind} at {e.at[0]:.0f}, {e.at[1]:.0f}) matched nothing within "
@@ -377,10 +407,7 @@ class Refinement:
 
     def _retraces(self, solution) -> tuple[dict, ...]:
         graph = solution.graph
-        count: dict[int, int] = {}
-        for passes in solution.ordering.strokes:
-            for step in passes:
-                count[step.branch] = count.get(step.branch, 0) + 1
+        count = _pass_counts(solution)
         result = []
         for bid in sorted(b for b, n in count.items() if n > 1):
             points = graph.branches[bid].points
@@ -403,6 +430,25 @@ class Refinement:
                             decision="passes", confidence=chance_of(drawn, simple.through_posterior.get(node)),
                             fixed=node in self.fixed, merged=True, passes=tuple(map(tuple, as_angles(drawn, angles))),
                             options=tuple({"passes": as_angles(p, angles), "p": q} for p, q in options))
+
+
+def _pass_counts(solution) -> dict[int, int]:
+    """branch id -> how many times the solution's strokes pass it."""
+    count: dict[int, int] = {}
+    for passes in solution.ordering.strokes:
+        for step in passes:
+            count[step.branch] = count.get(step.branch, 0) + 1
+    return count
+
+
+def _nearest_branch(graph, point: np.ndarray, tol: float) -> int | None:
+    """The id of the branch passing nearest `point`, if within tol."""
+    best = None
+    for bid, branch in graph.branches.items():
+        d = float(np.min(np.linalg.norm(branch.points - point, axis=1)))
+        if d <= tol and (best is None or d < best[0]):
+            best = (d, bid)
+    return None if best is None else best[1]
 
 
 def _nearest_mergeable(graph, point: np.ndarray, tol: float):

@@ -292,14 +292,16 @@ def _fleury(multi: _Multigraph, start: int, first_slot: int | None, turn) -> lis
 
 
 def plan_routes(graph: MedialGraph, pairings: dict, *, stroke_width: float, directions: dict,
-                end_cost: dict[int, float] | None = None) -> list[Route]:
+                end_cost: dict[int, float] | None = None, weight: dict[int, float] | None = None) -> list[Route]:
     """One stroke per piece of the graph over all its branches, retracing as little as it can.
 
     pairings: node -> slot pairs of its through-paths (decided junctions); directions: node
     -> (D, 2) unit tangents per slot, leaving the node (for junctions of degree >= 3);
     end_cost: px added when the pen starts or ends at a node (default 0): makes some nodes,
-    such as the tip of a sharp corner's spur, poor places to start. A graph that is one
-    piece under the pairings (see `connect_pairings`) gives exactly one route.
+    such as the tip of a sharp corner's spur, poor places to start. weight: branch id ->
+    factor on its length when retraces are chosen (default 1; a user's "draw this twice"
+    makes it small, "once" large). A graph that is one piece under the pairings (see
+    `connect_pairings`) gives exactly one route.
     """
     chain_list = chains(graph, pairings)
     nodes = sorted({c.u for c in chain_list if c.u >= 0} | {c.v for c in chain_list if c.v >= 0})
@@ -311,14 +313,18 @@ def plan_routes(graph: MedialGraph, pairings: dict, *, stroke_width: float, dire
     groups: dict[int, list[Chain]] = {}
     for c in open_chains:
         groups.setdefault(int(label[where[c.u]]), []).append(c)
-    routes = [_route(graph, group, stroke_width, directions, end_cost or {}) for _, group in sorted(groups.items())]
+    routes = [_route(graph, group, stroke_width, directions, end_cost or {}, weight or {})
+              for _, group in sorted(groups.items())]
     routes += [Route(c.passes, True, 0.0) for c in chain_list if c.u < 0]
     return routes
 
 
 def _route(graph: MedialGraph, chain_list: list[Chain], stroke_width: float, directions: dict,
-           end_cost: dict[int, float]) -> Route:
+           end_cost: dict[int, float], weight: dict[int, float]) -> Route:
     """The route over one connected piece of chains (none of them closed on its own)."""
+    # What retracing each chain costs: its length, with the branches' weights.
+    cost_of = [c.length if not weight else sum(graph.branches[p.branch].length * weight.get(p.branch, 1.0)
+                                               for p in c.passes) for c in chain_list]
     nodes = sorted({c.u for c in chain_list if c.u >= 0} | {c.v for c in chain_list if c.v >= 0})
     where = {n: i for i, n in enumerate(nodes)}
     degree = np.zeros(len(nodes), dtype=int)
@@ -348,7 +354,7 @@ def _route(graph: MedialGraph, chain_list: list[Chain], stroke_width: float, dir
         if c.u < 0 or c.u == c.v:
             continue
         key = (min(where[c.u], where[c.v]), max(where[c.u], where[c.v]))
-        if key not in best_chain or c.length < chain_list[best_chain[key]].length:
+        if key not in best_chain or cost_of[k] < cost_of[best_chain[key]]:
             best_chain[key] = k
     odd = [i for i in range(len(nodes)) if degree[i] % 2]
     pairs_out: list[tuple[int, int]] = []
@@ -356,7 +362,7 @@ def _route(graph: MedialGraph, chain_list: list[Chain], stroke_width: float, dir
     paths: list[list[int]] = []
     if odd:
         keys = list(best_chain)
-        weights = [max(chain_list[best_chain[k]].length, 1e-6) for k in keys]
+        weights = [max(cost_of[best_chain[k]], 1e-6) for k in keys]
         rows = [k[0] for k in keys]
         cols = [k[1] for k in keys]
         matrix = coo_matrix((weights, (rows, cols)), shape=(len(nodes), len(nodes))).tocsr()

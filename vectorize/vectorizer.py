@@ -255,7 +255,8 @@ def _order(graph: MedialGraph, ink, options: VectorizeOptions, ends: int, clock:
         ordering, tried = order_strokes(graph, simple, ranked, costs, stroke_width=w)
     else:
         ordering, tried = _single_route(graph, simple, ranked, costs, w,
-                                        refine.start_ends(graph) if refine is not None else None)
+                                        refine.start_ends(graph) if refine is not None else None,
+                                        refine.route_weights(graph) if refine is not None else None)
     clock.lap("traversal")
     return _Solution(graph, simple, junctions, verdicts, ordering, tried)
 
@@ -281,9 +282,10 @@ def _junction_end_cost(graph: MedialGraph, node: int, dirs: np.ndarray, w: float
 
 
 def _single_route(graph: MedialGraph, simple: Simplified, ranked: dict, costs: dict,
-                  w: float, start_at: dict | None = None) -> tuple[Ordering, int]:
+                  w: float, start_at: dict | None = None, weight: dict | None = None) -> tuple[Ordering, int]:
     """Single-line mode: one stroke over the whole (connected) graph, retracing the least.
-    start_at: node -> end cost (px) that overrides the rule (a user's start edit)."""
+    start_at: node -> end cost (px) that overrides the rule (a user's start edit); weight:
+    branch id -> factor on its retrace cost (a user's twice / once edits)."""
     pairing, tried = connect_pairings(graph, ranked, costs, fixed=simple.through)
     dirs = {n: directions(graph, n, 2.5 * w) for n in graph.incident if graph.degree(n) >= 3}
     # The tip of a sharp corner's spur is not where a pen starts; a junction is a poorer
@@ -293,7 +295,8 @@ def _single_route(graph: MedialGraph, simple: Simplified, ranked: dict, costs: d
     end_cost = {n: 3.0 * w for n in v_tips}
     end_cost.update({n: _junction_end_cost(graph, n, dirs[n], w) for n in dirs})
     end_cost.update(start_at or {})
-    routes = plan_routes(graph, {**simple.through, **pairing}, stroke_width=w, directions=dirs, end_cost=end_cost)
+    routes = plan_routes(graph, {**simple.through, **pairing}, stroke_width=w, directions=dirs, end_cost=end_cost,
+                         weight=weight)
     choice = tuple(pairing.get(n, ranked[n][0]) for n in simple.crossings)
     return Ordering(tuple(r.passes for r in routes), tuple(r.closed for r in routes), choice), tried
 
@@ -439,7 +442,7 @@ def run_pipeline(image: np.ndarray, options: VectorizeOptions, *,
         warnings.append(f"{len(simple.unresolved)} junction(s) where three or more strokes seem to meet:"
                         " they are not resolved and the order there may be wrong")
     if refine is not None:
-        warnings.extend(refine.unmatched())
+        warnings.extend(refine.unmatched() + refine.unheeded(best))
     if not options.multi and len(strokes) > 1:
         warnings.append(f"the line could not be followed in one stroke: {len(strokes)} strokes")
     report = VectorizeReport(

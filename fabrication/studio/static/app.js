@@ -129,6 +129,7 @@ function draw() {
   }
   const g = c.getContext("2d");
   g.setTransform(dpr, 0, 0, dpr, 0, 0);
+  studio.labels = [];  // the markers' texts, drawn after every marker
   g.clearRect(0, 0, c.clientWidth, c.clientHeight);
   if (!s) return;
   const v = studio.view;
@@ -155,6 +156,7 @@ function draw() {
   arrows(g, t);
   junctionMarkers(g);
   bridges(g);
+  placeLabels(g);
   // Start markers: where each stroke begins (over a junction the line starts at).
   s.strokes.forEach((stroke, k) => {
     const [x, y] = toScreen(...stroke.points[0]);
@@ -208,7 +210,7 @@ function bridges(g) {
     g.strokeStyle = COLORS.gap; g.lineWidth = 2; g.setLineDash([4, 3]);
     g.beginPath(); g.arc((ax + bx) / 2, (ay + by) / 2, r, 0, 2 * Math.PI); g.stroke();
     g.setLineDash([]);
-    label(g, "gap", (ax + bx) / 2 + r + 3, (ay + by) / 2);
+    label(g, "gap", (ax + bx) / 2, (ay + by) / 2, r + 3);
   }
   g.restore();
 }
@@ -231,14 +233,29 @@ function tripleMarker(g, j) {
   });
   const k = j.options.findIndex((o) => samePasses(o.passes, j.passes));
   label(g, `3 passes${j.confidence === null ? " (straightest)" : percent(j.confidence)} · ${k + 1}/${j.options.length}`,
-    x + r + 6, y);
+    x, y, r + 6);
 }
 
-// A marker's text, on a white halo so that it reads over the curve.
-function label(g, text, x, y) {
+// A marker's text, beside the marker at (x, y) of radius `gap`; drawn by `placeLabels`
+// once every marker is drawn.
+function label(g, text, x, y, gap) { studio.labels.push({ text, x, y, gap }); }
+
+// Each text on a white halo so that it reads over the curve, right of its marker, else
+// left, below or above, wherever it covers no marker and no text placed before (junctions
+// a few px apart would print over each other).
+function placeLabels(g) {
   g.font = "11px sans-serif"; g.textAlign = "left"; g.textBaseline = "middle";
-  g.strokeStyle = "rgba(255,255,255,0.9)"; g.lineWidth = 3; g.lineJoin = "round"; g.strokeText(text, x, y);
-  g.fillStyle = "#222"; g.fillText(text, x, y);
+  const boxes = studio.labels.map(({ x, y, gap }) => [x - gap, y - gap, 2 * gap, 2 * gap]);
+  const h = 13;
+  for (const { text, x, y, gap } of studio.labels) {
+    const w = g.measureText(text).width;
+    const spots = [[x + gap, y], [x - gap - w, y], [x - w / 2, y + gap + h / 2], [x - w / 2, y - gap - h / 2]];
+    const covers = (sx, sy, b) => sx < b[0] + b[2] && b[0] < sx + w && sy - h / 2 < b[1] + b[3] && b[1] < sy + h / 2;
+    const [lx, ly] = spots.find(([sx, sy]) => !boxes.some((b) => covers(sx, sy, b))) || spots[0];
+    boxes.push([lx, ly - h / 2, w, h]);
+    g.strokeStyle = "rgba(255,255,255,0.9)"; g.lineWidth = 3; g.lineJoin = "round"; g.strokeText(text, lx, ly);
+    g.fillStyle = "#222"; g.fillText(text, lx, ly);
+  }
 }
 
 function samePasses(a, b) { return JSON.stringify(a) === JSON.stringify(b); }
@@ -268,7 +285,7 @@ function junctionMarkers(g) {
       const open = j.role === "unresolved";
       g.strokeStyle = open ? COLORS.gap : COLORS.other; g.lineWidth = 2;
       g.beginPath(); g.arc(x, y, open ? 8 : 5, 0, 2 * Math.PI); g.stroke();
-      if (open) label(g, "unresolved ?", x + 11, y);
+      if (open) label(g, "unresolved ?", x, y, 11);
       continue;
     }
     const color = COLORS[j.decision] || COLORS.other;
@@ -279,7 +296,7 @@ function junctionMarkers(g) {
     // Confidence as the filled share of an inner disc.
     g.fillStyle = color; g.beginPath(); g.moveTo(x, y);
     g.arc(x, y, 6, -Math.PI / 2, -Math.PI / 2 + 2 * Math.PI * (j.confidence || 0)); g.closePath(); g.fill();
-    label(g, `${j.decision} ${Math.round(100 * (j.confidence || 0))}%`, x + 12, y);
+    label(g, `${j.decision} ${Math.round(100 * (j.confidence || 0))}%`, x, y, 12);
   }
 }
 
@@ -414,6 +431,20 @@ function onClick(event) {
     const e = nearest(ends, p, 24);
     if (e) apply(withEdit({ kind: "start", at: e.at.slice(0, 2) }, false));
     return;
+  }
+  if (tool === "retrace") {
+    // On a stretch drawn twice: draw it once; elsewhere on the line: go back over it here
+    // (route inspection then retraces this branch rather than another).
+    const twice = (s.graph.retraces || []).flatMap((r) => r.points.map((q) => ({ at: q })));
+    const onBand = nearest(twice, p, 14);
+    const q = onBand || nearest(studio.line.pts.map((q) => ({ at: q })), p, 16);
+    if (!q) return;
+    const edit = { kind: onBand ? "once" : "twice", at: q.at.slice(0, 2) };
+    const edits = JSON.parse(JSON.stringify(currentEdits()));
+    edits.edits = edits.edits.filter((e) => !((e.kind === "twice" || e.kind === "once") &&
+                                              dist(e.at, edit.at) <= edits.tolerance));
+    edits.edits.push(edit);
+    return apply(edits);
   }
   if (tool === "reverse") {
     const points = studio.line.pts.map((q) => ({ at: q }));

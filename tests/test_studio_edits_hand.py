@@ -1,0 +1,73 @@
+"""The edits the hand drawings need, through the library (no browser): every pairing the
+page offers at a triple point keeps the line one stroke and is drawn as chosen; the
+session's cached answers to a triple point split and a crossing then paired, and to a merge
+and a "twice" on the cursive word, are a fresh run's bytes (the browser test compares
+passes, start, once and reverse with the CLI)."""
+
+from __future__ import annotations
+
+import pytest
+
+from studio_fixtures import bench_drawing
+from vectorize import VectorizeOptions, vectorize_file
+from vectorize.edits import Edit, Edits
+from vectorize.refine import StageCache
+from vectorize.svg_write import drawing_to_svg
+
+pytestmark = pytest.mark.slow
+
+
+@pytest.fixture(scope="module")
+def drawings(tmp_path_factory):
+    folder = tmp_path_factory.mktemp("hand-edits")
+    return {which: bench_drawing(folder, which) for which in ("triple", "little")}
+
+
+def test_every_offered_triple_pairing_is_one_stroke_drawn_as_chosen(drawings):
+    path, cache = drawings["triple"], StageCache()
+    base = vectorize_file(path, VectorizeOptions(), edits=Edits(), cache=cache)
+    (triple,) = [j for j in base.graph.junctions if j.role == "triple"]
+    assert len(triple.options) >= 3 and triple.options[0]["passes"] == [list(p) for p in triple.passes]
+    for option in triple.options:
+        result = vectorize_file(path, VectorizeOptions(), cache=cache,
+                                edits=Edits(items=(Edit(kind="passes", at=triple.at, passes=option["passes"]),)))
+        (now,) = [j for j in result.graph.junctions if j.role == "triple"]
+        assert result.report.strokes == 1 and not result.report.warnings
+        assert [list(p) for p in now.passes] == option["passes"] and now.fixed
+
+
+def test_cached_answers_are_a_fresh_runs_bytes(drawings):
+    for which, edits_of in (("triple", _triple_edits), ("little", _little_edits)):
+        path, cache = drawings[which], StageCache()
+        base = vectorize_file(path, VectorizeOptions(), edits=Edits(), cache=cache)
+        for items in edits_of(base):
+            edits = Edits(items=tuple(items))
+            cached = vectorize_file(path, VectorizeOptions(), edits=edits, cache=cache)
+            fresh = vectorize_file(path, VectorizeOptions(), edits=edits)
+            assert drawing_to_svg(cached.drawing) == drawing_to_svg(fresh.drawing), (which, items)
+            assert not [w for w in cached.report.warnings if "matched nothing" in w], (which, items)
+
+
+def test_once_everywhere_is_said_where_it_cannot_be_kept(drawings):
+    """A line must go back over some stretch somewhere: marked "once" everywhere, the
+    stretches still drawn twice are named in the warnings, cached as fresh."""
+    path, cache = drawings["little"], StageCache()
+    base = vectorize_file(path, VectorizeOptions(), edits=Edits(), cache=cache)
+    edits = Edits(items=tuple(Edit(kind="once", at=r["at"]) for r in base.graph.retraces))
+    result = vectorize_file(path, VectorizeOptions(), edits=edits, cache=cache)
+    again = vectorize_file(path, VectorizeOptions(), edits=edits, cache=cache)  # from the solved cache
+    still = [w for w in result.report.warnings if "still drawn twice" in w]
+    assert still and again.report.warnings == result.report.warnings and result.report.strokes == 1
+    for warning in still:
+        x, y = (float(v) for v in warning.split(" at ")[1].split(" is ")[0].split(", "))
+        assert any(min(abs(x - p[0]) + abs(y - p[1]) for p in r["points"]) < 3 for r in result.graph.retraces)
+
+
+def _triple_edits(base):
+    triple = next(j for j in base.graph.junctions if j.role == "triple")
+    crossing = next(j for j in base.graph.junctions if j.role == "crossing")
+    yield [Edit(kind="split", at=triple.at), Edit(kind="pairing", at=crossing.at, pairing="touching")]
+
+
+def _little_edits(base):
+    yield [Edit(kind="merge", at=base.graph.branches[0].at), Edit(kind="twice", at=base.drawing.strokes[0].start)]
