@@ -249,18 +249,19 @@ def whole_process(gts: list, timeout: float, classifier: str) -> None:
     imports, model load, PNG read, SVG write included)."""
     from PIL import Image
 
+    from benchmarks.startup_cost import bytecode_note, child_cpu_seconds
     from vectorize.svg_read import read_svg
 
     exe = shutil.which("onestroke")
     base = [exe] if exe else [sys.executable, "-c", "from fabrication.cli import main; main()"]
     extra = [] if classifier in ("auto", "both") else ["--classifier", classifier]
-    times, failed = [], 0
+    times, cpus, failed = [], [], 0
     with tempfile.TemporaryDirectory(prefix="onestroke-bench-") as tmp:
         for gt in gts:
             src = Path(tmp) / f"{gt.name}.png"
             out = Path(tmp) / f"{gt.name}.svg"
             Image.fromarray(to_uint8(render(gt.drawing))).save(src)
-            start = time.perf_counter()
+            start, cpu_start = time.perf_counter(), child_cpu_seconds()
             try:
                 proc = subprocess.run(base + ["vectorize", str(src), "-o", str(out)] + extra, capture_output=True,
                                       text=True, timeout=timeout)
@@ -268,17 +269,21 @@ def whole_process(gts: list, timeout: float, classifier: str) -> None:
                 msg = (proc.stdout + proc.stderr).strip().splitlines()[-1:] or [""]
             except subprocess.TimeoutExpired:
                 code, msg = "timeout", [""]
-            elapsed = time.perf_counter() - start
+            elapsed, cpu = time.perf_counter() - start, child_cpu_seconds() - cpu_start
             strokes = len(read_svg(str(out)).strokes) if out.exists() else "-"
             if code == 0:
                 times.append(elapsed)
+                cpus.append(cpu)
             else:
                 failed += 1
-            print(f"  {gt.name:<28} {elapsed:6.2f} s  exit {code}  strokes {strokes}  {msg[0][-90:]}")
+            print(f"  {gt.name:<28} {elapsed:6.2f} s  CPU {cpu:5.2f} s  exit {code}  strokes {strokes}  "
+                  f"{msg[0][-90:]}")
     cmd = " ".join(["onestroke vectorize IN.png -o OUT.svg"] + extra)
+    print(f"bytecode: {bytecode_note(os.environ)}")
     if times:
         print(f"whole-process `{cmd}`: median {statistics.median(times):.2f} s, max {max(times):.2f} s over "
-              f"{len(times)} successful runs; {failed} failed")
+              f"{len(times)} successful runs; CPU (user+sys) median {statistics.median(cpus):.2f} s; "
+              f"{failed} failed")
     else:
         print(f"whole-process `{cmd}`: all {failed} runs failed")
 
