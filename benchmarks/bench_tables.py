@@ -177,6 +177,9 @@ def print_tables(rows: list[dict]) -> None:
     kinds: dict = {}
     for r in rows:
         kinds.setdefault((r["set"], r["classifier"], r["kind"]), []).append(r)
+    if len({r.get("condition") for r in rows}) > 1:  # the held-out set: also by rendering condition
+        for r in rows:
+            kinds.setdefault((r["set"], r["classifier"], f"[{r.get('condition')}]"), []).append(r)
     for (set_name, classifier, kind), rs in sorted(kinds.items()):
         s = _summary(rs)
         cells = [f"{set_name:<15}", f"{classifier:<10}", f"{kind:<17}", f"{s['n']:>3}", f"{s['fail']:>4}"]

@@ -10,7 +10,11 @@ real inputs are (seeded, one generator per drawing).
 - varwidth: pen pressure: the line width drifts smoothly between 0.5x and 1.5x;
 - half: the page scanned at half the resolution (the output is scaled back to compare);
 - gaps: the pen skipped twice: two gaps 1.5 widths (+2 px) long at random places of the
-  line's middle 80 %.
+  line's middle 80 %;
+- jpeg: the anti-aliased render saved as JPEG at quality 25-50 (ringing and 8x8 blocks
+  along every edge);
+- breaks: a dry pen: three short breaks across the line, 1 px to 0.6 widths + 1 px long, at
+  random places of the line's middle 80 %.
 """
 
 from __future__ import annotations
@@ -23,7 +27,7 @@ from scipy import ndimage
 
 from benchmarks.render import render, to_uint8
 
-CONDITIONS = ("clean", "noisy", "scan", "pencil", "specks", "varwidth", "half", "gaps")
+CONDITIONS = ("clean", "noisy", "scan", "pencil", "specks", "varwidth", "half", "gaps", "jpeg", "breaks")
 
 
 def _jpeg(image: np.ndarray, quality: int) -> np.ndarray:
@@ -67,6 +71,8 @@ def condition_image(drawing, gray: np.ndarray, condition: str,
     if condition == "half":
         small = Image.fromarray(to_uint8(gray)).resize((w // 2, h // 2), Image.LANCZOS)
         return np.asarray(small), w / (w // 2)
+    if condition == "jpeg":
+        return _jpeg(to_uint8(gray), int(rng.integers(25, 51))), 1.0
     if condition == "gaps":
         page = gray.copy()
         line = np.concatenate([s.sample_evenly(0.5) for s in drawing.strokes])
@@ -75,5 +81,20 @@ def condition_image(drawing, gray: np.ndarray, condition: str,
         for _ in range(2):
             x, y = line[rng.integers(len(line) // 10, len(line) * 9 // 10)]
             page[(cols + 0.5 - x) ** 2 + (rows + 0.5 - y) ** 2 <= radius ** 2] = 1.0
+        return to_uint8(page), 1.0
+    if condition == "breaks":
+        page = gray.copy()
+        line = np.concatenate([s.sample_evenly(0.5) for s in drawing.strokes])
+        rows, cols = np.mgrid[0:h, 0:w]
+        for _ in range(3):
+            # a band across the line, `length` px along it, wider than the ink
+            k = int(rng.integers(len(line) // 10, len(line) * 9 // 10))
+            tangent = line[min(k + 2, len(line) - 1)] - line[max(k - 2, 0)]
+            tangent /= max(np.linalg.norm(tangent), 1e-9)
+            length = rng.uniform(1.0, 0.6 * drawing.stroke_width + 1.0)
+            dx, dy = cols + 0.5 - line[k, 0], rows + 0.5 - line[k, 1]
+            along = np.abs(dx * tangent[0] + dy * tangent[1])
+            across = np.abs(dy * tangent[0] - dx * tangent[1])
+            page[(along <= length / 2) & (across <= drawing.stroke_width / 2 + 1.5)] = 1.0
         return to_uint8(page), 1.0
     raise ValueError(f"unknown condition {condition!r}; use one of {', '.join(CONDITIONS)}")

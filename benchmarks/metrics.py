@@ -245,12 +245,9 @@ def close_passes(stroke: Stroke, closed: bool, width: float) -> tuple[np.ndarray
     return s, pts, pairs[sep > 3 * w]
 
 
-def merged_without_crossing(stroke: Stroke, closed: bool, width: float, crossings: np.ndarray) -> list:
-    """Places where two passes of `stroke` run within one width of each other (their ink
-    merges) and that hold no crossing: near-retraces, narrow wedges, a pass grazing another.
-
-    Returns shapely MultiPoints of the centre-line samples involved (`close_passes`).
-    """
+def merged_clusters(stroke: Stroke, closed: bool, width: float) -> list[np.ndarray]:
+    """The places where two passes of `stroke` run within one width of each other, each as
+    the (K, 2) centre-line samples involved (`close_passes`), one array per connected place."""
     w = float(width)
     spacing = w / 4
     _, pts, pairs = close_passes(stroke, closed, w)
@@ -261,14 +258,44 @@ def merged_without_crossing(stroke: Stroke, closed: bool, width: float, crossing
     near = cKDTree(cp).query_pairs(2.0 * spacing, output_type="ndarray")
     graph = coo_matrix((np.ones(len(near)), (near[:, 0], near[:, 1])), shape=(len(cp), len(cp)))
     ncl, label = connected_components(graph, directed=False)
+    return [cp[label == c] for c in range(ncl)]
+
+
+def merged_without_crossing(stroke: Stroke, closed: bool, width: float, crossings: np.ndarray) -> list:
+    """Places where two passes of `stroke` run within one width of each other (their ink
+    merges) and that hold no crossing: near-retraces, narrow wedges, a pass grazing another.
+
+    Returns shapely MultiPoints of the centre-line samples involved (`close_passes`).
+    """
+    w = float(width)
     crossings = np.asarray(crossings, dtype=float).reshape(-1, 2)
     zones = []
-    for c in range(ncl):
-        cluster = cp[label == c]
+    for cluster in merged_clusters(stroke, closed, w):
         if len(crossings) and np.min(np.linalg.norm(cluster[:, None] - crossings[None], axis=2)) <= w:
             continue
         zones.append(shapely.MultiPoint(cluster))
     return zones
+
+
+def hidden_crossings(stroke: Stroke, closed: bool, width: float, crossings: np.ndarray,
+                     angles: np.ndarray) -> list:
+    """Crossings no ink can show: two passes that run within one width of each other far
+    beyond the crossing's own ink-merge zone (a near-retrace whose return pass crosses the
+    outward one at its base, as some font outlines draw it a unit off).
+
+    A crossing at angle a merges the passes over about w / sin(a/2) around it; a merged place
+    holding the crossing and reaching more than 2 widths beyond that hides it. Returns shapely
+    Points of the hidden crossings.
+    """
+    w = float(width)
+    crossings = np.asarray(crossings, dtype=float).reshape(-1, 2)
+    hidden = []
+    for cluster in merged_clusters(stroke, closed, w):
+        for p, a in zip(crossings, np.asarray(angles, dtype=float)):
+            reach = np.linalg.norm(cluster - p, axis=1)
+            if reach.min() <= w and reach.max() > w / max(np.sin(np.radians(a) / 2), 1e-3) + 2 * w:
+                hidden.append(shapely.Point(*p))
+    return hidden
 
 
 def drawing_polylines(drawing: Drawing, tolerance: float = FLATTEN_TOLERANCE) -> tuple[list[np.ndarray], list[bool]]:

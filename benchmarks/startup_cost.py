@@ -13,8 +13,8 @@ runs two kinds of fresh process, alternately:
   `time.perf_counter` (wall) and `time.process_time` (CPU): the interpreter's own start
   (CPU used before the first line runs; its wall share is the process's wall time less
   the parts), the CLI's imports (click, the command's module), the vectorizer's imports
-  (numpy, scipy, scikit-image, shapely, PIL), the CNN's onnxruntime session (import and
-  session), reading the PNG, vectorizing it (the first call in the process), writing the
+  library by library (`LIBRARIES`: each line adds only what the lines above did not
+  already import), the CNN's onnxruntime session (import and session), reading the PNG, vectorizing it (the first call in the process), writing the
   SVG; and then, for comparison, vectorizing the same image again (warm, as the in-process
   benchmark measures it).
 
@@ -32,13 +32,25 @@ import sys
 import time
 
 CHILD_FLAG = "--parts-child"
+# What the vectorizer's imports bring in, in an order where each line adds only its own
+# share (a module imported by an earlier line costs nothing again); the project's own
+# modules come last.
+LIBRARIES = (
+    ("numpy", ("numpy",)),
+    ("Pillow", ("PIL.Image", "PIL.PngImagePlugin")),
+    ("scipy.ndimage", ("scipy.ndimage",)),
+    ("scipy.sparse.csgraph", ("scipy.sparse.csgraph",)),
+    ("scipy.spatial", ("scipy.spatial",)),
+    ("scikit-image", ("skimage.filters.thresholding", "skimage.measure._find_contours")),
+    ("shapely", ("shapely",)),
+    ("scipy.optimize", ("scipy.optimize",)),
+    ("scipy.interpolate", ("scipy.interpolate",)),
+)
 
 
 def _parts_child(source: str, output: str) -> None:
     """The command's work in the command's order, each part timed; prints one JSON line."""
-    marks = [("interpreter", 0.0, 0.0)]
-    wall0 = time.perf_counter()
-    marks[0] = ("interpreter", wall0, time.process_time())
+    marks = [("interpreter", time.perf_counter(), time.process_time())]
 
     def mark(name: str) -> None:
         marks.append((name, time.perf_counter(), time.process_time()))
@@ -48,12 +60,16 @@ def _parts_child(source: str, output: str) -> None:
     importlib.import_module("fabrication.cli")
     importlib.import_module("fabrication.cli.vectorize_cmd")
     mark("CLI imports")
+    for name, modules in LIBRARIES:
+        for module in modules:
+            importlib.import_module(module)
+        mark(f"  {name}")
     from vectorize import VectorizeOptions, vectorize_image
     from vectorize.image_io import load_image
     from vectorize.svg_write import write_drawing
 
     importlib.import_module("vectorize.vectorizer")
-    mark("vectorizer imports")
+    mark("  the project's modules")
     from vectorize.classifiers import make_classifier
 
     options = VectorizeOptions()
@@ -73,20 +89,29 @@ def _parts_child(source: str, output: str) -> None:
     print(json.dumps(parts))
 
 
-def _child_cpu() -> float:
+def child_cpu_seconds() -> float:
+    """User + sys seconds of this process's finished children so far (all their threads)."""
     import resource
 
     usage = resource.getrusage(resource.RUSAGE_CHILDREN)
     return usage.ru_utime + usage.ru_stime
 
 
+def bytecode_note(env) -> str:
+    """Whether processes with environment `env` keep the project's compiled modules."""
+    if env.get("PYTHONDONTWRITEBYTECODE"):
+        return ("not written (PYTHONDONTWRITEBYTECODE is set: each process compiles the project's own modules "
+                "from source; an installed package has them compiled)")
+    return f"cached in {env.get('PYTHONPYCACHEPREFIX') or 'the __pycache__ folders'}"
+
+
 def _timed(cmd: list[str], env: dict, timeout: float) -> tuple[float, float, str]:
     """(wall s, CPU s of the child, stdout) of one process run to the end."""
     import subprocess
 
-    cpu0, start = _child_cpu(), time.perf_counter()
+    cpu0, start = child_cpu_seconds(), time.perf_counter()
     proc = subprocess.run(cmd, capture_output=True, text=True, env=env, timeout=timeout)
-    wall, cpu = time.perf_counter() - start, _child_cpu() - cpu0
+    wall, cpu = time.perf_counter() - start, child_cpu_seconds() - cpu0
     if proc.returncode != 0:
         raise RuntimeError(f"{' '.join(cmd[:3])} ... exited {proc.returncode}: {proc.stderr.strip()[-300:]}")
     return wall, cpu, proc.stdout
@@ -126,9 +151,6 @@ def main(argv: list[str] | None = None) -> int:
         env["PYTHONPYCACHEPREFIX"] = str(args.pycache.resolve())
     exe = shutil.which("onestroke")
     command = [exe] if exe else [sys.executable, "-m", "fabrication.cli"]
-    bytecode = ("not written (PYTHONDONTWRITEBYTECODE=1: the project's modules are compiled from source in "
-                "every process)" if env.get("PYTHONDONTWRITEBYTECODE") else
-                f"cached in {env.get('PYTHONPYCACHEPREFIX', 'the __pycache__ folders')}")
 
     whole_wall, whole_cpu, parts = [], [], {}
     with tempfile.TemporaryDirectory(prefix="onestroke-startup-") as tmp:
@@ -160,7 +182,7 @@ def main(argv: list[str] | None = None) -> int:
     load = " ".join(f"{x:.1f}" for x in os.getloadavg())
     print(f"start-up cost of `onestroke vectorize IN.png -o OUT.svg`: {len(picks)} drawings x {args.repeat} runs, "
           f"{os.cpu_count()} CPUs, load average {load}")
-    print(f"bytecode: {bytecode}")
+    print(f"bytecode: {bytecode_note(env)}")
     print(f"the command:   wall median {statistics.median(whole_wall):.3f} s, max {max(whole_wall):.3f} s;  "
           f"CPU (user+sys) median {statistics.median(whole_cpu):.3f} s")
     print("its parts (a process doing the same steps), medians:")
@@ -168,6 +190,8 @@ def main(argv: list[str] | None = None) -> int:
     for name, values in parts.items():
         if name == "(process total)" or name.startswith("vectorize again"):
             continue
+        if name == "  numpy":
+            print("  vectorizer imports:")
         print(f"  {name:26s} {statistics.median(values['wall']):8.3f} {statistics.median(values['cpu']):8.3f}")
     total = parts["(process total)"]
     print(f"  {'(process total)':26s} {statistics.median(total['wall']):8.3f} {statistics.median(total['cpu']):8.3f}")

@@ -12,7 +12,9 @@ Sets: "plain" (generated, no touches), "touch" (generated, with tangential touch
 near-touches), "hershey" (single-stroke font glyphs), "hershey-retrace" (the glyphs whose
 retraced branch cannot be told from the ink, fair-retrace rule), "relief" (Relief
 SingleLine glyphs), "triple" (three passes through a point), "handwriting" (jittered
-cursive words). Classifier "auto" runs the CNN everywhere and the geometric rule on touch
+cursive words); "heldout" (not in "all"): glyphs, words and seeds no other set uses, under
+scan, JPEG, noise, pen-pressure, broken-line, half-resolution and pencil conditions
+(benchmarks/heldout.py). Classifier "auto" runs the CNN everywhere and the geometric rule on touch
 too. See docs/benchmark.md for the columns.
 
 Each drawing is vectorized in a fresh process forked from this one (the vectorizer's
@@ -58,6 +60,7 @@ from benchmarks.render import render, to_uint8  # noqa: E402
 DEFAULT_COUNTS = {"plain": 42, "touch": 40, "hershey": 40, "hershey-retrace": 40, "relief": 40, "triple": 40,
                   "handwriting": 40}
 SETS = tuple(DEFAULT_COUNTS)
+HELDOUT_COUNT = 93  # --set heldout (benchmarks/heldout.py): not part of "all", which are the sets tuned on
 
 
 def build_set(name: str, count: int, seed: int) -> list:
@@ -72,6 +75,10 @@ def build_set(name: str, count: int, seed: int) -> list:
         from benchmarks.handwriting import handwriting_set
 
         return handwriting_set(count, seed)
+    if name == "heldout":
+        from benchmarks.heldout import heldout_set
+
+        return heldout_set(count, seed)
     return generate_set(name, count, seed)
 TASKS: list = []  # (set name, GroundTruth), inherited by the forked workers
 PLOT_DIR: list = []  # [Path] when --plot is given
@@ -141,7 +148,9 @@ def _run_one(index: int, classifier: str, oracle: bool, conn) -> None:
            "error": ""}
     try:
         gray = render(gt.drawing)
-        image, back = condition_image(gt.drawing, gray, CONDITION[0], np.random.default_rng(index))
+        condition = gt.meta.get("condition", CONDITION[0])  # the held-out set brings its own
+        row["condition"] = condition
+        image, back = condition_image(gt.drawing, gray, condition, np.random.default_rng(index))
         row["one_piece"] = ink_pieces(image, gt.width / back) == 1
         if oracle:
             output, seconds, peak, method, report = gt.drawing, 0.0, float("nan"), "none", None
@@ -240,18 +249,19 @@ def whole_process(gts: list, timeout: float, classifier: str) -> None:
     imports, model load, PNG read, SVG write included)."""
     from PIL import Image
 
+    from benchmarks.startup_cost import bytecode_note, child_cpu_seconds
     from vectorize.svg_read import read_svg
 
     exe = shutil.which("onestroke")
     base = [exe] if exe else [sys.executable, "-c", "from fabrication.cli import main; main()"]
     extra = [] if classifier in ("auto", "both") else ["--classifier", classifier]
-    times, failed = [], 0
+    times, cpus, failed = [], [], 0
     with tempfile.TemporaryDirectory(prefix="onestroke-bench-") as tmp:
         for gt in gts:
             src = Path(tmp) / f"{gt.name}.png"
             out = Path(tmp) / f"{gt.name}.svg"
             Image.fromarray(to_uint8(render(gt.drawing))).save(src)
-            start = time.perf_counter()
+            start, cpu_start = time.perf_counter(), child_cpu_seconds()
             try:
                 proc = subprocess.run(base + ["vectorize", str(src), "-o", str(out)] + extra, capture_output=True,
                                       text=True, timeout=timeout)
@@ -259,17 +269,21 @@ def whole_process(gts: list, timeout: float, classifier: str) -> None:
                 msg = (proc.stdout + proc.stderr).strip().splitlines()[-1:] or [""]
             except subprocess.TimeoutExpired:
                 code, msg = "timeout", [""]
-            elapsed = time.perf_counter() - start
+            elapsed, cpu = time.perf_counter() - start, child_cpu_seconds() - cpu_start
             strokes = len(read_svg(str(out)).strokes) if out.exists() else "-"
             if code == 0:
                 times.append(elapsed)
+                cpus.append(cpu)
             else:
                 failed += 1
-            print(f"  {gt.name:<28} {elapsed:6.2f} s  exit {code}  strokes {strokes}  {msg[0][-90:]}")
+            print(f"  {gt.name:<28} {elapsed:6.2f} s  CPU {cpu:5.2f} s  exit {code}  strokes {strokes}  "
+                  f"{msg[0][-90:]}")
     cmd = " ".join(["onestroke vectorize IN.png -o OUT.svg"] + extra)
+    print(f"bytecode: {bytecode_note(os.environ)}")
     if times:
         print(f"whole-process `{cmd}`: median {statistics.median(times):.2f} s, max {max(times):.2f} s over "
-              f"{len(times)} successful runs; {failed} failed")
+              f"{len(times)} successful runs; CPU (user+sys) median {statistics.median(cpus):.2f} s; "
+              f"{failed} failed")
     else:
         print(f"whole-process `{cmd}`: all {failed} runs failed")
 
@@ -339,7 +353,8 @@ def _git_commit() -> str:
 
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[1], formatter_class=argparse.RawTextHelpFormatter)
-    ap.add_argument("--set", default="all", choices=[*SETS, "all"])
+    ap.add_argument("--set", default="all", choices=[*SETS, "heldout", "all"],
+                    help="all: every set but heldout (the drawings and conditions no set tunes on)")
     ap.add_argument("--classifier", default="auto", choices=["auto", "cnn", "geometric", "both"],
                     help="auto: cnn on plain/hershey, both on touch")
     ap.add_argument("--count", type=int, default=None, help="drawings per set (default: plain 42, touch 40, "
@@ -368,7 +383,7 @@ def main(argv: list[str] | None = None) -> int:
         PLOT_DIR.append(args.plot)
     sets = list(SETS) if args.set == "all" else [args.set]
     for name in sets:
-        count = args.count if args.count is not None else DEFAULT_COUNTS[name]
+        count = args.count if args.count is not None else DEFAULT_COUNTS.get(name, HELDOUT_COUNT)
         gts = build_set(name, count, args.seed)
         TASKS.extend((name, gt) for gt in gts)
     t_gen = time.perf_counter() - t_start
@@ -439,7 +454,7 @@ def main(argv: list[str] | None = None) -> int:
     if args.csv:
         keys = ["set", "classifier", "name", "kind", "width", "closed", "strokes", "order", "correct", "ssim",
                 "psnr", "length_ratio", "gt_intersections", "out_intersections", "matched", "seconds",
-                "peak_mb", "order_correct", "fair", "one_piece", "excursion", "excursion_w", "within", "uncovered",
+                "peak_mb", "condition", "order_correct", "fair", "one_piece", "excursion", "excursion_w", "within", "uncovered",
                 "cover_tolerance", "out_length", "min_length",
                 "error", "warnings"]
         args.csv.parent.mkdir(parents=True, exist_ok=True)

@@ -179,3 +179,17 @@ def test_an_open_c_and_a_line_ending_beside_another_are_not_bridged():
     result = vectorize_image(render_polylines(tee, width=6.0), VectorizeOptions(seed=0))
     assert result.report.gaps_bridged == 0 and result.report.dropped_components == 1
     assert result.report.strokes == 1
+
+
+def test_a_line_cut_off_at_a_corner_is_bridged_to_the_corner():
+    # A "P" drawn in one stroke; a dry-pen break cuts the stem off just below the bowl's
+    # corner. The far side of that gap is a corner of the other piece, not an end.
+    truth = np.array([[100.0, 350.0], [100.0, 60.0], [300.0, 60.0], [300.0, 200.0], [100.0, 200.0]])
+    image = render_polylines([truth], width=6.0).copy()
+    image[205:209, 90:111] = 255
+    result = vectorize_image(image, VectorizeOptions(seed=0))
+    assert result.report.strokes == 1 and result.report.dropped_components == 0
+    assert result.report.gaps_bridged == 1
+    stroke = result.drawing.strokes[0]
+    assert np.linalg.norm(stroke.sample_evenly(2.0) - truth[0], axis=1).min() < 6.0  # the stem's foot is drawn
+    assert stroke.length == pytest.approx(np.linalg.norm(np.diff(truth, axis=0), axis=1).sum(), rel=0.03)

@@ -97,6 +97,21 @@ class MedialGraph:
                 self.remove_branch(bid)
         del self.incident[node], self.positions[node], self.radii[node]
 
+    def split_branch(self, bid: int, index: int) -> int:
+        """Cut branch `bid` at its point `index` into two branches meeting at a new node
+        (an end node when `index` is the first or last point); returns that node."""
+        branch = self.branches[bid]
+        if index <= 0:
+            return branch.a
+        if index >= len(branch.points) - 1:
+            return branch.b
+        self.remove_branch(bid)
+        node = self.add_node(branch.points[index], float(branch.radii[index]))
+        self.add_branch(Branch(branch.a, node, branch.points[:index + 1], branch.radii[:index + 1],
+                               branch.sins[:index]))
+        self.add_branch(Branch(node, branch.b, branch.points[index:], branch.radii[index:], branch.sins[index:]))
+        return node
+
     def degree(self, node: int) -> int:
         return len(self.incident[node])
 
