@@ -5,23 +5,11 @@ from __future__ import annotations
 
 import os
 import threading
-from dataclasses import replace
 from pathlib import Path
 
-import pytest
-
 from fabrication.studio.session import StudioSession, Superseded
-from tests.conftest import alpha_loop, render_polylines
+from tests.test_studio_edits import loop_png as drawing  # noqa: F401 (the same small drawing)
 from vectorize.edits import Edits
-
-
-@pytest.fixture(scope="module")
-def drawing(tmp_path_factory):
-    from PIL import Image
-
-    path = tmp_path_factory.mktemp("studio-warm") / "loop.png"
-    Image.fromarray(render_polylines([alpha_loop()])).save(path)
-    return path
 
 
 def test_neighbours_are_one_slider_step_away_in_the_direction_of_the_move(drawing):
