@@ -18,6 +18,7 @@ from benchmarks.metrics import (  # noqa: E402
     ORDER_THRESHOLD,
     ambiguous_junctions,
     evaluate,
+    hidden_crossings,
     match_points,
     order_score,
     order_tolerance,
@@ -151,6 +152,23 @@ def test_crossing_touch_and_retrace_are_told_apart():
     loop = np.array([[0, 0], [10, 0], [10, 10], [5, 10], [5, -10.0]])  # crosses itself at (5, 0)
     r = polyline_intersections([loop], [False])
     np.testing.assert_allclose(r.crossings, [[5, 0]], atol=1e-9)
+
+
+def test_a_crossing_inside_a_near_retrace_is_hidden_and_a_plain_crossing_is_not():
+    # The pen goes right along a stem, down an arm to its tip and back up the arm 1 px beside
+    # it, leaving the arm where the stem is: the return crosses the outward pass there, in
+    # ink that shows one line (the Nixish Y and K draw it so).
+    w = 4.0
+    path = np.array([[100.0, 100.0], [300.0, 100.0], [300.0, 400.0], [299.0, 400.0], [299.0, 98.0],
+                     [500.0, 98.0]])
+    stroke = Stroke.from_polyline(path)
+    x = polyline_intersections([path], [False])
+    assert len(x.crossings) == 1
+    assert len(hidden_crossings(stroke, False, w, x.crossings, x.crossing_angles)) == 1
+    cross = np.array([[100.0, 100.0], [400.0, 400.0], [400.0, 100.0], [100.0, 400.0]])  # an X and a loop
+    x = polyline_intersections([cross], [False])
+    assert len(x.crossings) == 1
+    assert hidden_crossings(Stroke.from_polyline(cross), False, w, x.crossings, x.crossing_angles) == []
 
 
 def test_matching_within_five_pixels():
