@@ -170,6 +170,7 @@ def print_tables(rows: list[dict]) -> None:
         if main:
             print(_fmt_row({"set": "plain+h", "classifier": "cnn", **_summary(main)}))
     _print_acceptance(rows)
+    _print_headroom(rows)
     print()
     print("by drawing kind:")
     print(f"{'set':<15}  {'classifier':<10}  {'kind':<17}  {'n':>3}  {'fail':>4}  {'correct %':>9}  "
@@ -189,6 +190,31 @@ def print_tables(rows: list[dict]) -> None:
             v = s[key]
             cells.append(("-" if isinstance(v, float) and math.isnan(v) else fmt.format(v)).rjust(width))
         print("  ".join(cells))
+
+
+NEAR_MISS = 0.5  # px: headroom to the excursion bound under which a drawing is a near miss
+
+
+def _print_headroom(rows: list[dict]) -> None:
+    """Per set and classifier, how far inside the bound (half width + 1 px) the excursions stay:
+    the smallest headroom (px; negative: outside), its 1st percentile, and the drawings that
+    come within `NEAR_MISS` px of the bound or cross it."""
+    from benchmarks.ink_metrics import excursion_bound
+
+    groups: dict = {}
+    for r in rows:
+        if not r.get("error") and not math.isnan(r.get("excursion", math.nan)):
+            groups.setdefault((r["set"], r["classifier"]), []).append(r)
+    if not groups:
+        return
+    print()
+    print(f"excursion headroom (half width + 1 px minus excursion), near miss: under {NEAR_MISS} px:")
+    for (set_name, classifier), rs in groups.items():
+        room = np.array([excursion_bound(r["width"]) - r["excursion"] for r in rs])
+        near = sorted((float(h), r["name"]) for h, r in zip(room, rs) if h < NEAR_MISS)
+        names = ", ".join(f"{name} {h:+.2f}" for h, name in near[:4]) + (" ..." if len(near) > 4 else "")
+        print(f"  {set_name:<15} {classifier:<10} min {room.min():+.2f} px  p1 {np.percentile(room, 1):+.2f} px  "
+              f"near or out {len(near)}" + (f": {names}" if near else ""))
 
 
 def failure_kind(row: dict) -> str:

@@ -43,6 +43,20 @@ def test_a_straight_chord_across_a_corner_is_outside_the_ink():
     assert curve_excess(guard, arm.control)[0] <= 0.0
 
 
+
+def test_a_piece_shrunk_to_a_point_is_checked_at_its_point():
+    """A fitted piece whose four control points coincide (loops.png at threshold 0.50 made
+    one) has no length for GEOS to segmentize: it is checked where it is."""
+    from pathlib import Path
+
+    from vectorize import vectorize_file
+
+    point = np.array([[[708.02, 404.09]] * 4])
+    assert np.array_equal(np.unique(curve_points(point), axis=0), point[0, :1])
+    loops = Path(__file__).resolve().parents[1] / "examples" / "loops.png"
+    assert len(vectorize_file(loops, VectorizeOptions(threshold=0.5)).drawing.strokes) == 1
+
+
 @pytest.mark.slow
 @pytest.mark.parametrize("name, width", [("Delta", 6.75), ("uni2074", 3.25), ("uni1E9E", 3.75)])
 def test_relief_glyphs_with_acute_corners_stay_in_the_ink(name, width):

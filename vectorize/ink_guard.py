@@ -44,7 +44,8 @@ def curve_points(control: np.ndarray) -> np.ndarray:
     the ink.
     """
     polyline = Stroke(control).flatten(FLATNESS)
-    if len(polyline) < 2:
+    # A piece shrunk to a point (GEOS cannot segmentize a line of no length) is its point.
+    if len(polyline) < 2 or not (polyline != polyline[0]).any():
         return polyline
     return shapely.get_coordinates(shapely.segmentize(shapely.linestrings(polyline), STEP))
 
