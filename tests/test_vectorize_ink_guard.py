@@ -7,6 +7,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from benchmarks.conditions import condition_image
 from benchmarks.drawings import generate_drawing
 from benchmarks.hershey import glyph_ground_truth
 from benchmarks.ink_metrics import excursion, excursion_bound
@@ -14,7 +15,8 @@ from benchmarks.relief import relief_glyphs
 from benchmarks.render import render, to_uint8
 from tests.conftest import render_polylines
 from vectorize import VectorizeOptions, vectorize_image
-from vectorize.ink_guard import InkGuard, curve_excess, curve_points
+from vectorize.drawing import Drawing
+from vectorize.ink_guard import FLATNESS, MARGIN, STEP, InkGuard, curve_excess, curve_points, guard_margin
 from vectorize.stroke import Stroke
 
 
@@ -84,3 +86,27 @@ def test_the_curve_as_written_stays_in_the_ink_after_a_retraced_spike_is_shared(
     stages = result.stages
     guard = InkGuard(stages["simplified"], stages["ink"].gray, stages["ink"].threshold)
     assert guard.stroke_excess(stages["working_strokes"][0]) <= 0.0
+
+
+def test_the_guard_keeps_thin_lines_within_one_width():
+    # Half a width + 1 px is more than one width for lines under 2 px: there the guard's
+    # margin shrinks to half the width, less its own sampling error.
+    assert guard_margin(2.0) == guard_margin(8.0) == MARGIN
+    for width in (0.75, 1.0, 1.5, 1.9):
+        assert 0.0 < guard_margin(width) + STEP / 2 + FLATNESS <= 0.5 * width + 1e-12
+
+
+def test_a_thin_glyph_scanned_at_half_resolution_stays_within_one_width():
+    # Relief's summation sign drawn 3 px wide, scanned at half the resolution (the held-out
+    # set's ReliefSingleLine-Regular-summation-half): the vectorizer sees a 1.5 px line. With
+    # the guard's margin of 0.7 px the curve ran 3.03 px (1.01 widths) from the centre line
+    # near a sharp corner; with the margin held to half the width, 1.18 px.
+    glyph = next(g for g in relief_glyphs() if g.name == "summation")
+    gt = glyph_ground_truth(glyph, 3.0, close_gaps=True, spacing=1.0, fit=0.8545664167524245)
+    image, back = condition_image(gt.drawing, render(gt.drawing), "half", None)
+    result = vectorize_image(image, VectorizeOptions(multi=False, classifier="cnn", seed=0))
+    scale = np.array([[back, 0.0, 0.0], [0.0, back, 0.0]])
+    output = Drawing(tuple(s.transformed(scale) for s in result.drawing.strokes), gt.drawing.width,
+                     gt.drawing.height, "px")
+    assert len(output.strokes) == 1
+    assert excursion(gt.drawing, output) <= gt.width

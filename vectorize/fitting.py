@@ -8,7 +8,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.interpolate import splev, splprep
 
-from vectorize.ink_guard import InkGuard, curve_excess, keep_in_ink
+from vectorize.ink_guard import MARGIN, InkGuard, curve_excess, keep_in_ink
 from vectorize.retraces import Twin, mirror_flags, mirror_keep, rolled, share_pieces, twin_piece, valid_twins
 from vectorize.stroke import Stroke
 
@@ -267,7 +267,10 @@ def fit_stroke(traced: list[TracedPoint], *, closed: bool, sigma: float, stroke_
         before, after = pieces[k], pieces[m]
         if corner[at]:
             point = _corner_point(before, after, xy[at], 2.0 * stroke_width)
-            if guard is not None and guard.excess(point)[0] > 0.0:
+            # A corner point is held to the invariant's own slack (half width + 1 px), not to a
+            # thin line's one-width margin: the image probe finds little ink around a faint
+            # tip, and the centre-line point instead cuts the corner.
+            if guard is not None and guard.excess(point)[0] > MARGIN - guard.margin:
                 point = xy[at]
         else:
             point = (before[-1, 3] + after[0, 0]) / 2.0

@@ -34,6 +34,15 @@ STEP = 0.4
 # Checked points must keep the sampling error in hand: the guard's margin is what is left.
 SLACK = 1.0
 MARGIN = SLACK - STEP / 2 - FLATNESS
+# Nor more than one width away: for lines under 2 px wide that is the nearer bound.
+MIN_MARGIN = 0.05
+
+
+def guard_margin(stroke_width: float) -> float:
+    """The guard's margin (px) for lines `stroke_width` px wide: the invariant's slack, at
+    most half the width (so no point strays more than one width from the centre line), less
+    the sampling error of the check."""
+    return max(min(SLACK, 0.5 * stroke_width) - STEP / 2 - FLATNESS, MIN_MARGIN)
 
 
 def curve_points(control: np.ndarray) -> np.ndarray:

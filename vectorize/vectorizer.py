@@ -15,7 +15,7 @@ from vectorize.edits import Edits
 from vectorize.fitting import TracedPoint, fit_stroke
 from vectorize.gaps import bridge_gaps, keep_largest_piece
 from vectorize.graph import MedialGraph
-from vectorize.ink_guard import InkGuard
+from vectorize.ink_guard import InkGuard, guard_margin
 from vectorize.classifiers import make_classifier, shipped_pass_scorer
 from vectorize.clusters import merge_triple_points, straightest_pairs
 from vectorize.intersections import Junction, JunctionVerdict, ranked_pairings
@@ -411,7 +411,7 @@ def run_pipeline(image: np.ndarray, options: VectorizeOptions, *,
     # Smoothing allowance: the medial axis wobbles by ~0.07 px per px of stroke width (pixel
     # grid, anti-aliasing); fitting tighter follows that wobble, looser cuts corners.
     sigma = float(np.clip(0.065 * w, 0.15, 0.8))
-    guard = InkGuard(graph, ink.gray, ink.threshold) if solved is None else None
+    guard = InkGuard(graph, ink.gray, ink.threshold, margin=guard_margin(w)) if solved is None else None
     strokes = list(solved[1]) if solved is not None else []
     for traced, closed, twins in _trace(graph, simple, ordering, junctions, verdicts, w) if solved is None else ():
         if len(traced) < 2:
