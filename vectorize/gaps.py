@@ -14,6 +14,7 @@ the nearest centre line of another piece it points at, making the junction the i
 from __future__ import annotations
 
 import math
+from functools import partial
 
 import numpy as np
 from scipy.sparse import coo_matrix
@@ -79,13 +80,7 @@ def bridge_gaps(graph: MedialGraph, *, stroke_width: float, made: list | None = 
             if off_a <= BRIDGE_ANGLE and off_b <= BRIDGE_ANGLE:
                 pairs.append((length / stroke_width + off_a + off_b, a, b, length))
     root = {p: p for p in set(piece.values())}
-
-    def find(p: int) -> int:
-        while root[p] != p:
-            root[p] = root[root[p]]
-            p = root[p]
-        return p
-
+    find = partial(_find, root)
     used: set[int] = set()
     bridges = 0
     open_ends = len(ends)
@@ -99,12 +94,7 @@ def bridge_gaps(graph: MedialGraph, *, stroke_width: float, made: list | None = 
         open_ends -= 2
         root[find(piece[a])] = find(piece[b])
         used.update((a, b))
-        count = max(2, int(math.ceil(length)) + 1)
-        points = np.linspace(position[a], position[b], count)
-        radii = np.linspace(graph.radii[a], graph.radii[b], count)
-        graph.add_branch(Branch(a, b, points, radii, np.ones(count - 1)))
-        if made is not None:
-            made.append((tuple(map(float, position[a])), tuple(map(float, position[b]))))
+        _add_bridge(graph, a, b, length, made)
         bridges += 1
     bridges += _bridge_to_lines(graph, stroke_width, heading, piece, root, made)
     if bridges:
@@ -122,12 +112,7 @@ def _bridge_to_lines(graph: MedialGraph, stroke_width: float, heading: dict, pie
     Pieces with less centre line than `BRIDGE_WIDTHS` widths (dust, a dot) are not joined.
     piece: node -> piece index; root: the union-find over pieces of the end-to-end bridges;
     made: as in `bridge_gaps`."""
-
-    def find(p: int) -> int:
-        while root[p] != p:
-            p = root[p]
-        return p
-
+    find = partial(_find, root)
     reach = BRIDGE_WIDTHS * stroke_width + BRIDGE_SLACK
     length: dict[int, float] = {}
     for branch in graph.branches.values():
@@ -167,14 +152,29 @@ def _bridge_to_lines(graph: MedialGraph, stroke_width: float, heading: dict, pie
         split.add(bid)
         piece[target] = target_piece
         root[find(piece[end])] = find(target_piece)
-        count = max(2, int(math.ceil(gap)) + 1)
-        pts = np.linspace(graph.positions[end], graph.positions[target], count)
-        radii = np.linspace(graph.radii[end], graph.radii[target], count)
-        graph.add_branch(Branch(end, target, pts, radii, np.ones(count - 1)))
-        if made is not None:
-            made.append((tuple(map(float, graph.positions[end])), tuple(map(float, graph.positions[target]))))
+        _add_bridge(graph, end, target, gap, made)
         bridges += 1
     return bridges
+
+
+def _find(root: dict, p: int) -> int:
+    """The representative of piece `p` in the union-find `root` (piece -> parent), halving
+    the path on the way."""
+    while root[p] != p:
+        root[p] = root[root[p]]
+        p = root[p]
+    return p
+
+
+def _add_bridge(graph: MedialGraph, a: int, b: int, length: float, made: list | None) -> None:
+    """A straight branch from node a to node b (`length` px apart) with the radii running
+    from one end's to the other's; its two ends go to `made` (see `bridge_gaps`)."""
+    count = max(2, int(math.ceil(length)) + 1)
+    points = np.linspace(graph.positions[a], graph.positions[b], count)
+    radii = np.linspace(graph.radii[a], graph.radii[b], count)
+    graph.add_branch(Branch(a, b, points, radii, np.ones(count - 1)))
+    if made is not None:
+        made.append((tuple(map(float, graph.positions[a])), tuple(map(float, graph.positions[b]))))
 
 
 def _faces(graph: MedialGraph, bid: int, index: int, toward: np.ndarray, stroke_width: float) -> bool:

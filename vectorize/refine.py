@@ -236,10 +236,9 @@ class Refinement:
             def after_merging(graph) -> int:
                 done = 0
                 for index, point in merges:
-                    found = _nearest_mergeable(graph, point, self.tol)
-                    if found is not None:
-                        bid, a, b = found
-                        _merge(graph, a, b, bid)
+                    bid = _nearest_branch(graph, point, self.tol, eligible=lambda branch: _mergeable(graph, branch))
+                    if bid is not None:
+                        _merge(graph, graph.branches[bid].a, graph.branches[bid].b, bid)
                         self.hits.add(index)
                         done += 1
                 return done
@@ -398,7 +397,7 @@ class Refinement:
                 nodes.append(JunctionInfo(node, self.to_output(graph.positions[node]), degree, role))
         branches = []
         for bid, branch in sorted(graph.branches.items()):
-            if branch.a != branch.b and graph.degree(branch.a) == 3 and graph.degree(branch.b) == 3:
+            if _mergeable(graph, branch):
                 middle = branch.points[len(branch.points) // 2]
                 branches.append(BranchInfo(bid, self.to_output(middle), round(branch.length / self.scale, 3)))
         ends = tuple(self.to_output(graph.positions[n]) for n in sorted(graph.incident) if graph.degree(n) == 1)
@@ -441,23 +440,19 @@ def _pass_counts(solution) -> dict[int, int]:
     return count
 
 
-def _nearest_branch(graph, point: np.ndarray, tol: float) -> int | None:
-    """The id of the branch passing nearest `point`, if within tol."""
+def _nearest_branch(graph, point: np.ndarray, tol: float, eligible=None) -> int | None:
+    """The id of the branch passing nearest `point`, if within tol; eligible: None or a
+    test a branch must pass to count."""
     best = None
     for bid, branch in graph.branches.items():
+        if eligible is not None and not eligible(branch):
+            continue
         d = float(np.min(np.linalg.norm(branch.points - point, axis=1)))
         if d <= tol and (best is None or d < best[0]):
             best = (d, bid)
     return None if best is None else best[1]
 
 
-def _nearest_mergeable(graph, point: np.ndarray, tol: float):
-    """(branch id, a, b) of the branch between two degree-3 nodes nearest `point`, within tol."""
-    best = None
-    for bid, branch in graph.branches.items():
-        if branch.a == branch.b or graph.degree(branch.a) != 3 or graph.degree(branch.b) != 3:
-            continue
-        d = float(np.min(np.linalg.norm(branch.points - point, axis=1)))
-        if d <= tol and (best is None or d < best[0]):
-            best = (d, bid, branch.a, branch.b)
-    return None if best is None else best[1:]
+def _mergeable(graph, branch) -> bool:
+    """Whether `branch` joins two different degree-3 nodes (a merge collapses it)."""
+    return branch.a != branch.b and graph.degree(branch.a) == 3 and graph.degree(branch.b) == 3
