@@ -96,3 +96,62 @@ def test_a_frame_is_found_in_a_crop_as_in_the_whole_image():
     # The band is a frame by the image's longest side, not by the crop's: in an image ten
     # times larger it would be too thin to be one.
     assert frame_labels(crop, count, longest=4000).tolist() == []
+
+
+def _closing_flattened(gray: np.ndarray) -> np.ndarray:
+    """`flatten_paper` by its definition: a grey closing, box-smoothed, divided out."""
+    size = max(31, int(round(max(gray.shape) / 8)))
+    paper = ndimage.grey_closing(gray, size=(size, size), mode="nearest")
+    paper = ndimage.uniform_filter(paper.astype(np.float64), size=size, mode="nearest")
+    return np.clip(gray / np.maximum(paper, 0.3), 0.0, 1.0).astype(np.float32)
+
+
+@pytest.mark.parametrize("name, page", _pages(), ids=[name for name, _ in _pages()])
+def test_flattened_paper_is_the_closing_divided_out(name, page):
+    from vectorize.binarize import flatten_paper, working_gray
+
+    for blur in (0.0, 1.5):
+        gray, _ = working_gray(page, max_size=1000, blur=blur)
+        assert np.array_equal(flatten_paper(gray), _closing_flattened(gray)), (name, blur)
+
+
+def test_a_window_holds_the_mask_where_the_maximum_filter_says_so():
+    from vectorize.binarize import in_every_window
+
+    rng = np.random.default_rng(5)
+    found = 0
+    for _ in range(300):
+        h, w = rng.integers(16, 260, 2)
+        size = int(rng.integers(3, 130))
+        mask = rng.random((h, w)) < rng.choice([0.0005, 0.002, 0.01, 0.05])
+        if in_every_window(mask, size):  # never claimed where a window of either origin misses
+            found += 1
+            assert ndimage.maximum_filter(mask, size=size, mode="nearest").all()
+            assert ndimage.grey_dilation(mask.astype(np.uint8), size=(size, size), mode="nearest").all()
+    assert found > 50
+    # A clean page holds its paper level everywhere; one dark band wider than a window does not.
+    gray, _ = paper_gray(_pages()[0][1], max_size=1000, blur=0.0)
+    assert in_every_window(gray == gray.max(), 125)
+    gray[:, 300:500] = 0.2
+    assert not in_every_window(gray == gray.max(), 125)
+
+
+def test_the_paper_noise_floor_of_clean_paper_is_its_level():
+    from vectorize.binarize import paper_noise_floor
+
+    def by_percentiles(gray):
+        q25, median = np.percentile(gray, [25, 50])
+        sigma = (median - q25) / 0.6745
+        return None if sigma > 0.1 else float(median - 4.5 * sigma)
+
+    rng = np.random.default_rng(2)
+    for n in (17, 400, 1001, 4096):
+        # Around the share of the brightest level where the lower quartile reaches it.
+        edge = int(0.25 * (n - 1))
+        for dark in (edge - 1, edge, edge + 1, edge + 2, n // 2):
+            gray = np.full(n, np.float32(0.97))
+            gray[:dark] = rng.random(dark).astype(np.float32) * 0.97
+            rng.shuffle(gray)
+            assert paper_noise_floor(gray.reshape(1, -1)) == by_percentiles(gray), (n, dark)
+    page = paper_gray(_pages()[1][1], max_size=1000, blur=0.0)[0]
+    assert paper_noise_floor(page) == by_percentiles(page) == float(page.max())

@@ -95,9 +95,28 @@ def flatten_paper(gray: np.ndarray) -> np.ndarray:
     than the window would be taken for paper, and no line drawing has those.
     """
     size = max(31, int(round(max(gray.shape) / 8)))
-    paper = ndimage.grey_closing(gray, size=(size, size), mode="nearest")
-    paper = ndimage.uniform_filter(paper.astype(np.float64), size=size, mode="nearest")
+    top = gray.max()
+    if in_every_window(gray == top, size):
+        # Paper at one level (a clean drawing): the closing is that level everywhere, and so
+        # is its smoothing, which the filter computes alike for any constant image.
+        paper = np.full((1, 1), top, dtype=np.float64)
+    else:
+        paper = ndimage.grey_closing(gray, size=(size, size), mode="nearest").astype(np.float64)
+    paper = ndimage.uniform_filter(paper, size=size, mode="nearest")
     return np.clip(gray / np.maximum(paper, MIN_PAPER), 0.0, 1.0).astype(np.float32)
+
+
+def in_every_window(mask: np.ndarray, size: int) -> bool:
+    """Whether every `size` x `size` window (centred on a pixel, cut at the image edge) of
+    `mask` (H, W) bool holds a True pixel: then a maximum filter of that size over an image
+    whose maximum is where `mask` is True is that maximum everywhere.
+
+    Tiles of (size + 1) // 2 px a side suffice to decide it: every window, cut at the edge
+    or not, contains a whole tile (the last tile of a row or column may be shorter)."""
+    step = (size + 1) // 2
+    rows = np.logical_or.reduceat(mask, np.arange(0, mask.shape[0], step), axis=0)
+    tiles = np.logical_or.reduceat(rows, np.arange(0, mask.shape[1], step), axis=1)
+    return bool(tiles.all())
 
 
 def paper_noise_floor(gray: np.ndarray) -> float | None:
@@ -105,6 +124,11 @@ def paper_noise_floor(gray: np.ndarray) -> float | None:
     the paper, with sigma from the lower quartile (a line drawing is mostly paper; the
     upper half may be clipped at white). None when the lower quartile is not paper grain
     (more than a quarter of the image is dark: a frame, a heavy drawing)."""
+    top, count = gray.max(), gray.size
+    if np.count_nonzero(gray == top) >= count - int(0.25 * (count - 1)):
+        # Three quarters of the image at its brightest level (clean paper): both quantiles
+        # are that level, sigma is 0, as np.percentile would find after sorting.
+        return float(top)
     q25, median = np.percentile(gray, [25, 50])
     sigma = (median - q25) / 0.6745
     if sigma > MAX_PAPER_SIGMA:
