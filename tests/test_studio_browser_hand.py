@@ -2,7 +2,8 @@
 point (six branches, three passes) clicked through its pairings, picked from its list and
 split into two crossings; a cursive word whose stems are drawn down and back up, with two
 pen gaps (the stretches drawn twice and the bridged gaps shown; the line started at the
-tip of its lead-in; a stretch drawn twice made once); and the page's exports against the CLI's bytes with those edits.
+tip of its lead-in; a stretch drawn twice made once; a bridged gap opened and closed); and
+the page's exports against the CLI's bytes with those edits.
 Screenshots go to test-artifacts/."""
 
 from __future__ import annotations
@@ -139,6 +140,39 @@ def test_a_cursive_word_shows_its_retraces_and_starts_at_a_stems_tip(served, tmp
     edits = page.evaluate(f"{STATE}.edits")
     exports_match_the_cli(page, drawing, edits, tmp_path, "laser", "gcode", "--size", "80mm", "--feed", "1500mm/min",
                           "--power", "60%", "--passes", "1", "--origin", "lower-left")
+
+
+def test_a_bridged_gap_opened_closed_undone_and_both_pieces_kept(served, tmp_path):
+    """The gap tool on the word's pen gap before its e: open, the line keeps the largest
+    piece and the page says so; closed again by a click; undone; both pieces kept by the
+    page's multi-stroke button. The page's SVG with the gap open is the CLI's."""
+    page, drawing = served["little"]
+    before = page.evaluate(f"{STATE}.edits.edits.length")
+    gap = max(page.evaluate(f"{STATE}.graph.bridges"), key=lambda g: g[0][0])  # the e's
+    middle = [(gap[0][0] + gap[1][0]) / 2, (gap[0][1] + gap[1][1]) / 2]
+    page.check("input[name=tool][value=gap]")
+    click_at(page, middle)
+    settle(page, before + 1)
+    assert page.evaluate(f"{STATE}.edits.edits.slice(-1)[0].kind") == "unbridge"
+    assert page.evaluate(f"{STATE}.graph.unbridged") == [gap] and len(page.evaluate(f"{STATE}.graph.bridges")) == 1
+    assert page.evaluate(f"{STATE}.report.dropped") == 1 and page.evaluate(f"{STATE}.report.strokes") == 1
+    assert "the ink is in 2 pieces" in page.inner_text("#junctions") and page.is_visible("#keep-pieces")
+    assert any("1 separate ink piece(s) dropped" in w for w in page.evaluate(f"{STATE}.report.warnings"))
+    page.screenshot(path=str(ARTIFACTS / "studio-hand-6-gap-opened.png"))
+    _, svg = download(page, "[data-export=svg]")
+    assert svg == cli_bytes("vectorize", drawing, page.evaluate(f"{STATE}.edits"), tmp_path, ".svg")
+
+    click_at(page, middle)  # on the struck-through circle: closed again
+    settle(page, before)
+    assert len(page.evaluate(f"{STATE}.graph.bridges")) == 2 and page.evaluate(f"{STATE}.report.dropped") == 0
+    page.click("#undo")
+    settle(page, before + 1)
+    assert page.evaluate(f"{STATE}.graph.unbridged") == [gap]
+    page.click("#keep-pieces")
+    settle(page, before + 1, f"{STATE}.settings.multi")
+    assert page.evaluate(f"{STATE}.report.strokes") >= 2 and page.evaluate(f"{STATE}.report.dropped") == 0
+    assert not [w for w in page.evaluate(f"{STATE}.report.warnings") if "unbridge" in w]
+    page.check("input[name=tool][value=pairing]")
 
 
 def exports_match_the_cli(page, drawing, edits, tmp_path, command: str, kind: str, *flags) -> None:

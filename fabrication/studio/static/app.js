@@ -201,18 +201,38 @@ function retraces(g) {
   g.restore();
 }
 
-// Pen gaps the vectorizer bridged: the two ends joined, dashed, under the curve.
+// Pen gaps the vectorizer bridged: the two ends joined, dashed, under the curve; gaps the
+// user kept open (an "unbridge" edit): a grey circle struck through.
 function bridges(g) {
   g.save();
-  for (const [a, b] of studio.state.graph.bridges || []) {
+  const ring = ([a, b]) => {
     const [ax, ay] = toScreen(...a), [bx, by] = toScreen(...b);
-    const r = Math.max(9, Math.hypot(bx - ax, by - ay) / 2 + 5);
-    g.strokeStyle = COLORS.gap; g.lineWidth = 2; g.setLineDash([4, 3]);
-    g.beginPath(); g.arc((ax + bx) / 2, (ay + by) / 2, r, 0, 2 * Math.PI); g.stroke();
+    return [(ax + bx) / 2, (ay + by) / 2, Math.max(9, Math.hypot(bx - ax, by - ay) / 2 + 5)];
+  };
+  for (const gap of studio.state.graph.bridges || []) {
+    const [x, y, r] = ring(gap);
+    g.strokeStyle = COLORS.gap; g.lineWidth = studio.tool === "gap" ? 3 : 2; g.setLineDash([4, 3]);
+    g.beginPath(); g.arc(x, y, r, 0, 2 * Math.PI); g.stroke();
     g.setLineDash([]);
-    label(g, "gap", (ax + bx) / 2, (ay + by) / 2, r + 3);
+    label(g, "gap", x, y, r + 3);
+  }
+  for (const gap of studio.state.graph.unbridged || []) {
+    const [x, y, r] = ring(gap);
+    g.strokeStyle = COLORS.other; g.lineWidth = 2;
+    g.beginPath(); g.arc(x, y, r, 0, 2 * Math.PI);
+    g.moveTo(x - r * 0.7, y + r * 0.7); g.lineTo(x + r * 0.7, y - r * 0.7); g.stroke();
+    label(g, "gap open", x, y, r + 3);
   }
   g.restore();
+}
+
+function middle([a, b]) { return { at: [(a[0] + b[0]) / 2, (a[1] + b[1]) / 2], ends: [a, b] }; }
+
+// Distance from point p to the segment a-b (image px).
+function toSegment(p, [a, b]) {
+  const dx = b[0] - a[0], dy = b[1] - a[1], n = dx * dx + dy * dy;
+  const t = n ? Math.max(0, Math.min(1, ((p[0] - a[0]) * dx + (p[1] - a[1]) * dy) / n)) : 0;
+  return dist(p, [a[0] + t * dx, a[1] + t * dy]);
 }
 
 function percent(p) { return p === null || p === undefined ? "" : p < 0.001 ? " <0.1%" : ` ${Math.round(100 * p)}%`; }
@@ -340,7 +360,27 @@ function show(state) {
   if (gaps.length) {
     const li = document.createElement("li");
     li.className = "gaps";
-    li.textContent = `pen gap${gaps.length === 1 ? "" : "s"} bridged: ${gaps.length} (dashed circles)`;
+    li.textContent = `pen gap${gaps.length === 1 ? "" : "s"} bridged: ${gaps.length} (dashed circle${gaps.length === 1 ? "" : "s"})`;
+    list.appendChild(li);
+  }
+  const open = state.graph.unbridged || [];
+  if (open.length) {
+    const li = document.createElement("li");
+    li.className = "open-gaps";
+    li.textContent = `pen gap${open.length === 1 ? "" : "s"} kept open by you: ${open.length} (struck-through circle${open.length === 1 ? "" : "s"})`;
+    list.appendChild(li);
+  }
+  if (r.dropped && !state.settings.multi) {
+    // What single-line mode does with ink in several pieces (as the CLI does): the largest
+    // piece is the line; the others stay grey, undrawn.
+    const li = document.createElement("li");
+    li.className = "pieces";
+    li.append(`the ink is in ${r.dropped + 1} pieces: one line keeps the largest, the grey rest is not drawn. `);
+    const keep = document.createElement("button");
+    keep.id = "keep-pieces"; keep.textContent = "Keep every piece (multi-stroke)";
+    keep.title = "Multi-stroke mode draws each piece as its own stroke (and bridges no pen gap)";
+    keep.onclick = () => settingsEdit({ multi: true });
+    li.appendChild(keep);
     list.appendChild(li);
   }
   const twice = state.graph.retraces || [];
@@ -445,6 +485,18 @@ function onClick(event) {
                                               dist(e.at, edit.at) <= edits.tolerance));
     edits.edits.push(edit);
     return apply(edits);
+  }
+  if (tool === "gap") {
+    // A gap kept open: close it again (drop the edits that opened it); a bridged gap: open it.
+    const open = nearest((s.graph.unbridged || []).map(middle), p, 24);
+    if (open) {
+      const edits = JSON.parse(JSON.stringify(currentEdits()));
+      edits.edits = edits.edits.filter((e) => !(e.kind === "unbridge" && toSegment(e.at, open.ends) <= edits.tolerance));
+      return apply(edits);
+    }
+    const gap = nearest((s.graph.bridges || []).map(middle), p, 24);
+    if (gap) apply(withEdit({ kind: "unbridge", at: gap.at }, false));
+    return;
   }
   if (tool === "reverse") {
     const points = studio.line.pts.map((q) => ({ at: q }));
