@@ -12,7 +12,7 @@ from onestroke.errors import InputError
 from vectorize.binarize import ink_image, paper_gray
 from vectorize.drawing import Drawing
 from vectorize.edits import Edits
-from vectorize.fitting import TracedPoint, fit_stroke
+from vectorize.fitting import TracedPoints, fit_stroke
 from vectorize.gaps import bridge_gaps, keep_largest_piece
 from vectorize.graph import MedialGraph
 from vectorize.ink_guard import InkGuard, guard_margin
@@ -127,7 +127,7 @@ def _pairing_costs(verdict: JunctionVerdict) -> tuple[float, float, float]:
 
 
 def _trace(graph: MedialGraph, simple: Simplified, ordering: Ordering, junctions: dict,
-           verdicts: dict, stroke_width: float) -> list[tuple[list[TracedPoint], bool, list[Twin]]]:
+           verdicts: dict, stroke_width: float) -> list[tuple[TracedPoints, bool, list[Twin]]]:
     """Turn branch passes into point lists flagged for filtering (paper 3.4), with the
     stretches each stroke draws twice (`vectorize.retraces`)."""
     # V-spikes: the foot is where both sides' inks merge, its points are uncertain; the
@@ -185,7 +185,8 @@ def _trace(graph: MedialGraph, simple: Simplified, ordering: Ordering, junctions
             tips.append(tip)
         twins = twin_spans([p.branch for p in passes], [p.start for p in passes], spans, not_twins)
         if not parts:
-            result.append(([], closed, twins))
+            result.append((TracedPoints(xy=np.zeros((0, 2)), keep=np.zeros(0, bool), split=np.zeros(0, bool)),
+                           closed, twins))
             continue
         xy, keep, split = np.concatenate(parts), np.concatenate(keeps), np.concatenate(tips)
         for base in sharp_points:
@@ -194,8 +195,7 @@ def _trace(graph: MedialGraph, simple: Simplified, ordering: Ordering, junctions
             dist = np.linalg.norm(xy - center, axis=1)
             near = dist < reach
             keep[near] &= crossing & (dist[near] < 1e-6)
-        traced = [TracedPoint(p, k, t) for p, k, t in zip(xy, keep.tolist(), split.tolist())]
-        result.append((traced, closed, twins))
+        result.append((TracedPoints(xy=xy, keep=keep, split=split), closed, twins))
     return result
 
 
