@@ -72,15 +72,18 @@ def test_a_triple_point_cycles_through_the_pairings_that_keep_one_stroke(served,
     assert seen[0] != seen[1] != seen[2]
     assert "fixed by you" in page.inner_text("#junctions")
     # The list picks any of them: back to the first, fixed now, and the first order again.
-    page.select_option("#junctions select.passes", "0")
+    page.click("#junctions .pass-option[data-index='0']")
     settle(page, 1, f"{TRIPLE}.fixed && JSON.stringify({TRIPLE}.passes) === '{_json(triple['passes'])}'")
     assert order(page) == before
 
-    # Split: not three passes through one point but two crossings, each then cycled.
+    # Split: not three passes through one point but two crossings, each then cycled; the
+    # pairing chosen there goes with it (it would match nothing).
     page.check("input[name=tool][value=split]")
     click_at(page, triple["at"])
-    settle(page, 2, f"!{TRIPLE}")
+    settle(page, 1, f"!{TRIPLE}")
+    assert page.evaluate(f"{STATE}.edits.edits.map(e => e.kind)") == ["split"]
     assert page.evaluate(f"{STATE}.report.intersections") == 5 and page.evaluate(f"{STATE}.report.strokes") == 1
+    assert not page.evaluate(f"{STATE}.report.warnings")
     page.click("#undo")
     settle(page, 1, f"!!{TRIPLE}")
     page.check("input[name=tool][value=pairing]")
@@ -92,6 +95,34 @@ def test_a_triple_point_cycles_through_the_pairings_that_keep_one_stroke(served,
     assert [e["kind"] for e in edits["edits"]] == ["passes"]
     exports_match_the_cli(page, drawing, edits, tmp_path, "embroider", "pes",
                           "--size", "90mm", "--hoop", "100x100", "--color", "#1f3a93")
+
+
+def test_multi_stroke_offers_every_pairing_of_a_triple_point_likeliest_first(served):
+    """In multi-stroke mode all 15 pairings are offered, in the pass scorer's order; the
+    list draws each and outlines the one drawn, which the marker's label names; a click on
+    the marker takes the next, a click in the list any."""
+    page, _ = served["triple"]
+    count = page.evaluate(f"{STATE}.edits.edits.length")
+    page.check("#multi")
+    settle(page, count, f"{STATE}.settings.multi")
+    triple = page.evaluate(TRIPLE)
+    chances = [o["p"] for o in triple["options"]]
+    assert len(chances) == 15 and chances == sorted(chances, reverse=True)
+    assert page.locator("#junctions .pass-option").count() == 15
+    current = page.evaluate(f"[...document.querySelectorAll('#junctions .pass-option')]"
+                            ".findIndex(b => b.classList.contains('current'))")
+    rank = [o["passes"] for o in triple["options"]].index([list(p) for p in triple["passes"]])
+    assert current == rank
+    assert page.evaluate(f"window.studio.labels.some(l => l.text.startsWith('3 passes: pairing {rank + 1}/15'))")
+    assert "all 15 pairings, likeliest first" in page.inner_text("#junctions")
+    click_at(page, triple["at"])
+    following = triple["options"][(rank + 1) % 15]["passes"]
+    settle(page, None, f"JSON.stringify({TRIPLE}.passes) === '{_json(following)}'")
+    assert page.evaluate("document.querySelector('#junctions .pass-option.current').dataset.index") == str((rank + 1) % 15)
+    page.screenshot(path=str(ARTIFACTS / "studio-hand-2b-triple-multi.png"))
+    page.click("#junctions .pass-option[data-index='14']")
+    settle(page, None, f"JSON.stringify({TRIPLE}.passes) === '{_json(triple['options'][14]['passes'])}'")
+    assert page.evaluate(f"window.studio.labels.some(l => l.text.startsWith('3 passes: pairing 15/15'))")
 
 
 def test_a_cursive_word_shows_its_retraces_and_starts_at_a_stems_tip(served, tmp_path):

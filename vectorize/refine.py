@@ -249,12 +249,19 @@ class Refinement:
         if hit is None:
             return None
         *solution, hits = hit
-        self.hits |= hits
+        self._recall(hits)
         return tuple(solution)
 
     def store(self, ends: int, solution: tuple) -> None:
-        mine = {self._index[id(e)] for e in self.edits.of("split", "merge")} & self.hits
-        _bounded_put(self.cache.simplified, self.simplify_key(ends), (*solution, frozenset(mine)))
+        _bounded_put(self.cache.simplified, self.simplify_key(ends), (*solution, self._heeded("split", "merge")))
+
+    # A cached stage keeps which edits it acted on by what they say, not by their place in
+    # the list: the same splits after a different first edit share the entry (its key).
+    def _heeded(self, *kinds: str) -> frozenset:
+        return frozenset(_said(e) for e in self.edits.of(*kinds) if self._index[id(e)] in self.hits)
+
+    def _recall(self, heeded: frozenset) -> None:
+        self.hits |= {i for i, e in enumerate(self.edits.items) if _said(e) in heeded}
 
     def simplify_hooks(self) -> dict:
         """Keyword hooks for `simplify`: splits refuse merges, merges collapse branches."""
@@ -336,14 +343,13 @@ class Refinement:
         if hit is None:
             return None
         best, strokes, hits, fixed = hit
-        self.hits |= hits
+        self._recall(hits)
         self.fixed = dict(fixed)
         return best, strokes
 
     def keep_solved(self, best, strokes) -> None:
-        early = {self._index[id(e)] for e in self.edits.of("split", "merge", "pairing", "passes", "twice", "once")}
-        early &= self.hits
-        _bounded_put(self.cache.solved, self._solved_key(), (best, tuple(strokes), frozenset(early), dict(self.fixed)))
+        early = self._heeded("split", "merge", "pairing", "passes", "twice", "once")
+        _bounded_put(self.cache.solved, self._solved_key(), (best, tuple(strokes), early, dict(self.fixed)))
 
     def fix_passes(self, graph, simple):
         """`simple` with the triple points' pairings the user chose (`passes` edits)."""
@@ -480,6 +486,11 @@ class Refinement:
                             decision="passes", confidence=chance_of(drawn, simple.through_posterior.get(node)),
                             fixed=node in self.fixed, merged=True, passes=tuple(map(tuple, as_angles(drawn, angles))),
                             options=tuple({"passes": as_angles(p, angles), "p": q} for p, q in options))
+
+
+def _said(edit) -> tuple:
+    """What an edit says (kind, place and choice): equal for equal edits."""
+    return (edit.kind, edit.at, edit.pairing, edit.passes)
 
 
 def _pass_counts(solution) -> dict[int, int]:

@@ -248,7 +248,10 @@ class StudioSession:
 
         values = _clean(values, LASER_FIELDS)
         if "passes" in values:
-            values["passes"] = int(values["passes"])
+            try:
+                values["passes"] = int(str(values["passes"]))
+            except ValueError:
+                raise InputError(f"--passes {values['passes']!r} is not a whole number") from None
         settings = laser_settings(profile_path=self.profile, **values)
         drawing = self.vectorize(edits).drawing
         program = laser_program(drawing, settings.profile, settings.toolpath, settings.gcode,

@@ -156,16 +156,33 @@ function draw() {
   arrows(g, t);
   junctionMarkers(g);
   bridges(g);
-  placeLabels(g);
-  // Start markers: where each stroke begins (over a junction the line starts at).
-  s.strokes.forEach((stroke, k) => {
-    const [x, y] = toScreen(...stroke.points[0]);
+  const starts = startPlaces();
+  placeLabels(g, starts.map(([x, y]) => [x - 8, y - 8, 16, 16]));
+  startMarkers(g, starts);
+  if (studio.pen < 1 || studio.playing) penMarker(g, t, penAt);
+  else $("where").textContent = `${Math.round(t.total)} px, ${s.strokes.length} stroke${s.strokes.length === 1 ? "" : "s"}`;
+}
+
+// Start markers: where each stroke begins. One that would hide a junction's marker (a line
+// starting at a junction) sits just beyond it along its stroke.
+function startPlaces() {
+  const s = studio.state;
+  const markers = s.graph.junctions.map((j) => ({ at: toScreen(...j.at), r: j.role === "triple" ? 24 : 11 }));
+  return s.strokes.map((stroke) => {
+    const start = toScreen(...stroke.points[0]);
+    const under = markers.find((m) => Math.hypot(m.at[0] - start[0], m.at[1] - start[1]) < m.r + 6);
+    if (!under) return start;
+    return stroke.points.map((p) => toScreen(...p))
+      .find(([px, py]) => Math.hypot(px - under.at[0], py - under.at[1]) > under.r + 9) || start;
+  });
+}
+
+function startMarkers(g, starts) {
+  starts.forEach(([x, y], k) => {
     g.fillStyle = COLORS.start; g.beginPath(); g.arc(x, y, k === 0 ? 7 : 5, 0, 2 * Math.PI); g.fill();
     g.fillStyle = "#fff"; g.font = "bold 9px sans-serif"; g.textAlign = "center"; g.textBaseline = "middle";
     g.fillText(String(k + 1), x, y + 0.5);
   });
-  if (studio.pen < 1 || studio.playing) penMarker(g, t, penAt);
-  else $("where").textContent = `${Math.round(t.total)} px, ${s.strokes.length} stroke${s.strokes.length === 1 ? "" : "s"}`;
 }
 
 function arrows(g, t) {
@@ -237,42 +254,66 @@ function toSegment(p, [a, b]) {
 
 function percent(p) { return p === null || p === undefined ? "" : p < 0.001 ? " <0.1%" : ` ${Math.round(100 * p)}%`; }
 
-// A triple point: its three passes drawn through the marker, each pair of branch directions
-// joined through the centre, so the pairing is seen, not read.
+// The passes of a triple point in a circle of radius r at (x, y): each pass joins its two
+// branch directions through the centre in its own colour, on a white halo; stub: px it
+// runs on beyond the circle along the real branches, so that each branch shows its pass.
+function drawPasses(g, x, y, r, passes, stub = 0) {
+  const at = (deg, d) => [x + d * Math.cos((deg * Math.PI) / 180), y + d * Math.sin((deg * Math.PI) / 180)];
+  const path = ([a, b]) => {
+    g.beginPath(); g.moveTo(...at(a, r + stub)); g.lineTo(...at(a, r));
+    const [qx, qy] = at(b, r);
+    g.quadraticCurveTo(x, y, qx, qy); g.lineTo(...at(b, r + stub));
+  };
+  g.save();
+  g.lineCap = "round"; g.lineJoin = "round";
+  passes.forEach((pass, k) => {
+    g.strokeStyle = "rgba(255,255,255,0.95)"; g.lineWidth = Math.max(4, r / 3.5); path(pass); g.stroke();
+    g.strokeStyle = PASS_COLORS[k % PASS_COLORS.length]; g.lineWidth = Math.max(2, r / 7); path(pass); g.stroke();
+  });
+  g.restore();
+}
+
+// The place of the pairing drawn among the ones offered (likeliest first), 1-based.
+function passRank(j) { return j.options.findIndex((o) => samePasses(o.passes, j.passes)) + 1; }
+
+// A triple point: its three passes drawn through the marker and along each branch, so the
+// pairing is seen, not read; a square when you chose it.
 function tripleMarker(g, j) {
-  const [x, y] = toScreen(...j.at), r = 16;
-  g.lineWidth = 3; g.strokeStyle = COLORS.passes; g.fillStyle = "rgba(255,255,255,0.9)";
+  const [x, y] = toScreen(...j.at), r = 20;
+  g.lineWidth = 3; g.strokeStyle = COLORS.passes; g.fillStyle = "rgba(255,255,255,0.92)";
   g.beginPath();
   if (j.fixed) g.rect(x - r - 2, y - r - 2, 2 * r + 4, 2 * r + 4); else g.arc(x, y, r + 2, 0, 2 * Math.PI);
   g.fill(); g.stroke();
-  j.passes.forEach(([a, b], k) => {
-    const ra = (a * Math.PI) / 180, rb = (b * Math.PI) / 180;
-    g.strokeStyle = PASS_COLORS[k % PASS_COLORS.length]; g.lineWidth = 2.5;
-    g.beginPath(); g.moveTo(x + r * Math.cos(ra), y + r * Math.sin(ra));
-    g.quadraticCurveTo(x, y, x + r * Math.cos(rb), y + r * Math.sin(rb)); g.stroke();
-  });
-  const k = j.options.findIndex((o) => samePasses(o.passes, j.passes));
-  label(g, `3 passes${j.confidence === null ? " (straightest)" : percent(j.confidence)} · ${k + 1}/${j.options.length}`,
-    x, y, r + 6);
+  drawPasses(g, x, y, r - 2, j.passes, 12);
+  const scorer = j.confidence === null ? " (straightest)" : percent(j.confidence);
+  label(g, `3 passes: pairing ${passRank(j)}/${j.options.length}${scorer}${j.fixed ? " · yours" : ""}`, x, y, r + 12);
 }
 
 // A marker's text, beside the marker at (x, y) of radius `gap`; drawn by `placeLabels`
 // once every marker is drawn.
 function label(g, text, x, y, gap) { studio.labels.push({ text, x, y, gap }); }
 
-// Each text on a white halo so that it reads over the curve, right of its marker, else
-// left, below or above, wherever it covers no marker and no text placed before (junctions
-// a few px apart would print over each other).
-function placeLabels(g) {
+// Each text on a white box so that it reads over the curve, right of its marker, else
+// left, below or above, wherever it stays on the canvas and covers no marker (nor `more`
+// boxes: [x, y, w, h]) and no text placed before (junctions a few px apart would print
+// over each other).
+function placeLabels(g, more = []) {
   g.font = "11px sans-serif"; g.textAlign = "left"; g.textBaseline = "middle";
-  const boxes = studio.labels.map(({ x, y, gap }) => [x - gap, y - gap, 2 * gap, 2 * gap]);
-  const h = 13;
+  const boxes = studio.labels.map(({ x, y, gap }) => [x - gap, y - gap, 2 * gap, 2 * gap]).concat(more);
+  const h = 13, c = $("canvas");
+  const placed = [];
   for (const { text, x, y, gap } of studio.labels) {
+    // Two nodes a pixel or two apart (a split crossing) would print the same text twice.
+    if (placed.some((q) => q.text === text && Math.hypot(q.x - x, q.y - y) < 12)) continue;
+    placed.push({ text, x, y });
     const w = g.measureText(text).width;
     const spots = [[x + gap, y], [x - gap - w, y], [x - w / 2, y + gap + h / 2], [x - w / 2, y - gap - h / 2]];
     const covers = (sx, sy, b) => sx < b[0] + b[2] && b[0] < sx + w && sy - h / 2 < b[1] + b[3] && b[1] < sy + h / 2;
-    const [lx, ly] = spots.find(([sx, sy]) => !boxes.some((b) => covers(sx, sy, b))) || spots[0];
+    const inside = (sx, sy) => sx >= 2 && sx + w <= c.clientWidth - 2 && sy - h / 2 >= 0 && sy + h / 2 <= c.clientHeight;
+    const [lx, ly] = spots.find(([sx, sy]) => inside(sx, sy) && !boxes.some((b) => covers(sx, sy, b))) ||
+      spots.find(([sx, sy]) => inside(sx, sy)) || spots[0];
     boxes.push([lx, ly - h / 2, w, h]);
+    g.fillStyle = "rgba(255,255,255,0.8)"; g.fillRect(lx - 2, ly - h / 2, w + 4, h);
     g.strokeStyle = "rgba(255,255,255,0.9)"; g.lineWidth = 3; g.lineJoin = "round"; g.strokeText(text, lx, ly);
     g.fillStyle = "#222"; g.fillText(text, lx, ly);
   }
@@ -347,9 +388,12 @@ function show(state) {
     const where = `(${j.at[0].toFixed(0)}, ${j.at[1].toFixed(0)})`;
     li.style.color = COLORS[j.decision];
     if (j.role === "triple") {
-      li.append(`${where} three passes · ${j.confidence === null ? "straightest" : "pass scorer" + percent(j.confidence)} `);
+      const offered = state.settings.multi ? `all ${j.options.length} pairings`
+        : `the ${j.options.length} pairings that keep one line`;
+      li.append(`${where} three passes: pairing ${passRank(j)} · ` +
+        `${j.confidence === null ? "straightest" : "pass scorer" + percent(j.confidence)}` +
+        `${j.fixed ? " · fixed by you" : ""} · ${offered}, likeliest first:`);
       li.appendChild(passChoice(j));
-      if (j.fixed) li.append(" · fixed by you");
     } else {
       li.textContent = `${where} ${j.decision} · CNN p(cross) ${(j.p_crossing * 100).toFixed(0)}%` +
         (j.fixed ? " · fixed by you" : "");
@@ -407,19 +451,30 @@ function show(state) {
   refreshPanel();
 }
 
-// The pairings a triple point may take (each keeps the line one stroke), likeliest first.
+// The pairings a triple point may take, likeliest first (single-line mode: those that keep
+// the line one stroke; multi-stroke: all 15), each a small drawing of its passes with its
+// place and the pass scorer's posterior; the one drawn is outlined. A click picks one.
 function passChoice(j) {
-  const select = document.createElement("select");
-  select.className = "passes"; select.title = "How the pen went through: the pairs of branch directions (degrees)";
+  const box = document.createElement("div");
+  box.className = "pass-options";
+  const dpr = window.devicePixelRatio || 1;
   j.options.forEach((o, k) => {
-    const option = document.createElement("option");
-    option.value = String(k);
-    option.textContent = `${k + 1}: ` + o.passes.map(([a, b]) => `${Math.round(a)}°–${Math.round(b)}°`).join(", ") + percent(o.p);
-    option.selected = samePasses(o.passes, j.passes);
-    select.appendChild(option);
+    const button = document.createElement("button");
+    button.type = "button"; button.dataset.index = String(k);
+    button.className = "pass-option" + (samePasses(o.passes, j.passes) ? " current" : "");
+    button.title = `pairing ${k + 1}${percent(o.p)}: passes ` +
+      o.passes.map(([a, b]) => `${Math.round(a)}°–${Math.round(b)}°`).join(", ");
+    const c = document.createElement("canvas");
+    c.width = c.height = Math.round(34 * dpr); c.style.width = c.style.height = "34px";
+    const g = c.getContext("2d"); g.scale(dpr, dpr);
+    drawPasses(g, 17, 17, 13, o.passes, 2);
+    const caption = document.createElement("span");
+    caption.textContent = `${k + 1}${percent(o.p)}`;
+    button.append(c, caption);
+    button.onclick = () => choosePasses(j, o);
+    box.appendChild(button);
   });
-  select.onchange = () => choosePasses(j, j.options[Number(select.value)]);
-  return select;
+  return box;
 }
 
 function choosePasses(j, option) {
@@ -446,7 +501,13 @@ function onClick(event) {
   if (tool === "pairing" || tool === "split") {
     const j = nearest(crossings, p, 18);
     if (!j) return;
-    if (tool === "split") return apply(withEdit({ kind: "split", at: j.at }, false));
+    if (tool === "split") {
+      // A pairing chosen at this junction has nothing left to act on once it is split.
+      const edits = withEdit({ kind: "split", at: j.at }, false);
+      edits.edits = edits.edits.filter((e) => !((e.kind === "pairing" || e.kind === "passes") &&
+                                              dist(e.at, j.at) <= edits.tolerance));
+      return apply(edits);
+    }
     if (j.role === "triple") {
       // The next of the pairings that keep one stroke, in the order of their likelihood.
       if (!j.options.length) return;
@@ -548,7 +609,7 @@ function frame(now) {
 function play() {
   if (studio.playing) { studio.playing = false; $("play").textContent = "▶ Play"; return; }
   if (studio.pen >= 1) studio.pen = 0;
-  studio.playing = true; lastFrame = 0; $("play").textContent = "⏸ Pause";
+  studio.playing = true; lastFrame = 0; $("play").textContent = "▮▮ Pause";
   requestAnimationFrame(frame);
 }
 
@@ -610,7 +671,10 @@ function setup() {
   };
   $("open").onchange = async () => {
     const file = $("open").files[0]; if (!file) return;
-    try { apply(JSON.parse(await file.text())); } catch (error) { report(error); }
+    let data;
+    try { data = JSON.parse(await file.text()); }
+    catch (error) { report(new Error(`${file.name} is not an edits file (not JSON)`)); }
+    if (data !== undefined) apply(data);
     $("open").value = "";
   };
   studio.image.onload = draw;
