@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import time
 from dataclasses import replace
-from typing import NamedTuple
+from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
 
@@ -23,12 +23,14 @@ from vectorize.medial_axis import medial_axis
 from vectorize.outline import outline_rings
 from vectorize.options import InputFrame, VectorizeOptions, VectorizeReport, VectorizeResult
 from vectorize.pruning import prune, trim_free_ends
-from vectorize.refine import Refinement, StageCache, Unbridging
 from vectorize.retraces import Twin, foot_is_retraced, twin_spans
 from vectorize.route_inspection import connect_pairings, plan_routes
 from vectorize.simplify import Simplified, is_t_shape, directions, simplify, slots
 from vectorize.stroke import Stroke
 from vectorize.traversal import Ordering, order_strokes
+
+if TYPE_CHECKING:  # the studio's refinement is imported where edits or a session ask for it
+    from vectorize.refine import Refinement, StageCache
 
 # Vanishing-angle thresholds (notes: 0.95 single-line, 0.90 multi-line).
 PRUNE_SINGLE, PRUNE_MULTI = 0.95, 0.90
@@ -375,6 +377,8 @@ def _front(image: np.ndarray, options: VectorizeOptions, clock: _Clock, cache: S
     refuse = None
     if not options.multi:
         if edits is not None and edits.of("unbridge"):
+            from vectorize.refine import Unbridging
+
             refuse = Unbridging(edits, output_matrix(ink.scale, frame or _pixel_frame(image)))
         bridge_gaps(graph, stroke_width=w, made=bridges, refuse=refuse)
         dropped = keep_largest_piece(graph)
@@ -401,6 +405,9 @@ def run_pipeline(image: np.ndarray, options: VectorizeOptions, *,
         frame = _pixel_frame(image)
     refining = edits is not None or cache is not None
     if refining:
+        # Only the studio and --edits refine: a plain run never imports (or compiles) it.
+        from vectorize.refine import Refinement, StageCache
+
         edits = edits if edits is not None else Edits()
         options = edits.applied_to(options)
         cache = cache if cache is not None else StageCache()
