@@ -32,7 +32,7 @@ with open(listing, "w") as fh:
 """
 
 # Not on the path of a plain `onestroke vectorize IN.png -o OUT.svg` with stderr in a pipe.
-NOT_IMPORTED = ("rich", "vectorize.debug_overlay", "skimage.transform._warps", "skimage.filters._gaussian",
+NOT_IMPORTED = ("rich", "vectorize.debug_overlay", "vectorize.refine", "vectorize.pass_choices", "skimage.transform._warps", "skimage.filters._gaussian",
                 "fabrication.embroidery", "fabrication.laser", "fabrication.studio", "machines",
                 "pyembroidery", "svgelements", "torch")
 

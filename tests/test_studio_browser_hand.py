@@ -2,7 +2,8 @@
 point (six branches, three passes) clicked through its pairings, picked from its list and
 split into two crossings; a cursive word whose stems are drawn down and back up, with two
 pen gaps (the stretches drawn twice and the bridged gaps shown; the line started at the
-tip of its lead-in; a stretch drawn twice made once); and the page's exports against the CLI's bytes with those edits.
+tip of its lead-in; a stretch drawn twice made once; a bridged gap opened and closed); and
+the page's exports against the CLI's bytes with those edits.
 Screenshots go to test-artifacts/."""
 
 from __future__ import annotations
@@ -71,15 +72,18 @@ def test_a_triple_point_cycles_through_the_pairings_that_keep_one_stroke(served,
     assert seen[0] != seen[1] != seen[2]
     assert "fixed by you" in page.inner_text("#junctions")
     # The list picks any of them: back to the first, fixed now, and the first order again.
-    page.select_option("#junctions select.passes", "0")
+    page.click("#junctions .pass-option[data-index='0']")
     settle(page, 1, f"{TRIPLE}.fixed && JSON.stringify({TRIPLE}.passes) === '{_json(triple['passes'])}'")
     assert order(page) == before
 
-    # Split: not three passes through one point but two crossings, each then cycled.
+    # Split: not three passes through one point but two crossings, each then cycled; the
+    # pairing chosen there goes with it (it would match nothing).
     page.check("input[name=tool][value=split]")
     click_at(page, triple["at"])
-    settle(page, 2, f"!{TRIPLE}")
+    settle(page, 1, f"!{TRIPLE}")
+    assert page.evaluate(f"{STATE}.edits.edits.map(e => e.kind)") == ["split"]
     assert page.evaluate(f"{STATE}.report.intersections") == 5 and page.evaluate(f"{STATE}.report.strokes") == 1
+    assert not page.evaluate(f"{STATE}.report.warnings")
     page.click("#undo")
     settle(page, 1, f"!!{TRIPLE}")
     page.check("input[name=tool][value=pairing]")
@@ -91,6 +95,34 @@ def test_a_triple_point_cycles_through_the_pairings_that_keep_one_stroke(served,
     assert [e["kind"] for e in edits["edits"]] == ["passes"]
     exports_match_the_cli(page, drawing, edits, tmp_path, "embroider", "pes",
                           "--size", "90mm", "--hoop", "100x100", "--color", "#1f3a93")
+
+
+def test_multi_stroke_offers_every_pairing_of_a_triple_point_likeliest_first(served):
+    """In multi-stroke mode all 15 pairings are offered, in the pass scorer's order; the
+    list draws each and outlines the one drawn, which the marker's label names; a click on
+    the marker takes the next, a click in the list any."""
+    page, _ = served["triple"]
+    count = page.evaluate(f"{STATE}.edits.edits.length")
+    page.check("#multi")
+    settle(page, count, f"{STATE}.settings.multi")
+    triple = page.evaluate(TRIPLE)
+    chances = [o["p"] for o in triple["options"]]
+    assert len(chances) == 15 and chances == sorted(chances, reverse=True)
+    assert page.locator("#junctions .pass-option").count() == 15
+    current = page.evaluate(f"[...document.querySelectorAll('#junctions .pass-option')]"
+                            ".findIndex(b => b.classList.contains('current'))")
+    rank = [o["passes"] for o in triple["options"]].index([list(p) for p in triple["passes"]])
+    assert current == rank
+    assert page.evaluate(f"window.studio.labels.some(l => l.text.startsWith('3 passes: pairing {rank + 1}/15'))")
+    assert "all 15 pairings, likeliest first" in page.inner_text("#junctions")
+    click_at(page, triple["at"])
+    following = triple["options"][(rank + 1) % 15]["passes"]
+    settle(page, None, f"JSON.stringify({TRIPLE}.passes) === '{_json(following)}'")
+    assert page.evaluate("document.querySelector('#junctions .pass-option.current').dataset.index") == str((rank + 1) % 15)
+    page.screenshot(path=str(ARTIFACTS / "studio-hand-2b-triple-multi.png"))
+    page.click("#junctions .pass-option[data-index='14']")
+    settle(page, None, f"JSON.stringify({TRIPLE}.passes) === '{_json(triple['options'][14]['passes'])}'")
+    assert page.evaluate(f"window.studio.labels.some(l => l.text.startsWith('3 passes: pairing 15/15'))")
 
 
 def test_a_cursive_word_shows_its_retraces_and_starts_at_a_stems_tip(served, tmp_path):
@@ -139,6 +171,43 @@ def test_a_cursive_word_shows_its_retraces_and_starts_at_a_stems_tip(served, tmp
     edits = page.evaluate(f"{STATE}.edits")
     exports_match_the_cli(page, drawing, edits, tmp_path, "laser", "gcode", "--size", "80mm", "--feed", "1500mm/min",
                           "--power", "60%", "--passes", "1", "--origin", "lower-left")
+
+
+def test_a_bridged_gap_opened_closed_undone_and_both_pieces_kept(served, tmp_path):
+    """The gap tool on the word's pen gap before its e: open, the line keeps the largest
+    piece and the page says so; closed again by a click; undone; both pieces kept by the
+    page's multi-stroke button. The page's SVG with the gap open is the CLI's."""
+    page, drawing = served["little"]
+    before = page.evaluate(f"{STATE}.edits.edits.length")
+    gap = max(page.evaluate(f"{STATE}.graph.bridges"), key=lambda g: g[0][0])  # the e's
+    middle = [(gap[0][0] + gap[1][0]) / 2, (gap[0][1] + gap[1][1]) / 2]
+    page.check("input[name=tool][value=gap]")
+    click_at(page, [5, 5])  # nothing there: the page says what the tool wants
+    page.wait_for_function("!document.getElementById('hint').hidden")
+    assert "click on a dashed circle" in page.inner_text("#hint")
+    click_at(page, middle)
+    settle(page, before + 1)
+    assert page.is_hidden("#hint")
+    assert page.evaluate(f"{STATE}.edits.edits.slice(-1)[0].kind") == "unbridge"
+    assert page.evaluate(f"{STATE}.graph.unbridged") == [gap] and len(page.evaluate(f"{STATE}.graph.bridges")) == 1
+    assert page.evaluate(f"{STATE}.report.dropped") == 1 and page.evaluate(f"{STATE}.report.strokes") == 1
+    assert "the ink is in 2 pieces" in page.inner_text("#junctions") and page.is_visible("#keep-pieces")
+    assert any("1 separate ink piece(s) dropped" in w for w in page.evaluate(f"{STATE}.report.warnings"))
+    page.screenshot(path=str(ARTIFACTS / "studio-hand-6-gap-opened.png"))
+    _, svg = download(page, "[data-export=svg]")
+    assert svg == cli_bytes("vectorize", drawing, page.evaluate(f"{STATE}.edits"), tmp_path, ".svg")
+
+    click_at(page, middle)  # on the struck-through circle: closed again
+    settle(page, before)
+    assert len(page.evaluate(f"{STATE}.graph.bridges")) == 2 and page.evaluate(f"{STATE}.report.dropped") == 0
+    page.click("#undo")
+    settle(page, before + 1)
+    assert page.evaluate(f"{STATE}.graph.unbridged") == [gap]
+    page.click("#keep-pieces")
+    settle(page, before + 1, f"{STATE}.settings.multi")
+    assert page.evaluate(f"{STATE}.report.strokes") >= 2 and page.evaluate(f"{STATE}.report.dropped") == 0
+    assert not [w for w in page.evaluate(f"{STATE}.report.warnings") if "unbridge" in w]
+    page.check("input[name=tool][value=pairing]")
 
 
 def exports_match_the_cli(page, drawing, edits, tmp_path, command: str, kind: str, *flags) -> None:

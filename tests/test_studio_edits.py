@@ -135,6 +135,22 @@ def test_unmatched_edit_is_a_warning(loop_png):
     assert any("matched nothing" in w for w in result.report.warnings)
 
 
+def test_cached_warnings_name_the_edits_a_fresh_run_names(loop_png):
+    """A cached stage remembers the edits it acted on by what they say: the same split after
+    another first edit (an undo, an opened file) is still heeded, and the edit that matched
+    nothing is still the one named."""
+    cache = StageCache()
+    junction = crossing(vectorize_file(loop_png, OPTIONS, edits=Edits(), cache=cache))
+    split, astray = Edit(kind="split", at=junction.at), Edit(kind="reverse", at=(2.0, 2.0))
+    for items in ((astray, split), (split, astray), (split,)):
+        cached = vectorize_file(loop_png, OPTIONS, edits=Edits(items=items), cache=cache)
+        fresh = vectorize_file(loop_png, OPTIONS, edits=Edits(items=items))
+        assert cached.report.warnings == fresh.report.warnings, items
+        skipped = [w for w in cached.report.warnings if "matched nothing" in w]
+        assert skipped == ([f"edit {items.index(astray) + 1} (reverse at 2, 2) matched nothing within 8 px and "
+                            "was skipped"] if astray in items else [])
+
+
 def test_cli_replays_edits_byte_for_byte(loop_png, tmp_path):
     cache = StageCache()
     base = vectorize_file(loop_png, OPTIONS, edits=Edits(), cache=cache)

@@ -1,5 +1,6 @@
 """The edits the hand drawings need, through the library (no browser): every pairing the
-page offers at a triple point keeps the line one stroke and is drawn as chosen; the
+page offers at a triple point keeps the line one stroke and is drawn as chosen (in
+multi-stroke mode: all 15, likeliest first, each drawn as chosen); the
 session's cached answers to a triple point split and a crossing then paired, and to a merge
 and a "twice" on the cursive word, are a fresh run's bytes (the browser test compares
 passes, start, once and reverse with the CLI)."""
@@ -34,6 +35,25 @@ def test_every_offered_triple_pairing_is_one_stroke_drawn_as_chosen(drawings):
         (now,) = [j for j in result.graph.junctions if j.role == "triple"]
         assert result.report.strokes == 1 and not result.report.warnings
         assert [list(p) for p in now.passes] == option["passes"] and now.fixed
+
+
+def test_multi_stroke_offers_all_fifteen_pairings_likeliest_first_each_drawn_as_chosen(drawings):
+    path, cache = drawings["triple"], StageCache()
+    single = vectorize_file(path, VectorizeOptions(), edits=Edits(), cache=cache)
+    base = vectorize_file(path, VectorizeOptions(), edits=Edits(multi=True), cache=cache)
+    (triple,) = [j for j in base.graph.junctions if j.role == "triple"]
+    (one_line,) = [j for j in single.graph.junctions if j.role == "triple"]
+    offered = [o["passes"] for o in triple.options]
+    assert len(offered) == 15 and len({str(p) for p in offered}) == 15  # every pairing of six branches, once
+    assert [o["passes"] for o in one_line.options] == [p for p in offered if p in [o["passes"] for o in one_line.options]]
+    chances = [o["p"] for o in triple.options]
+    assert chances == sorted(chances, reverse=True) and triple.options[0]["passes"] == [list(p) for p in triple.passes]
+    for option in triple.options:
+        edits = Edits(multi=True, items=(Edit(kind="passes", at=triple.at, passes=option["passes"]),))
+        result = vectorize_file(path, VectorizeOptions(), edits=edits, cache=cache)
+        (now,) = [j for j in result.graph.junctions if j.role == "triple"]
+        assert [list(p) for p in now.passes] == option["passes"] and now.fixed
+        assert not [w for w in result.report.warnings if "matched nothing" in w]
 
 
 def test_cached_answers_are_a_fresh_runs_bytes(drawings):

@@ -45,6 +45,23 @@ def test_a_straight_chord_across_a_corner_is_outside_the_ink():
     assert curve_excess(guard, arm.control)[0] <= 0.0
 
 
+def test_strays_is_the_excess_wherever_a_point_is_outside():
+    # The cheap check (nearest ball first) against the full one, on points all over a real
+    # drawing's page: inside the ink, near its edge, at the corner's tip, on the paper.
+    guard = _guard(render_polylines([[(80, 60), (200, 340), (320, 60)], [(40, 380), (360, 380)]], width=6.0))
+    rng = np.random.default_rng(7)
+    on_line = guard.points[rng.integers(len(guard.points), size=3000)] + rng.normal(scale=3.0, size=(3000, 2))
+    points = np.vstack([on_line, rng.uniform(0, 400, size=(2000, 2))])
+    full, cheap = guard.excess(points), guard.strays(points)
+    outside = full > 0.0
+    assert 500 < outside.sum() < len(points) - 500  # both kinds, many of each
+    assert np.array_equal(cheap[outside], full[outside])
+    assert (cheap[~outside] <= 0.0).all()
+    # Hence the same answer to "does it leave, how far at most, where".
+    assert cheap.max() == full.max() and np.argmax(cheap) == np.argmax(full)
+    inside = points[~outside]
+    assert guard.strays(inside).max() <= 0.0 and guard.excess(inside).max() <= 0.0
+
 
 def test_a_piece_shrunk_to_a_point_is_checked_at_its_point():
     """A fitted piece whose four control points coincide (loops.png at threshold 0.50 made

@@ -26,7 +26,7 @@ ROOT = Path(__file__).resolve().parents[1]
 def _nodes(scene):
     """The vectorizer's own stages on a scene: (ink, graph, triple-point nodes)."""
     image = np.round(scene.gray * 255.0).astype(np.uint8)
-    ink, _, graph, _, _ = _front(image, VectorizeOptions(), _Clock())
+    ink, _, graph, *_ = _front(image, VectorizeOptions(), _Clock())
     return ink, graph, list(merge_triple_points(graph, stroke_width=ink.stroke_width))
 
 

@@ -21,7 +21,12 @@ Kinds, and the stage each one re-runs from:
   becomes an end of the route, which then retraces other branches): from traversal;
 - `twice` / `once` (single-line mode: the branch at the position is, or is not, where the
   line goes back over itself when it must retrace something: route inspection then
-  prefers, or avoids, retracing it): from traversal.
+  prefers, or avoids, retracing it): from traversal;
+- `unbridge` (single-line mode: the pen gap that gap bridging joined at the position, its
+  middle, stays open: its two sides are separate strokes): from gap bridging. When the ink
+  then falls into pieces, single-line mode keeps the largest, as it does for any drawing
+  of several pieces, and says so in a warning; multi-stroke mode bridges no gap, so there
+  the edit has nothing to do and is not reported as unmatched.
 """
 
 from __future__ import annotations
@@ -34,7 +39,7 @@ from onestroke.errors import InputError
 
 FORMAT = "onestroke-edits"
 PAIRINGS = ("crossing", "touching", "third")
-KINDS = ("pairing", "passes", "split", "merge", "reverse", "start", "twice", "once")
+KINDS = ("pairing", "passes", "split", "merge", "reverse", "start", "twice", "once", "unbridge")
 # Default match radius in output px: a click lands within a few pixels of a marker.
 TOLERANCE = 8.0
 

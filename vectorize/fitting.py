@@ -13,16 +13,23 @@ from vectorize.retraces import Twin, mirror_flags, mirror_keep, rolled, share_pi
 from vectorize.stroke import Stroke
 
 
-@dataclass(frozen=True)
-class TracedPoint:
-    """A point of a traversed stroke with what the filter needs to know about it: keep it
-    for the fit; split the fit there; a corner (split, and the joint goes where the two
-    sides' tangents meet)."""
+@dataclass(frozen=True, kw_only=True)
+class TracedPoints:
+    """The points of a traversed stroke with what the filter needs to know about each, as
+    arrays (a stroke has thousands of points: one object per point cost more than the fit).
+
+    xy: (N, 2) px; keep: (N,) bool, keep the point for the fit; split: (N,) bool, split the
+    fit there; corner: (N,) bool or None (none), a corner (split, and the joint goes where
+    the two sides' tangents meet).
+    """
 
     xy: np.ndarray
-    keep: bool
-    split: bool
-    corner: bool = False
+    keep: np.ndarray
+    split: np.ndarray
+    corner: np.ndarray | None = None
+
+    def __len__(self) -> int:
+        return len(self.xy)
 
 
 def _dedupe(points: np.ndarray, min_step: float) -> np.ndarray:
@@ -236,19 +243,20 @@ def _settle(pieces: list[np.ndarray], cuts: list[int], xy: np.ndarray, twins: li
         pieces[k] = keep_in_ink(whole, _open_fit(whole, sigma), guard, _open_fit, sigma)
 
 
-def fit_stroke(traced: list[TracedPoint], *, closed: bool, sigma: float, stroke_width: float,
+def fit_stroke(traced: TracedPoints, *, closed: bool, sigma: float, stroke_width: float,
                guard: InkGuard | None = None, twins: tuple[Twin, ...] = ()) -> Stroke:
     """Filter, split at sharp features (Y-feet tips, cusps, corners) and fit one traversed
     stroke; with `guard`, every piece is brought back inside the ink where it strays
     (`vectorize.ink_guard`). twins: stretches the stroke draws twice (`vectorize.retraces`):
     fitted once, the later pass repeats the earlier one's curve."""
-    xy = np.array([p.xy for p in traced])
-    keep = np.array([p.keep for p in traced])
-    split = np.array([p.split for p in traced])
+    xy = np.array(traced.xy, dtype=float).reshape(-1, 2)
+    keep = np.array(traced.keep, dtype=bool)
+    split = np.array(traced.split, dtype=bool)
     corner = np.zeros(len(xy), dtype=bool)
     found = sharp_corners(xy, stroke_width, closed=closed)
     corner[found[keep[found] & ~split[found]]] = True
-    corner |= np.array([p.corner for p in traced], dtype=bool)
+    if traced.corner is not None:
+        corner |= np.asarray(traced.corner, dtype=bool)
     split |= corner
     twins = valid_twins(xy, twins)
     mirror_flags(twins, split, corner)

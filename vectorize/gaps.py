@@ -52,13 +52,16 @@ def end_direction(graph: MedialGraph, node: int, stroke_width: float) -> np.ndar
     return -slot_direction(graph, slots(graph, node)[0], DIRECTION_REACH * stroke_width)
 
 
-def bridge_gaps(graph: MedialGraph, *, stroke_width: float, made: list | None = None) -> int:
+def bridge_gaps(graph: MedialGraph, *, stroke_width: float, made: list | None = None, refuse=None) -> int:
     """Join free ends of different pieces across pen gaps, in place; returns the bridges made.
 
     Pairs are taken cheapest first (gap length in widths plus the two ends' angles off the
     gap, in radians). Ends of different pieces are always joined; ends of one piece only
     while more than two free ends are left. made: a list that receives each bridge's two
-    ends, ((x, y), (x, y)) px (the page shows them).
+    ends, ((x, y), (x, y)) px (the page shows them). refuse: None or a callable
+    refuse(a, b) -> bool asked before each bridge is made, with its two ends (2,) px: True
+    leaves that gap open (a user said the two sides are separate strokes); the ends may
+    still be bridged elsewhere.
     """
     ends = [n for n, incident in graph.incident.items() if len(incident) == 1]
     if len(ends) < 2:
@@ -91,19 +94,21 @@ def bridge_gaps(graph: MedialGraph, *, stroke_width: float, made: list | None = 
         # than a single line can have (two), so a nearly closed "C" stays open.
         if find(piece[a]) == find(piece[b]) and open_ends < 4:
             continue
+        if refuse is not None and refuse(graph.positions[a], graph.positions[b]):
+            continue
         open_ends -= 2
         root[find(piece[a])] = find(piece[b])
         used.update((a, b))
         _add_bridge(graph, a, b, length, made)
         bridges += 1
-    bridges += _bridge_to_lines(graph, stroke_width, heading, piece, root, made)
+    bridges += _bridge_to_lines(graph, stroke_width, heading, piece, root, made, refuse)
     if bridges:
         graph.dissolve_degree_two()
     return bridges
 
 
 def _bridge_to_lines(graph: MedialGraph, stroke_width: float, heading: dict, piece: dict, root: dict,
-                     made: list | None = None) -> int:
+                     made: list | None = None, refuse=None) -> int:
     """Join free ends of pieces that are still apart to the nearest centre-line point of
     another piece that each points at (within `BRIDGE_WIDTHS` and `BRIDGE_ANGLE`) where that
     line turns with its outside to the end (`_faces`), cheapest first, splitting the branch
@@ -111,7 +116,7 @@ def _bridge_to_lines(graph: MedialGraph, stroke_width: float, heading: dict, pie
 
     Pieces with less centre line than `BRIDGE_WIDTHS` widths (dust, a dot) are not joined.
     piece: node -> piece index; root: the union-find over pieces of the end-to-end bridges;
-    made: as in `bridge_gaps`."""
+    made, refuse: as in `bridge_gaps`."""
     find = partial(_find, root)
     reach = BRIDGE_WIDTHS * stroke_width + BRIDGE_SLACK
     length: dict[int, float] = {}
@@ -148,6 +153,8 @@ def _bridge_to_lines(graph: MedialGraph, stroke_width: float, heading: dict, pie
         target_piece = piece[graph.branches[bid].a]
         if find(piece[end]) == find(target_piece):
             continue  # already joined by a cheaper bridge
+        if refuse is not None and refuse(graph.positions[end], graph.branches[bid].points[index]):
+            continue
         target = graph.split_branch(bid, index)
         split.add(bid)
         piece[target] = target_piece

@@ -27,12 +27,13 @@ class Branch:
     radii: np.ndarray
     sins: np.ndarray
 
-    @property
-    def edge_lengths(self) -> np.ndarray:
-        return np.linalg.norm(np.diff(self.points, axis=0), axis=1)
-
-    # Cached: pruning asks every leaf for both on every round, and a branch's arrays are
+    # Cached: pruning asks every leaf for these on every round, and a branch's arrays are
     # never changed once made (stages replace branches instead).
+    @cached_property
+    def edge_lengths(self) -> np.ndarray:
+        """(M-1,) px: the length of each edge (read only: shared with derived branches)."""
+        return edge_lengths(self.points)
+
     @cached_property
     def length(self) -> float:
         return float(self.edge_lengths.sum())
@@ -51,7 +52,130 @@ class Branch:
         """This branch read starting at `node`."""
         if node == self.a:
             return self
-        return Branch(self.b, self.a, self.points[::-1], self.radii[::-1], self.sins[::-1])
+        reverse = Branch(self.b, self.a, self.points[::-1], self.radii[::-1], self.sins[::-1])
+        if "edge_lengths" in self.__dict__:
+            # The same edges the other way (|-d| = |d| exactly); sums are taken afresh,
+            # in the new order, as they always were.
+            reverse.__dict__["edge_lengths"] = self.__dict__["edge_lengths"][::-1]
+        return reverse
+
+
+def edge_lengths(points: np.ndarray) -> np.ndarray:
+    """(M, 2) points -> (M-1,) distances between successive points (px).
+
+    The same numbers as `np.linalg.norm(np.diff(points, axis=0), axis=1)` (that is how it
+    sums the squares), without its overhead: this runs on a thousand small arrays per drawing.
+    """
+    d = points[1:] - points[:-1]
+    return np.sqrt(d[:, 0] * d[:, 0] + d[:, 1] * d[:, 1])
+
+
+# `measure_short` measures branches of up to this many points together.
+SHORT = 8
+
+
+def measure_short(branches: list[Branch]) -> None:
+    """Fill in `length` and `significance` of the branches with at most `SHORT` points, all
+    at once (pruning asks for them of every leaf, and most leaves are one or two Voronoi
+    edges: one small array each cost more than the arithmetic).
+
+    The numbers are exactly the properties' own: numpy sums fewer than 8 numbers one after
+    the other (pairwise blocks start at 8), and so do the sums here.
+    """
+    short = [b for b in branches
+             if len(b.points) <= SHORT and len(b.sins) == len(b.points) - 1 and "length" not in b.__dict__]
+    if not short:
+        return
+    counts = np.array([len(b.points) for b in short])
+    # Edges across two branches' arrays are computed too and masked out; the 0 appended
+    # makes every index valid.
+    lengths = np.append(edge_lengths(np.concatenate([b.points for b in short])), 0.0)
+    sins = np.append(np.concatenate([b.sins for b in short]), 0.0)
+    starts = np.concatenate([[0], np.cumsum(counts)[:-1]])
+    column = np.arange(SHORT - 1)
+    mask = column[None, :] < (counts - 1)[:, None]
+    edge_at = np.where(mask, starts[:, None] + column[None, :], -1)
+    sin_at = np.where(mask, (starts - np.arange(len(short)))[:, None] + column[None, :], -1)
+    edges = np.where(mask, lengths[edge_at], 0.0)
+    weighted = np.where(mask, edges * sins[sin_at], 0.0)
+
+    def sums(values: np.ndarray) -> np.ndarray:
+        total = values[:, 0].copy()
+        for k in range(1, values.shape[1]):
+            total += values[:, k]  # + 0.0 past a branch's last edge: exact
+        return total
+
+    total, moment = sums(edges), sums(weighted)
+    for branch, length, weight in zip(short, total.tolist(), moment.tolist()):
+        branch.__dict__["length"] = length
+        branch.__dict__["significance"] = weight / length if length > 0 else 0.0
+
+
+class _Chain:
+    """Branches joined end to end, from node `a` to node `b`, not yet made into one
+    (`MedialGraph.dissolve_degree_two` joins whole runs of degree-2 nodes at once).
+
+    A leaf holds a branch; a join holds two chains, the second without its first point (the
+    node they share: the point joining the branches one by one would have dropped). `back`:
+    read the whole backwards. Joining and reversing cost the same however long the chain.
+    """
+
+    __slots__ = ("a", "b", "part", "back")
+
+    def __init__(self, a: int, b: int, part: "Branch | tuple[_Chain, _Chain]", back: bool = False) -> None:
+        self.a, self.b, self.part, self.back = a, b, part, back
+
+    def oriented_from(self, node: int) -> "_Chain":
+        return self if node == self.a else _Chain(self.b, self.a, self.part, not self.back)
+
+    def joined(self, after: "_Chain") -> "_Chain":
+        """This chain, then `after` without its first point (self.b is after.a)."""
+        return _Chain(self.a, after.b, (self, after))
+
+    def parts(self) -> list[tuple[Branch, bool, bool, bool]]:
+        """(branch, read backwards, drop its first point, drop its last point) from a to b."""
+        parts = []
+        stack = [(self, False, False, False)]  # chains still to read, the next on top
+        while stack:
+            chain, flip, head, tail = stack.pop()
+            back = chain.back != flip
+            if isinstance(chain.part, Branch):
+                parts.append((chain.part, back, head, tail))
+                continue
+            first, second = chain.part
+            if back:  # second read backwards (its dropped first point now last), then first
+                stack += [(first, True, False, tail), (second, True, head, True)]
+            else:
+                stack += [(second, False, True, tail), (first, False, head, False)]
+        return parts
+
+    def branch(self) -> Branch:
+        """The joined branch."""
+        parts = self.parts()
+        points, radii, sins, edges = [], [], [], []
+        for branch, back, head, tail in parts:
+            step = -1 if back else 1
+            cut = slice(1 if head else None, -1 if tail else None)
+            points.append(branch.points[::step][cut])
+            radii.append(branch.radii[::step][cut])
+            sins.append(branch.sins[::step])
+            edges.append(branch.__dict__.get("edge_lengths"))
+        joined = Branch(self.a, self.b, np.concatenate(points), np.concatenate(radii), np.concatenate(sins))
+        # Known edge lengths carry over where each joint's two points are one (they always
+        # are): the joined branch then measures itself without going over every point again.
+        if all(e is not None for e in edges) and all(
+                np.array_equal(_end(p1, True), _end(p2, False)) for p1, p2 in zip(parts, parts[1:])):
+            joined.__dict__["edge_lengths"] = np.concatenate([e[::-1] if p[1] else e for e, p in zip(edges, parts)])
+        return joined
+
+
+def _end(part: tuple[Branch, bool, bool, bool], last: bool) -> np.ndarray:
+    """The first or last point of a chain's part, in the chain's reading, dropped or not."""
+    branch, back, _, _ = part
+    return branch.points[0 if back == last else -1]
+
+
+_NO_POINTS = np.zeros(0)
 
 
 @dataclass
@@ -119,24 +243,44 @@ class MedialGraph:
         return [n for n, inc in self.incident.items() if len(inc) == degree]
 
     def dissolve_degree_two(self) -> None:
-        """Join the two branches at every degree-2 node into one (loops stay as they are)."""
+        """Join the two branches at every degree-2 node into one (loops stay as they are).
+
+        Node by node, in node order, each join a new branch id; the joined arrays are only
+        made once a run of joins is done (a long stroke that lost a spur every few pixels
+        would otherwise be copied once per spur).
+        """
+        chains: dict[int, _Chain] = {}  # joined branch ids whose arrays are not made yet
+
+        def take(bid: int) -> _Chain:
+            branch = self.branches.pop(bid)
+            self.incident[branch.a].remove(bid)
+            self.incident[branch.b].remove(bid)
+            return chains.pop(bid, None) or _Chain(branch.a, branch.b, branch)
+
         for node in [n for n, inc in self.incident.items() if len(inc) == 2]:
             first, second = self.incident[node]
             if first == second:
                 continue  # an isolated closed loop through this node: keep the node
-            b1 = self.remove_branch(first).oriented_from(node)
-            b2 = self.remove_branch(second).oriented_from(node)
-            # b1 reversed runs into node, then b2 leaves it.
-            into = Branch(b1.b, node, b1.points[::-1], b1.radii[::-1], b1.sins[::-1])
-            joined = Branch(into.a, b2.b, np.vstack([into.points, b2.points[1:]]),
-                            np.concatenate([into.radii, b2.radii[1:]]),
-                            np.concatenate([into.sins, b2.sins]))
+            c1 = take(first).oriented_from(node)
+            c2 = take(second).oriented_from(node)
+            # c1 reversed runs into node, then c2 leaves it.
+            joined = c1.oriented_from(c1.b).joined(c2)
             del self.incident[node], self.positions[node], self.radii[node]
-            self.add_branch(joined)
+            # A placeholder branch keeps the graph's bookkeeping (ids, incidence order) exact.
+            chains[self.add_branch(Branch(joined.a, joined.b, _NO_POINTS, _NO_POINTS, _NO_POINTS))] = joined
+        for bid, chain in chains.items():
+            self.branches[bid] = chain.branch()
 
     def copy(self) -> "MedialGraph":
         graph = MedialGraph(dict(self.positions), dict(self.radii),
-                            {k: Branch(b.a, b.b, b.points, b.radii, b.sins) for k, b in self.branches.items()},
+                            {k: _same(b) for k, b in self.branches.items()},
                             {k: list(v) for k, v in self.incident.items()}, dict(self.spans),
                             self._next_node, self._next_branch)
         return graph
+
+
+def _same(branch: Branch) -> Branch:
+    """A copy of `branch` sharing its (never changed) arrays and what it measured of them."""
+    copy = Branch(branch.a, branch.b, branch.points, branch.radii, branch.sins)
+    copy.__dict__.update((k, v) for k, v in branch.__dict__.items() if k not in ("a", "b", "points", "radii", "sins"))
+    return copy

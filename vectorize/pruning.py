@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from vectorize.graph import MedialGraph
+from vectorize.graph import MedialGraph, measure_short
 
 # A leaf that runs on more than this many stroke widths beyond its junction's disc, mostly
 # as a tube, is a stroke's end, whatever its mean object angle. Thick strokes need this:
@@ -29,19 +29,23 @@ def prune(graph: MedialGraph, *, threshold: float, stroke_width: float) -> int:
     length is under the junction radius plus a quarter stroke width). Long tubes stay.
     """
     removed = 0
+    incident, radii = graph.incident, graph.radii
     while True:
+        measure_short(list(graph.branches.values()))
         doomed = []
         for bid, branch in graph.branches.items():
-            da, db = graph.degree(branch.a), graph.degree(branch.b)
-            if branch.a == branch.b or (da == 1) == (db == 1):
+            a, b = branch.a, branch.b
+            leaf_a, leaf_b = len(incident[a]) == 1, len(incident[b]) == 1
+            if a == b or leaf_a == leaf_b:
                 continue  # loops, whole isolated strokes, and inner branches stay
-            junction = branch.b if da == 1 else branch.a
-            reach = branch.length - graph.radii[junction]  # how far it leaves the junction's disc
-            if reach > TUBE_REACH * stroke_width and branch.significance > TUBE_SIGNIFICANCE:
+            junction = b if leaf_a else a
+            reach = branch.length - radii[junction]  # how far it leaves the junction's disc
+            significance = branch.significance
+            if reach > TUBE_REACH * stroke_width and significance > TUBE_SIGNIFICANCE:
                 continue  # a stroke's real end (see TUBE_REACH)
             short = reach < 0.25 * stroke_width
-            if short or branch.significance < threshold:
-                doomed.append((branch.significance, bid))
+            if short or significance < threshold:
+                doomed.append((significance, bid))
         if not doomed:
             break
         # Remove the least significant spur at each junction first: two spurs of one

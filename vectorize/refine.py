@@ -13,6 +13,7 @@ from __future__ import annotations
 from dataclasses import dataclass, replace
 
 import numpy as np
+import shapely
 
 from onestroke.errors import Cancelled
 from vectorize.drawing import Drawing
@@ -40,7 +41,8 @@ class StageCache:
     paper: (blur, max_size) -> (gray, scale) of `vectorize.binarize.paper_gray` (the
     threshold does not change it); axis: (threshold, blur, max_size) -> (ink, rings,
     medial graph before pruning) (the mode does not change them); front: `front_key` ->
-    the pruned (and in single-line mode bridged) graph with its ink.
+    the pruned (and in single-line mode bridged) graph with its ink (the "unbridge" edits
+    change it too).
 
     cancel: None or a callable the pipeline asks between stages; when it says True the run
     stops with `onestroke.errors.Cancelled`. Every entry is stored only once its stage has
@@ -62,14 +64,15 @@ class StageCache:
         if self.cancel is not None and self.cancel():
             raise Cancelled("a newer request replaced this one")
 
-    def front_for(self, image, options, compute):
-        """Binarization to gap bridging for these options, computed once; compute(cache)
-        may use `stage` for the parts that fewer options change."""
+    def front_for(self, image, options, compute, edits: Edits | None = None):
+        """Binarization to gap bridging for these options (and the edits' "unbridge"
+        positions), computed once; compute(cache) may use `stage` for the parts that fewer
+        options change."""
         if self._image is not image:
             for store in (self.paper, self.axis, self.front, self.simplified, self.solved):
                 store.clear()
             self._image = image
-        key = front_key(options)
+        key = front_key(options, edits)
         if key not in self.front:
             _bounded_put(self.front, key, compute(self))
         return self.front[key]
@@ -82,8 +85,45 @@ class StageCache:
         return store[key]
 
 
-def front_key(options) -> tuple:
-    return (options.threshold, options.blur, options.multi, options.max_size)
+def front_key(options, edits: Edits | None = None) -> tuple:
+    """What binarization to gap bridging depend on: threshold, blur, mode, size and, in
+    single-line mode, the gaps the user kept open (with the match radius)."""
+    key = (options.threshold, options.blur, options.multi, options.max_size)
+    gaps = () if edits is None or options.multi else tuple(e.at for e in edits.of("unbridge"))
+    return key + (gaps, edits.tolerance) if gaps else key
+
+
+def to_working(matrix: np.ndarray, at) -> np.ndarray:
+    """(x, y) output px -> (2,) working px, for `matrix` 2x3 working px -> output px."""
+    return (np.asarray(at, dtype=float) - matrix[:, 2]) * (1.0 / float(matrix[0, 0]))
+
+
+def to_output(matrix: np.ndarray, xy) -> tuple[float, float]:
+    """(2,) working px -> (x, y) output px, rounded to 0.001 px (as the page gets it)."""
+    out = matrix[:, :2] @ np.asarray(xy, dtype=float) + matrix[:, 2]
+    return (round(float(out[0]), 3), round(float(out[1]), 3))
+
+
+class Unbridging:
+    """The "unbridge" edits as gap bridging asks for them (`vectorize.gaps.bridge_gaps`'s
+    `refuse`): a bridge passing within the edits' tolerance of an edit's position is not made.
+
+    matrix: 2x3 working px -> output px. refused: (edit position, (end, end)) of each bridge
+    refused, output px (the page shows them, to put them back)."""
+
+    def __init__(self, edits: Edits, matrix: np.ndarray) -> None:
+        self.matrix = matrix
+        self.points = [(e.at, shapely.Point(to_working(matrix, e.at))) for e in edits.of("unbridge")]
+        self.tol = edits.tolerance * (1.0 / float(matrix[0, 0]))
+        self.refused: list = []
+
+    def __call__(self, a: np.ndarray, b: np.ndarray) -> bool:
+        gap = shapely.LineString([a, b])
+        for at, point in self.points:
+            if gap.distance(point) <= self.tol:
+                self.refused.append((at, (to_output(self.matrix, a), to_output(self.matrix, b))))
+                return True
+        return False
 
 
 def _bounded_put(store: dict, key, value, keep: int = KEEP) -> None:
@@ -138,11 +178,13 @@ class GraphView:
     retraces: tuple[dict, ...] = ()
     ends: tuple[tuple[float, float], ...] = ()  # the free ends of the line (where it may start)
     bridges: tuple[tuple[tuple[float, float], tuple[float, float]], ...] = ()  # pen gaps joined: their ends
+    unbridged: tuple[tuple[tuple[float, float], tuple[float, float]], ...] = ()  # gaps kept open by an edit
 
     def to_dict(self) -> dict:
         return {"junctions": [vars(j) for j in self.junctions], "branches": [vars(b) for b in self.branches],
                 "retraces": list(self.retraces), "ends": [list(e) for e in self.ends],
-                "bridges": [[list(a), list(b)] for a, b in self.bridges]}
+                "bridges": [[list(a), list(b)] for a, b in self.bridges],
+                "unbridged": [[list(a), list(b)] for a, b in self.unbridged]}
 
 
 def _pairings(directions: np.ndarray) -> tuple:
@@ -184,28 +226,42 @@ class Refinement:
         self._index = {id(e): i for i, e in enumerate(edits.items)}
 
     def to_working(self, at) -> np.ndarray:
-        return (np.asarray(at, dtype=float) - self.matrix[:, 2]) * self.scale
+        return to_working(self.matrix, at)
 
     def to_output(self, xy) -> tuple[float, float]:
-        out = self.matrix[:, :2] @ np.asarray(xy, dtype=float) + self.matrix[:, 2]
-        return (round(float(out[0]), 3), round(float(out[1]), 3))
+        return to_output(self.matrix, xy)
+
+    def gaps_kept_open(self, refused) -> None:
+        """Count the "unbridge" edits as heeded: those that refused a bridge (`refused`, as
+        `Unbridging.refused`), and all of them in multi-stroke mode, which bridges nothing."""
+        done = {at for at, _ in refused}
+        for edit in self.edits.of("unbridge"):
+            if self.options.multi or edit.at in done:
+                self.hits.add(self._index[id(edit)])
 
     # -- simplification ------------------------------------------------------------
     def simplify_key(self, ends: int) -> tuple:
         graph_edits = tuple((e.kind, e.at) for e in self.edits.of("split", "merge"))
-        return (front_key(self.options), ends, self.options.classifier, self.edits.tolerance, graph_edits)
+        return (front_key(self.options, self.edits), ends, self.options.classifier, self.edits.tolerance, graph_edits)
 
     def lookup(self, ends: int):
         hit = self.cache.simplified.get(self.simplify_key(ends))
         if hit is None:
             return None
         *solution, hits = hit
-        self.hits |= hits
+        self._recall(hits)
         return tuple(solution)
 
     def store(self, ends: int, solution: tuple) -> None:
-        mine = {self._index[id(e)] for e in self.edits.of("split", "merge")} & self.hits
-        _bounded_put(self.cache.simplified, self.simplify_key(ends), (*solution, frozenset(mine)))
+        _bounded_put(self.cache.simplified, self.simplify_key(ends), (*solution, self._heeded("split", "merge")))
+
+    # A cached stage keeps which edits it acted on by what they say, not by their place in
+    # the list: the same splits after a different first edit share the entry (its key).
+    def _heeded(self, *kinds: str) -> frozenset:
+        return frozenset(_said(e) for e in self.edits.of(*kinds) if self._index[id(e)] in self.hits)
+
+    def _recall(self, heeded: frozenset) -> None:
+        self.hits |= {i for i, e in enumerate(self.edits.items) if _said(e) in heeded}
 
     def simplify_hooks(self) -> dict:
         """Keyword hooks for `simplify`: splits refuse merges, merges collapse branches."""
@@ -287,14 +343,13 @@ class Refinement:
         if hit is None:
             return None
         best, strokes, hits, fixed = hit
-        self.hits |= hits
+        self._recall(hits)
         self.fixed = dict(fixed)
         return best, strokes
 
     def keep_solved(self, best, strokes) -> None:
-        early = {self._index[id(e)] for e in self.edits.of("split", "merge", "pairing", "passes", "twice", "once")}
-        early &= self.hits
-        _bounded_put(self.cache.solved, self._solved_key(), (best, tuple(strokes), frozenset(early), dict(self.fixed)))
+        early = self._heeded("split", "merge", "pairing", "passes", "twice", "once")
+        _bounded_put(self.cache.solved, self._solved_key(), (best, tuple(strokes), early, dict(self.fixed)))
 
     def fix_passes(self, graph, simple):
         """`simple` with the triple points' pairings the user chose (`passes` edits)."""
@@ -375,8 +430,9 @@ class Refinement:
                 for i, e in enumerate(self.edits.items) if i not in self.hits]
 
     # -- the page's view -------------------------------------------------------------
-    def graph_view(self, solution, bridges=()) -> GraphView:
-        """What the page shows of `solution`; bridges: the pen gaps bridged (working px)."""
+    def graph_view(self, solution, bridges=(), refused=()) -> GraphView:
+        """What the page shows of `solution`; bridges: the pen gaps bridged (working px);
+        refused: the gaps kept open by an edit (`Unbridging.refused`)."""
         graph, simple = solution.graph, solution.simple
         choice = dict(zip(simple.crossings, solution.ordering.choice))
         nodes = []
@@ -402,7 +458,8 @@ class Refinement:
                 branches.append(BranchInfo(bid, self.to_output(middle), round(branch.length / self.scale, 3)))
         ends = tuple(self.to_output(graph.positions[n]) for n in sorted(graph.incident) if graph.degree(n) == 1)
         gaps = tuple((self.to_output(a), self.to_output(b)) for a, b in bridges)
-        return GraphView(tuple(nodes), tuple(branches), self._retraces(solution), ends, gaps)
+        return GraphView(tuple(nodes), tuple(branches), self._retraces(solution), ends, gaps,
+                         tuple(pair for _, pair in refused))
 
     def _retraces(self, solution) -> tuple[dict, ...]:
         graph = solution.graph
@@ -429,6 +486,11 @@ class Refinement:
                             decision="passes", confidence=chance_of(drawn, simple.through_posterior.get(node)),
                             fixed=node in self.fixed, merged=True, passes=tuple(map(tuple, as_angles(drawn, angles))),
                             options=tuple({"passes": as_angles(p, angles), "p": q} for p, q in options))
+
+
+def _said(edit) -> tuple:
+    """What an edit says (kind, place and choice): equal for equal edits."""
+    return (edit.kind, edit.at, edit.pairing, edit.passes)
 
 
 def _pass_counts(solution) -> dict[int, int]:

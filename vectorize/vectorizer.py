@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import time
 from dataclasses import replace
-from typing import NamedTuple
+from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
 
@@ -12,7 +12,7 @@ from onestroke.errors import InputError
 from vectorize.binarize import ink_image, paper_gray
 from vectorize.drawing import Drawing
 from vectorize.edits import Edits
-from vectorize.fitting import TracedPoint, fit_stroke
+from vectorize.fitting import TracedPoints, fit_stroke
 from vectorize.gaps import bridge_gaps, keep_largest_piece
 from vectorize.graph import MedialGraph
 from vectorize.ink_guard import InkGuard, guard_margin
@@ -23,12 +23,14 @@ from vectorize.medial_axis import medial_axis
 from vectorize.outline import outline_rings
 from vectorize.options import InputFrame, VectorizeOptions, VectorizeReport, VectorizeResult
 from vectorize.pruning import prune, trim_free_ends
-from vectorize.refine import Refinement, StageCache
 from vectorize.retraces import Twin, foot_is_retraced, twin_spans
 from vectorize.route_inspection import connect_pairings, plan_routes
 from vectorize.simplify import Simplified, is_t_shape, directions, simplify, slots
 from vectorize.stroke import Stroke
 from vectorize.traversal import Ordering, order_strokes
+
+if TYPE_CHECKING:  # the studio's refinement is imported where edits or a session ask for it
+    from vectorize.refine import Refinement, StageCache
 
 # Vanishing-angle thresholds (notes: 0.95 single-line, 0.90 multi-line).
 PRUNE_SINGLE, PRUNE_MULTI = 0.95, 0.90
@@ -127,7 +129,7 @@ def _pairing_costs(verdict: JunctionVerdict) -> tuple[float, float, float]:
 
 
 def _trace(graph: MedialGraph, simple: Simplified, ordering: Ordering, junctions: dict,
-           verdicts: dict, stroke_width: float) -> list[tuple[list[TracedPoint], bool, list[Twin]]]:
+           verdicts: dict, stroke_width: float) -> list[tuple[TracedPoints, bool, list[Twin]]]:
     """Turn branch passes into point lists flagged for filtering (paper 3.4), with the
     stretches each stroke draws twice (`vectorize.retraces`)."""
     # V-spikes: the foot is where both sides' inks merge, its points are uncertain; the
@@ -185,7 +187,8 @@ def _trace(graph: MedialGraph, simple: Simplified, ordering: Ordering, junctions
             tips.append(tip)
         twins = twin_spans([p.branch for p in passes], [p.start for p in passes], spans, not_twins)
         if not parts:
-            result.append(([], closed, twins))
+            result.append((TracedPoints(xy=np.zeros((0, 2)), keep=np.zeros(0, bool), split=np.zeros(0, bool)),
+                           closed, twins))
             continue
         xy, keep, split = np.concatenate(parts), np.concatenate(keeps), np.concatenate(tips)
         for base in sharp_points:
@@ -194,8 +197,7 @@ def _trace(graph: MedialGraph, simple: Simplified, ordering: Ordering, junctions
             dist = np.linalg.norm(xy - center, axis=1)
             near = dist < reach
             keep[near] &= crossing & (dist[near] < 1e-6)
-        traced = [TracedPoint(p, k, t) for p, k, t in zip(xy, keep.tolist(), split.tolist())]
-        result.append((traced, closed, twins))
+        result.append((TracedPoints(xy=xy, keep=keep, split=split), closed, twins))
     return result
 
 
@@ -337,10 +339,23 @@ def _axis(image: np.ndarray, options: VectorizeOptions, clock: _Clock, cache: St
     return ink, rings, graph
 
 
-def _front(image: np.ndarray, options: VectorizeOptions, clock: _Clock, cache: StageCache | None = None):
+def output_matrix(ink_scale: float, frame: InputFrame) -> np.ndarray:
+    """2x3 working px -> output units, for the working image's `ink_scale` (working px per
+    input px) and the input's `frame`."""
+    scale = ink_scale * frame.scale  # working px per output unit
+    # Working pixel centres sit at integers (scikit-image); in SVG and in the input's pixel
+    # frame pixel i covers [i, i + 1), so its centre is at i + 0.5.
+    return np.array([[1 / scale, 0, frame.offset[0] + 0.5 / scale],
+                     [0, 1 / scale, frame.offset[1] + 0.5 / scale]])
+
+
+def _front(image: np.ndarray, options: VectorizeOptions, clock: _Clock, cache: StageCache | None = None,
+           frame: InputFrame | None = None, edits: Edits | None = None):
     """Binarize, outline, medial axis, pruning and (single-line) gap bridging: the stages
-    that only threshold, blur and mode change. Returns (ink, rings, graph, bridges, dropped),
-    bridges: the pen gaps bridged, each as its two ends (working px).
+    that only threshold, blur and mode change (and the edits' "unbridge" positions, in
+    `frame`). Returns (ink, rings, graph, bridges, dropped, unbridged), bridges: the pen
+    gaps bridged, each as its two ends (working px); unbridged: the bridges the edits
+    refused (`vectorize.refine.Unbridging.refused`).
 
     With `cache`, the stages before pruning are shared between the modes (a copy of the
     cached graph is pruned) and the paper-flattened gray between thresholds."""
@@ -359,10 +374,21 @@ def _front(image: np.ndarray, options: VectorizeOptions, clock: _Clock, cache: S
                   options.threshold is not None)
     bridges: list = []
     dropped = 0
+    refuse = None
     if not options.multi:
-        bridge_gaps(graph, stroke_width=w, made=bridges)
+        if edits is not None and edits.of("unbridge"):
+            from vectorize.refine import Unbridging
+
+            refuse = Unbridging(edits, output_matrix(ink.scale, frame or _pixel_frame(image)))
+        bridge_gaps(graph, stroke_width=w, made=bridges, refuse=refuse)
         dropped = keep_largest_piece(graph)
-    return ink, rings, graph, tuple(bridges), dropped
+    return ink, rings, graph, tuple(bridges), dropped, tuple(refuse.refused) if refuse is not None else ()
+
+
+def _pixel_frame(image: np.ndarray) -> InputFrame:
+    """The input's own pixels as the output frame."""
+    shape = np.asarray(image).shape
+    return InputFrame(1.0, (0.0, 0.0), float(shape[1]), float(shape[0]))
 
 
 def run_pipeline(image: np.ndarray, options: VectorizeOptions, *,
@@ -376,23 +402,26 @@ def run_pipeline(image: np.ndarray, options: VectorizeOptions, *,
     clock = _Clock(cache.checkpoint if cache is not None else None)
     shape = np.asarray(image).shape
     if frame is None:
-        frame = InputFrame(1.0, (0.0, 0.0), float(shape[1]), float(shape[0]))
+        frame = _pixel_frame(image)
     refining = edits is not None or cache is not None
     if refining:
+        # Only the studio and --edits refine: a plain run never imports (or compiles) it.
+        from vectorize.refine import Refinement, StageCache
+
         edits = edits if edits is not None else Edits()
         options = edits.applied_to(options)
         cache = cache if cache is not None else StageCache()
-        front = cache.front_for(image, options, lambda stages: _front(image, options, clock, stages))
+        front = cache.front_for(image, options, lambda stages: _front(image, options, clock, stages, frame, edits),
+                                edits)
     else:
         front = _front(image, options, clock)
-    ink, rings, graph, bridges, dropped = front
+    ink, rings, graph, bridges, dropped, unbridged = front
     w = ink.stroke_width
     scale = ink.scale * frame.scale  # working px per output unit
-    # Working pixel centres sit at integers (scikit-image); in SVG and in the input's pixel
-    # frame pixel i covers [i, i + 1), so its centre is at i + 0.5.
-    matrix = np.array([[1 / scale, 0, frame.offset[0] + 0.5 / scale],
-                       [0, 1 / scale, frame.offset[1] + 0.5 / scale]])
+    matrix = output_matrix(ink.scale, frame)
     refine = Refinement(edits, cache, matrix, options, w) if refining else None
+    if refine is not None:
+        refine.gaps_kept_open(unbridged)
     stages = {"ink": ink, "rings": rings, "pruned": graph.copy()} if options.keep_stages else None
     # A single line has two free ends, or none when it closes: free ends beyond those are
     # spikes drawn out and back. Try the open reading first, the closed one if it fails.
@@ -454,5 +483,5 @@ def run_pipeline(image: np.ndarray, options: VectorizeOptions, *,
     if stages is not None:
         stages.update(simplified=graph, simple=simple, junctions=junctions, verdicts=verdicts,
                       ordering=ordering, working_strokes=strokes)
-    view = refine.graph_view(best, bridges) if refine is not None else None
+    view = refine.graph_view(best, bridges, unbridged) if refine is not None else None
     return VectorizeResult(drawing, report, stages, view)

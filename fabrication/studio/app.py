@@ -121,6 +121,8 @@ def create_app(session: StudioSession, *, token: str, hosts: set[str]) -> Guard:
                 return await handler(request)
             except OnestrokeError as error:
                 return _error(error)
+            except Exception as error:  # noqa: BLE001 - the page shows one line, never a bare "500"
+                return JSONResponse({"error": f"internal error: {type(error).__name__}: {error}"}, status_code=500)
         return endpoint
 
     async def index(request: Request):
@@ -194,7 +196,10 @@ def create_app(session: StudioSession, *, token: str, hosts: set[str]) -> Guard:
         if session.sender is not None and session.sender.running:
             raise InputError("a job is already being sent; abort it first")
         port = _checked_port(str(data.get("port") or ""))
-        baud = int(data.get("baud") or 115200)
+        try:
+            baud = int(data.get("baud") or 115200)
+        except (TypeError, ValueError):
+            raise InputError(f"baud rate {data.get('baud')!r} is not a whole number") from None
         name, _, content = await run_in_threadpool(session.export, "gcode", edits, options)
         session.sender = LaserSender(content.decode(), port=port, baud=baud, name=name).start()
         return JSONResponse(session.sender.status())

@@ -193,7 +193,7 @@ class StudioSession:
             "stroke_width": round(float(drawing.stroke_width), 3), "strokes": strokes,
             "graph": result.graph.to_dict() if result.graph is not None else {"junctions": [], "branches": []},
             "report": {"strokes": report.strokes, "intersections": report.intersections,
-                       "warnings": list(report.warnings),
+                       "dropped": report.dropped_components, "warnings": list(report.warnings),
                        "seconds": round(float(report.total_seconds), 3)},
             "settings": {"threshold": settings.threshold, "blur": settings.blur, "multi": settings.multi},
             "edits": edits.to_dict(),
@@ -248,7 +248,10 @@ class StudioSession:
 
         values = _clean(values, LASER_FIELDS)
         if "passes" in values:
-            values["passes"] = int(values["passes"])
+            try:
+                values["passes"] = int(str(values["passes"]))
+            except ValueError:
+                raise InputError(f"--passes {values['passes']!r} is not a whole number") from None
         settings = laser_settings(profile_path=self.profile, **values)
         drawing = self.vectorize(edits).drawing
         program = laser_program(drawing, settings.profile, settings.toolpath, settings.gcode,

@@ -87,7 +87,7 @@ def _pipeline_chunk(args: tuple[str, int, int, int]) -> list[tuple[bool, bool, b
     for index in range(start, stop):
         scene = render_scene(np.random.default_rng([seed, index]))
         image = np.round(scene.gray * 255.0).astype(np.uint8)
-        ink, _, graph, _, _ = _front(image, VectorizeOptions(), _Clock())
+        ink, _, graph, *_ = _front(image, VectorizeOptions(), _Clock())
         w = ink.stroke_width
         for node in merge_triple_points(graph, stroke_width=w):
             feet = directions(graph, node, 2.5 * w)

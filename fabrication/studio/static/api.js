@@ -12,7 +12,9 @@ export async function call(path, body, raw = false) {
     init.headers["Content-Type"] = "application/json";
     init.body = JSON.stringify(body);
   }
-  const response = await fetch(path, init);
+  let response;
+  try { response = await fetch(path, init); }
+  catch (error) { throw new Error("the studio server does not answer (was it stopped?): " + error.message); }
   if (!response.ok) {
     let message = response.statusText;
     try { message = (await response.json()).error || message; } catch (e) { /* not JSON */ }
@@ -28,11 +30,12 @@ export function busy(on) {
   document.body.classList.toggle("busy", busyCount > 0);
 }
 
-export function report(error) {
-  $("warnings").innerHTML = "";
+// An error in one line, in the warnings list of the panel in view (`list`: its id).
+export function report(error, list = "warnings") {
+  $(list).innerHTML = "";
   const li = document.createElement("li");
   li.textContent = "error: " + error.message;
-  $("warnings").appendChild(li);
+  $(list).appendChild(li);
 }
 
 export function escapeHtml(text) {

@@ -156,16 +156,33 @@ function draw() {
   arrows(g, t);
   junctionMarkers(g);
   bridges(g);
-  placeLabels(g);
-  // Start markers: where each stroke begins (over a junction the line starts at).
-  s.strokes.forEach((stroke, k) => {
-    const [x, y] = toScreen(...stroke.points[0]);
+  const starts = startPlaces();
+  placeLabels(g, starts.map(([x, y]) => [x - 8, y - 8, 16, 16]));
+  startMarkers(g, starts);
+  if (studio.pen < 1 || studio.playing) penMarker(g, t, penAt);
+  else $("where").textContent = `${Math.round(t.total)} px, ${s.strokes.length} stroke${s.strokes.length === 1 ? "" : "s"}`;
+}
+
+// Start markers: where each stroke begins. One that would hide a junction's marker (a line
+// starting at a junction) sits just beyond it along its stroke.
+function startPlaces() {
+  const s = studio.state;
+  const markers = s.graph.junctions.map((j) => ({ at: toScreen(...j.at), r: j.role === "triple" ? 24 : 11 }));
+  return s.strokes.map((stroke) => {
+    const start = toScreen(...stroke.points[0]);
+    const under = markers.find((m) => Math.hypot(m.at[0] - start[0], m.at[1] - start[1]) < m.r + 6);
+    if (!under) return start;
+    return stroke.points.map((p) => toScreen(...p))
+      .find(([px, py]) => Math.hypot(px - under.at[0], py - under.at[1]) > under.r + 9) || start;
+  });
+}
+
+function startMarkers(g, starts) {
+  starts.forEach(([x, y], k) => {
     g.fillStyle = COLORS.start; g.beginPath(); g.arc(x, y, k === 0 ? 7 : 5, 0, 2 * Math.PI); g.fill();
     g.fillStyle = "#fff"; g.font = "bold 9px sans-serif"; g.textAlign = "center"; g.textBaseline = "middle";
     g.fillText(String(k + 1), x, y + 0.5);
   });
-  if (studio.pen < 1 || studio.playing) penMarker(g, t, penAt);
-  else $("where").textContent = `${Math.round(t.total)} px, ${s.strokes.length} stroke${s.strokes.length === 1 ? "" : "s"}`;
 }
 
 function arrows(g, t) {
@@ -201,58 +218,102 @@ function retraces(g) {
   g.restore();
 }
 
-// Pen gaps the vectorizer bridged: the two ends joined, dashed, under the curve.
+// Pen gaps the vectorizer bridged: the two ends joined, dashed, under the curve; gaps the
+// user kept open (an "unbridge" edit): a grey circle struck through.
 function bridges(g) {
   g.save();
-  for (const [a, b] of studio.state.graph.bridges || []) {
+  const ring = ([a, b]) => {
     const [ax, ay] = toScreen(...a), [bx, by] = toScreen(...b);
-    const r = Math.max(9, Math.hypot(bx - ax, by - ay) / 2 + 5);
-    g.strokeStyle = COLORS.gap; g.lineWidth = 2; g.setLineDash([4, 3]);
-    g.beginPath(); g.arc((ax + bx) / 2, (ay + by) / 2, r, 0, 2 * Math.PI); g.stroke();
+    return [(ax + bx) / 2, (ay + by) / 2, Math.max(9, Math.hypot(bx - ax, by - ay) / 2 + 5)];
+  };
+  for (const gap of studio.state.graph.bridges || []) {
+    const [x, y, r] = ring(gap);
+    g.strokeStyle = COLORS.gap; g.lineWidth = studio.tool === "gap" ? 3 : 2; g.setLineDash([4, 3]);
+    g.beginPath(); g.arc(x, y, r, 0, 2 * Math.PI); g.stroke();
     g.setLineDash([]);
-    label(g, "gap", (ax + bx) / 2, (ay + by) / 2, r + 3);
+    label(g, "gap", x, y, r + 3);
+  }
+  for (const gap of studio.state.graph.unbridged || []) {
+    const [x, y, r] = ring(gap);
+    g.strokeStyle = COLORS.other; g.lineWidth = 2;
+    g.beginPath(); g.arc(x, y, r, 0, 2 * Math.PI);
+    g.moveTo(x - r * 0.7, y + r * 0.7); g.lineTo(x + r * 0.7, y - r * 0.7); g.stroke();
+    label(g, "gap open", x, y, r + 3);
   }
   g.restore();
 }
 
+function middle([a, b]) { return { at: [(a[0] + b[0]) / 2, (a[1] + b[1]) / 2], ends: [a, b] }; }
+
+// Distance from point p to the segment a-b (image px).
+function toSegment(p, [a, b]) {
+  const dx = b[0] - a[0], dy = b[1] - a[1], n = dx * dx + dy * dy;
+  const t = n ? Math.max(0, Math.min(1, ((p[0] - a[0]) * dx + (p[1] - a[1]) * dy) / n)) : 0;
+  return dist(p, [a[0] + t * dx, a[1] + t * dy]);
+}
+
 function percent(p) { return p === null || p === undefined ? "" : p < 0.001 ? " <0.1%" : ` ${Math.round(100 * p)}%`; }
 
-// A triple point: its three passes drawn through the marker, each pair of branch directions
-// joined through the centre, so the pairing is seen, not read.
+// The passes of a triple point in a circle of radius r at (x, y): each pass joins its two
+// branch directions through the centre in its own colour, on a white halo; stub: px it
+// runs on beyond the circle along the real branches, so that each branch shows its pass.
+function drawPasses(g, x, y, r, passes, stub = 0) {
+  const at = (deg, d) => [x + d * Math.cos((deg * Math.PI) / 180), y + d * Math.sin((deg * Math.PI) / 180)];
+  const path = ([a, b]) => {
+    g.beginPath(); g.moveTo(...at(a, r + stub)); g.lineTo(...at(a, r));
+    const [qx, qy] = at(b, r);
+    g.quadraticCurveTo(x, y, qx, qy); g.lineTo(...at(b, r + stub));
+  };
+  g.save();
+  g.lineCap = "round"; g.lineJoin = "round";
+  passes.forEach((pass, k) => {
+    g.strokeStyle = "rgba(255,255,255,0.95)"; g.lineWidth = Math.max(4, r / 3.5); path(pass); g.stroke();
+    g.strokeStyle = PASS_COLORS[k % PASS_COLORS.length]; g.lineWidth = Math.max(2, r / 7); path(pass); g.stroke();
+  });
+  g.restore();
+}
+
+// The place of the pairing drawn among the ones offered (likeliest first), 1-based.
+function passRank(j) { return j.options.findIndex((o) => samePasses(o.passes, j.passes)) + 1; }
+
+// A triple point: its three passes drawn through the marker and along each branch, so the
+// pairing is seen, not read; a square when you chose it.
 function tripleMarker(g, j) {
-  const [x, y] = toScreen(...j.at), r = 16;
-  g.lineWidth = 3; g.strokeStyle = COLORS.passes; g.fillStyle = "rgba(255,255,255,0.9)";
+  const [x, y] = toScreen(...j.at), r = 20;
+  g.lineWidth = 3; g.strokeStyle = COLORS.passes; g.fillStyle = "rgba(255,255,255,0.92)";
   g.beginPath();
   if (j.fixed) g.rect(x - r - 2, y - r - 2, 2 * r + 4, 2 * r + 4); else g.arc(x, y, r + 2, 0, 2 * Math.PI);
   g.fill(); g.stroke();
-  j.passes.forEach(([a, b], k) => {
-    const ra = (a * Math.PI) / 180, rb = (b * Math.PI) / 180;
-    g.strokeStyle = PASS_COLORS[k % PASS_COLORS.length]; g.lineWidth = 2.5;
-    g.beginPath(); g.moveTo(x + r * Math.cos(ra), y + r * Math.sin(ra));
-    g.quadraticCurveTo(x, y, x + r * Math.cos(rb), y + r * Math.sin(rb)); g.stroke();
-  });
-  const k = j.options.findIndex((o) => samePasses(o.passes, j.passes));
-  label(g, `3 passes${j.confidence === null ? " (straightest)" : percent(j.confidence)} · ${k + 1}/${j.options.length}`,
-    x, y, r + 6);
+  drawPasses(g, x, y, r - 2, j.passes, 12);
+  const scorer = j.confidence === null ? " (straightest)" : percent(j.confidence);
+  label(g, `3 passes: pairing ${passRank(j)}/${j.options.length}${scorer}${j.fixed ? " · yours" : ""}`, x, y, r + 12);
 }
 
 // A marker's text, beside the marker at (x, y) of radius `gap`; drawn by `placeLabels`
 // once every marker is drawn.
 function label(g, text, x, y, gap) { studio.labels.push({ text, x, y, gap }); }
 
-// Each text on a white halo so that it reads over the curve, right of its marker, else
-// left, below or above, wherever it covers no marker and no text placed before (junctions
-// a few px apart would print over each other).
-function placeLabels(g) {
+// Each text on a white box so that it reads over the curve, right of its marker, else
+// left, below or above, wherever it stays on the canvas and covers no marker (nor `more`
+// boxes: [x, y, w, h]) and no text placed before (junctions a few px apart would print
+// over each other).
+function placeLabels(g, more = []) {
   g.font = "11px sans-serif"; g.textAlign = "left"; g.textBaseline = "middle";
-  const boxes = studio.labels.map(({ x, y, gap }) => [x - gap, y - gap, 2 * gap, 2 * gap]);
-  const h = 13;
+  const boxes = studio.labels.map(({ x, y, gap }) => [x - gap, y - gap, 2 * gap, 2 * gap]).concat(more);
+  const h = 13, c = $("canvas");
+  const placed = [];
   for (const { text, x, y, gap } of studio.labels) {
+    // Two nodes a pixel or two apart (a split crossing) would print the same text twice.
+    if (placed.some((q) => q.text === text && Math.hypot(q.x - x, q.y - y) < 12)) continue;
+    placed.push({ text, x, y });
     const w = g.measureText(text).width;
     const spots = [[x + gap, y], [x - gap - w, y], [x - w / 2, y + gap + h / 2], [x - w / 2, y - gap - h / 2]];
     const covers = (sx, sy, b) => sx < b[0] + b[2] && b[0] < sx + w && sy - h / 2 < b[1] + b[3] && b[1] < sy + h / 2;
-    const [lx, ly] = spots.find(([sx, sy]) => !boxes.some((b) => covers(sx, sy, b))) || spots[0];
+    const inside = (sx, sy) => sx >= 2 && sx + w <= c.clientWidth - 2 && sy - h / 2 >= 0 && sy + h / 2 <= c.clientHeight;
+    const [lx, ly] = spots.find(([sx, sy]) => inside(sx, sy) && !boxes.some((b) => covers(sx, sy, b))) ||
+      spots.find(([sx, sy]) => inside(sx, sy)) || spots[0];
     boxes.push([lx, ly - h / 2, w, h]);
+    g.fillStyle = "rgba(255,255,255,0.8)"; g.fillRect(lx - 2, ly - h / 2, w + 4, h);
     g.strokeStyle = "rgba(255,255,255,0.9)"; g.lineWidth = 3; g.lineJoin = "round"; g.strokeText(text, lx, ly);
     g.fillStyle = "#222"; g.fillText(text, lx, ly);
   }
@@ -327,9 +388,12 @@ function show(state) {
     const where = `(${j.at[0].toFixed(0)}, ${j.at[1].toFixed(0)})`;
     li.style.color = COLORS[j.decision];
     if (j.role === "triple") {
-      li.append(`${where} three passes · ${j.confidence === null ? "straightest" : "pass scorer" + percent(j.confidence)} `);
+      const offered = state.settings.multi ? `all ${j.options.length} pairings`
+        : `the ${j.options.length} pairings that keep one line`;
+      li.append(`${where} three passes: pairing ${passRank(j)} · ` +
+        `${j.confidence === null ? "straightest" : "pass scorer" + percent(j.confidence)}` +
+        `${j.fixed ? " · fixed by you" : ""} · ${offered}, likeliest first:`);
       li.appendChild(passChoice(j));
-      if (j.fixed) li.append(" · fixed by you");
     } else {
       li.textContent = `${where} ${j.decision} · CNN p(cross) ${(j.p_crossing * 100).toFixed(0)}%` +
         (j.fixed ? " · fixed by you" : "");
@@ -340,7 +404,27 @@ function show(state) {
   if (gaps.length) {
     const li = document.createElement("li");
     li.className = "gaps";
-    li.textContent = `pen gap${gaps.length === 1 ? "" : "s"} bridged: ${gaps.length} (dashed circles)`;
+    li.textContent = `pen gap${gaps.length === 1 ? "" : "s"} bridged: ${gaps.length} (dashed circle${gaps.length === 1 ? "" : "s"})`;
+    list.appendChild(li);
+  }
+  const open = state.graph.unbridged || [];
+  if (open.length) {
+    const li = document.createElement("li");
+    li.className = "open-gaps";
+    li.textContent = `pen gap${open.length === 1 ? "" : "s"} kept open by you: ${open.length} (struck-through circle${open.length === 1 ? "" : "s"})`;
+    list.appendChild(li);
+  }
+  if (r.dropped && !state.settings.multi) {
+    // What single-line mode does with ink in several pieces (as the CLI does): the largest
+    // piece is the line; the others stay grey, undrawn.
+    const li = document.createElement("li");
+    li.className = "pieces";
+    li.append(`the ink is in ${r.dropped + 1} pieces: one line keeps the largest, the grey rest is not drawn. `);
+    const keep = document.createElement("button");
+    keep.id = "keep-pieces"; keep.textContent = "Keep every piece (multi-stroke)";
+    keep.title = "Multi-stroke mode draws each piece as its own stroke (and bridges no pen gap)";
+    keep.onclick = () => settingsEdit({ multi: true });
+    li.appendChild(keep);
     list.appendChild(li);
   }
   const twice = state.graph.retraces || [];
@@ -367,19 +451,30 @@ function show(state) {
   refreshPanel();
 }
 
-// The pairings a triple point may take (each keeps the line one stroke), likeliest first.
+// The pairings a triple point may take, likeliest first (single-line mode: those that keep
+// the line one stroke; multi-stroke: all 15), each a small drawing of its passes with its
+// place and the pass scorer's posterior; the one drawn is outlined. A click picks one.
 function passChoice(j) {
-  const select = document.createElement("select");
-  select.className = "passes"; select.title = "How the pen went through: the pairs of branch directions (degrees)";
+  const box = document.createElement("div");
+  box.className = "pass-options";
+  const dpr = window.devicePixelRatio || 1;
   j.options.forEach((o, k) => {
-    const option = document.createElement("option");
-    option.value = String(k);
-    option.textContent = `${k + 1}: ` + o.passes.map(([a, b]) => `${Math.round(a)}°–${Math.round(b)}°`).join(", ") + percent(o.p);
-    option.selected = samePasses(o.passes, j.passes);
-    select.appendChild(option);
+    const button = document.createElement("button");
+    button.type = "button"; button.dataset.index = String(k);
+    button.className = "pass-option" + (samePasses(o.passes, j.passes) ? " current" : "");
+    button.title = `pairing ${k + 1}${percent(o.p)}: passes ` +
+      o.passes.map(([a, b]) => `${Math.round(a)}°–${Math.round(b)}°`).join(", ");
+    const c = document.createElement("canvas");
+    c.width = c.height = Math.round(34 * dpr); c.style.width = c.style.height = "34px";
+    const g = c.getContext("2d"); g.scale(dpr, dpr);
+    drawPasses(g, 17, 17, 13, o.passes, 2);
+    const caption = document.createElement("span");
+    caption.textContent = `${k + 1}${percent(o.p)}`;
+    button.append(c, caption);
+    button.onclick = () => choosePasses(j, o);
+    box.appendChild(button);
   });
-  select.onchange = () => choosePasses(j, j.options[Number(select.value)]);
-  return select;
+  return box;
 }
 
 function choosePasses(j, option) {
@@ -396,20 +491,47 @@ function nearest(items, point, radius) {
   return best;
 }
 
+// What a click that finds nothing to act on says, per tool.
+const MISSED = {
+  pairing: () => "no crossing or triple point here: click on a junction's marker",
+  split: () => "no crossing or triple point here: click on a junction's marker",
+  merge: () => studio.state.graph.branches.length ? "no branch handle (◆) here: click on one"
+    : "no branch joins two degree-3 nodes in this reading: nothing to merge",
+  start: () => "no free end here: click on a stroke's end or a ring (◌)",
+  retrace: () => "no line here: click on the line",
+  reverse: () => "no stroke here: click on a stroke",
+  gap: () => (studio.state.graph.bridges || []).length + (studio.state.graph.unbridged || []).length
+    ? "no pen gap here: click on a dashed circle to open it, a struck-through one to close it"
+    : "no pen gap was bridged in this drawing (single-line mode bridges them; multi-stroke none)",
+};
+
+function hint(text) { $("hint").textContent = text || ""; $("hint").hidden = !text; }
+
 function onClick(event) {
   const s = studio.state;
   if (!s || studio.dragged) return;
   const r = $("canvas").getBoundingClientRect();
   const p = toImage(event.clientX - r.left, event.clientY - r.top);
+  hint(clickTool(s, p) ? "" : MISSED[studio.tool]());
+}
+
+// The edit a click at image point p makes with the current tool (its request), or nothing.
+function clickTool(s, p) {
   const crossings = s.graph.junctions.filter((j) => j.role === "crossing" || j.role === "triple");
   const tool = studio.tool;
   if (tool === "pairing" || tool === "split") {
     const j = nearest(crossings, p, 18);
     if (!j) return;
-    if (tool === "split") return apply(withEdit({ kind: "split", at: j.at }, false));
+    if (tool === "split") {
+      // A pairing chosen at this junction has nothing left to act on once it is split.
+      const edits = withEdit({ kind: "split", at: j.at }, false);
+      edits.edits = edits.edits.filter((e) => !((e.kind === "pairing" || e.kind === "passes") &&
+                                              dist(e.at, j.at) <= edits.tolerance));
+      return apply(edits);
+    }
     if (j.role === "triple") {
       // The next of the pairings that keep one stroke, in the order of their likelihood.
-      if (!j.options.length) return;
+      if (!j.options.length) return null;
       const k = j.options.findIndex((o) => samePasses(o.passes, j.passes));
       return choosePasses(j, j.options[(k + 1) % j.options.length]);
     }
@@ -418,8 +540,7 @@ function onClick(event) {
   }
   if (tool === "merge") {
     const b = nearest(s.graph.branches, p, 16);
-    if (b) apply(withEdit({ kind: "merge", at: b.at }, false));
-    return;
+    return b ? apply(withEdit({ kind: "merge", at: b.at }, false)) : null;
   }
   if (tool === "start") {
     // A stroke's end, or a free end the line passes (the tip of a stem drawn down and back
@@ -429,8 +550,7 @@ function onClick(event) {
       ends.push({ at: stroke.points[0] }, { at: stroke.points[stroke.points.length - 1] });
     }
     const e = nearest(ends, p, 24);
-    if (e) apply(withEdit({ kind: "start", at: e.at.slice(0, 2) }, false));
-    return;
+    return e ? apply(withEdit({ kind: "start", at: e.at.slice(0, 2) }, false)) : null;
   }
   if (tool === "retrace") {
     // On a stretch drawn twice: draw it once; elsewhere on the line: go back over it here
@@ -446,10 +566,21 @@ function onClick(event) {
     edits.edits.push(edit);
     return apply(edits);
   }
+  if (tool === "gap") {
+    // A gap kept open: close it again (drop the edits that opened it); a bridged gap: open it.
+    const open = nearest((s.graph.unbridged || []).map(middle), p, 24);
+    if (open) {
+      const edits = JSON.parse(JSON.stringify(currentEdits()));
+      edits.edits = edits.edits.filter((e) => !(e.kind === "unbridge" && toSegment(e.at, open.ends) <= edits.tolerance));
+      return apply(edits);
+    }
+    const gap = nearest((s.graph.bridges || []).map(middle), p, 24);
+    return gap ? apply(withEdit({ kind: "unbridge", at: gap.at }, false)) : null;
+  }
   if (tool === "reverse") {
     const points = studio.line.pts.map((q) => ({ at: q }));
     const q = nearest(points, p, 16);
-    if (q) apply(withEdit({ kind: "reverse", at: q.at.slice(0, 2) }, false));
+    return q ? apply(withEdit({ kind: "reverse", at: q.at.slice(0, 2) }, false)) : null;
   }
 }
 
@@ -496,7 +627,7 @@ function frame(now) {
 function play() {
   if (studio.playing) { studio.playing = false; $("play").textContent = "▶ Play"; return; }
   if (studio.pen >= 1) studio.pen = 0;
-  studio.playing = true; lastFrame = 0; $("play").textContent = "⏸ Pause";
+  studio.playing = true; lastFrame = 0; $("play").textContent = "▮▮ Pause";
   requestAnimationFrame(frame);
 }
 
@@ -527,7 +658,7 @@ function setup() {
     if (e.key === "y" || (e.key === "z" && e.shiftKey)) { e.preventDefault(); redo(); }
   });
   for (const radio of document.querySelectorAll("input[name=tool]")) {
-    radio.onchange = () => { studio.tool = radio.value; draw(); };
+    radio.onchange = () => { studio.tool = radio.value; hint(""); draw(); };
   }
   $("reverse-all").onclick = () => {
     const s = studio.state; if (!s || !s.strokes.length) return;
@@ -558,7 +689,10 @@ function setup() {
   };
   $("open").onchange = async () => {
     const file = $("open").files[0]; if (!file) return;
-    try { apply(JSON.parse(await file.text())); } catch (error) { report(error); }
+    let data;
+    try { data = JSON.parse(await file.text()); }
+    catch (error) { report(new Error(`${file.name} is not an edits file (not JSON)`)); }
+    if (data !== undefined) apply(data);
     $("open").value = "";
   };
   studio.image.onload = draw;

@@ -33,7 +33,7 @@ export async function refreshPanel() {
     if (ticket !== panelTicket) return;
     if (tab === "embroidery") showStitches(data); else showToolpath(data);
   } catch (error) {
-    $(`${tab}-warnings`).innerHTML = `<li>error: ${error.message}</li>`;
+    report(error, `${tab}-warnings`);
   } finally {
     busy(false);
   }
@@ -65,8 +65,8 @@ function showToolpath(data) {
 
 async function download(kind) {
   busy(true);
+  const tab = ["pes", "dst", "jef", "exp", "vp3"].includes(kind) ? "embroidery" : kind === "gcode" ? "laser" : "refine";
   try {
-    const tab = ["pes", "dst", "jef", "exp", "vp3"].includes(kind) ? "embroidery" : kind === "gcode" ? "laser" : "refine";
     const response = await call(`api/export/${kind}`, { edits: edits(), options: panelOptions(tab) }, true);
     const blob = await response.blob();
     const name = /filename="([^"]+)"/.exec(response.headers.get("Content-Disposition") || "")?.[1] || `drawing.${kind}`;
@@ -75,7 +75,7 @@ async function download(kind) {
     document.body.appendChild(a); a.click(); a.remove();
     setTimeout(() => URL.revokeObjectURL(a.href), 10000);
   } catch (error) {
-    report(error);
+    report(error, tab === "refine" ? "warnings" : `${tab}-warnings`);  // beside the button clicked
   } finally {
     busy(false);
   }
