@@ -16,7 +16,10 @@ from binarization.
 
 `--hand` adds two 1000 px hand drawings of the benchmark's generators (the "triple" set's
 second drawing: a triple point and three crossings; the cursive word "little", stems
-drawn down and back up), rendered to a temporary folder.
+drawn down and back up), rendered to a temporary folder. `--gaps` adds (alone: times only)
+that word with two pen gaps wiped out, whose bridges the "unbridge" kind keeps open, one
+at a time (a re-run from gap bridging on: pruning is redone, binarization to the medial
+axis come from the cache).
 
 The last columns are the slider steps of a session that precomputes (`onestroke studio`):
 after each threshold or blur answer the server computes the neighbouring slider values
@@ -69,6 +72,7 @@ def bench(path: Path, panels: bool = False, repeats: int = REPEATS) -> tuple[dic
     crossings = [j for j in base["graph"]["junctions"] if j["role"] == "crossing"] or [None]
     triples = [j for j in base["graph"]["junctions"] if j["role"] == "triple" and len(j["options"]) > 2]
     stroke = base["strokes"][0]["points"]
+    bridges = base["graph"].get("bridges") or []
 
     cpu: dict[str, list[float]] = {}
     panel_cpu: dict[str, list[float]] = {}
@@ -116,6 +120,14 @@ def bench(path: Path, panels: bool = False, repeats: int = REPEATS) -> tuple[dic
             session.cache.solved.clear()
             option = t["options"][1 + rep % 2]["passes"]
             times.add("passes", post({}, [{"kind": "passes", "at": t["at"], "passes": option}]))
+        for gap in (bridges[rep % len(bridges)],) if bridges else ():
+            # A gap kept open re-runs from pruning (gap bridging) on; never seen in this form.
+            for key in [k for k in session.cache.front if len(k) > 4]:  # keyed by the gaps kept open
+                session.cache.front.pop(key)
+            session.cache.simplified.clear()
+            session.cache.solved.clear()
+            middle = [(gap[0][0] + gap[1][0]) / 2, (gap[0][1] + gap[1][1]) / 2]
+            times.add("unbridge", post({}, [{"kind": "unbridge", "at": middle}]))
         post({}, [])  # the page shows the automatic result before the user picks an end
         times.add("start", post({}, [{"kind": "start", "at": stroke[-1] if rep % 2 == 0 else stroke[0]}]))
         times.add("reverse", post({}, [{"kind": "reverse", "at": stroke[len(stroke) // 2]}]))
@@ -173,22 +185,37 @@ def hand_drawings() -> list[Path]:
     return paths
 
 
+def gap_drawing() -> Path:
+    """The cursive word "little" with two pen gaps wiped out, as the studio's browser tests
+    draw it (`tests/studio_fixtures.bench_drawing`), as a PNG in a temporary folder."""
+    import tempfile
+
+    from tests.studio_fixtures import bench_drawing
+
+    return bench_drawing(Path(tempfile.mkdtemp(prefix="studio-edit-gaps-")), "little")
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description="Median answer time of each studio edit kind.")
     parser.add_argument("drawings", nargs="*", type=Path, help="raster drawings (default: three 1000 px examples)")
     parser.add_argument("--hand", action="store_true",
                         help="also two hand drawings of the benchmark's generators (triple point, cursive word)")
+    parser.add_argument("--gaps", action="store_true",
+                        help="also the cursive word with two pen gaps wiped out (the studio's browser-test drawing), "
+                             "for the unbridge edit (alone: only it)")
     parser.add_argument("--panels", action="store_true",
                         help="also time the embroidery and laser previews the page asks for after each edit")
     parser.add_argument("--repeats", type=int, default=REPEATS, help=f"answers timed per edit kind (default {REPEATS})")
     args = parser.parse_args()
-    paths = args.drawings or [Path(p) for p in DEFAULT]
+    paths = args.drawings or ([] if args.gaps and not args.hand else [Path(p) for p in DEFAULT])
     if args.hand:
         paths = list(paths) + hand_drawings()
+    if args.gaps:
+        paths = list(paths) + [gap_drawing()]
     print(f"load: {os.getloadavg()[0]:.2f} (1 min), {os.cpu_count()} cores; "
           f"median of {args.repeats} per edit kind, seconds")
-    kinds = ("first", "pairing", "passes", "start", "reverse", "split", "merge", "threshold", "blur", "multi",
-             "thr step", "blur step", "idle")
+    kinds = ("first", "pairing", "passes", "start", "reverse", "split", "merge", "unbridge", "threshold", "blur",
+             "multi", "thr step", "blur step", "idle")
     print(f"{'drawing':40s} " + " ".join(f"{k:>9s}" for k in kinds))
     for path in paths:
         from PIL import Image

@@ -491,11 +491,32 @@ function nearest(items, point, radius) {
   return best;
 }
 
+// What a click that finds nothing to act on says, per tool.
+const MISSED = {
+  pairing: () => "no crossing or triple point here: click on a junction's marker",
+  split: () => "no crossing or triple point here: click on a junction's marker",
+  merge: () => studio.state.graph.branches.length ? "no branch handle (◆) here: click on one"
+    : "no branch joins two degree-3 nodes in this reading: nothing to merge",
+  start: () => "no free end here: click on a stroke's end or a ring (◌)",
+  retrace: () => "no line here: click on the line",
+  reverse: () => "no stroke here: click on a stroke",
+  gap: () => (studio.state.graph.bridges || []).length + (studio.state.graph.unbridged || []).length
+    ? "no pen gap here: click on a dashed circle to open it, a struck-through one to close it"
+    : "no pen gap was bridged in this drawing (single-line mode bridges them; multi-stroke none)",
+};
+
+function hint(text) { $("hint").textContent = text || ""; $("hint").hidden = !text; }
+
 function onClick(event) {
   const s = studio.state;
   if (!s || studio.dragged) return;
   const r = $("canvas").getBoundingClientRect();
   const p = toImage(event.clientX - r.left, event.clientY - r.top);
+  hint(clickTool(s, p) ? "" : MISSED[studio.tool]());
+}
+
+// The edit a click at image point p makes with the current tool (its request), or nothing.
+function clickTool(s, p) {
   const crossings = s.graph.junctions.filter((j) => j.role === "crossing" || j.role === "triple");
   const tool = studio.tool;
   if (tool === "pairing" || tool === "split") {
@@ -510,7 +531,7 @@ function onClick(event) {
     }
     if (j.role === "triple") {
       // The next of the pairings that keep one stroke, in the order of their likelihood.
-      if (!j.options.length) return;
+      if (!j.options.length) return null;
       const k = j.options.findIndex((o) => samePasses(o.passes, j.passes));
       return choosePasses(j, j.options[(k + 1) % j.options.length]);
     }
@@ -519,8 +540,7 @@ function onClick(event) {
   }
   if (tool === "merge") {
     const b = nearest(s.graph.branches, p, 16);
-    if (b) apply(withEdit({ kind: "merge", at: b.at }, false));
-    return;
+    return b ? apply(withEdit({ kind: "merge", at: b.at }, false)) : null;
   }
   if (tool === "start") {
     // A stroke's end, or a free end the line passes (the tip of a stem drawn down and back
@@ -530,8 +550,7 @@ function onClick(event) {
       ends.push({ at: stroke.points[0] }, { at: stroke.points[stroke.points.length - 1] });
     }
     const e = nearest(ends, p, 24);
-    if (e) apply(withEdit({ kind: "start", at: e.at.slice(0, 2) }, false));
-    return;
+    return e ? apply(withEdit({ kind: "start", at: e.at.slice(0, 2) }, false)) : null;
   }
   if (tool === "retrace") {
     // On a stretch drawn twice: draw it once; elsewhere on the line: go back over it here
@@ -556,13 +575,12 @@ function onClick(event) {
       return apply(edits);
     }
     const gap = nearest((s.graph.bridges || []).map(middle), p, 24);
-    if (gap) apply(withEdit({ kind: "unbridge", at: gap.at }, false));
-    return;
+    return gap ? apply(withEdit({ kind: "unbridge", at: gap.at }, false)) : null;
   }
   if (tool === "reverse") {
     const points = studio.line.pts.map((q) => ({ at: q }));
     const q = nearest(points, p, 16);
-    if (q) apply(withEdit({ kind: "reverse", at: q.at.slice(0, 2) }, false));
+    return q ? apply(withEdit({ kind: "reverse", at: q.at.slice(0, 2) }, false)) : null;
   }
 }
 
@@ -640,7 +658,7 @@ function setup() {
     if (e.key === "y" || (e.key === "z" && e.shiftKey)) { e.preventDefault(); redo(); }
   });
   for (const radio of document.querySelectorAll("input[name=tool]")) {
-    radio.onchange = () => { studio.tool = radio.value; draw(); };
+    radio.onchange = () => { studio.tool = radio.value; hint(""); draw(); };
   }
   $("reverse-all").onclick = () => {
     const s = studio.state; if (!s || !s.strokes.length) return;
