@@ -71,6 +71,11 @@ def test_branches_run_from_node_to_node():
         inner = np.vstack([b.points[1:-1] for b in graph.branches.values() if len(b.points) > 2])
         assert len(np.unique(inner, axis=0)) == points
         assert not (set(map(tuple, inner)) & set(tuple(p) for p in graph.positions.values()))
+        # Branches are cut from shared arrays: no two of them hold the same memory.
+        arrays = [(b.points, b.radii, b.sins) for b in graph.branches.values()]
+        for i, first in enumerate(arrays):
+            for second in arrays[i + 1:]:
+                assert not any(np.shares_memory(x, y) for x, y in zip(first, second))
 
 
 def test_chains_become_branches_and_a_closed_chain_is_one_loop():

@@ -95,9 +95,28 @@ def flatten_paper(gray: np.ndarray) -> np.ndarray:
     than the window would be taken for paper, and no line drawing has those.
     """
     size = max(31, int(round(max(gray.shape) / 8)))
-    paper = ndimage.grey_closing(gray, size=(size, size), mode="nearest")
-    paper = ndimage.uniform_filter(paper.astype(np.float64), size=size, mode="nearest")
+    top = gray.max()
+    if in_every_window(gray == top, size):
+        # Paper at one level (a clean drawing): the closing is that level everywhere, and so
+        # is its smoothing, which the filter computes alike for any constant image.
+        paper = np.full((1, 1), top, dtype=np.float64)
+    else:
+        paper = ndimage.grey_closing(gray, size=(size, size), mode="nearest").astype(np.float64)
+    paper = ndimage.uniform_filter(paper, size=size, mode="nearest")
     return np.clip(gray / np.maximum(paper, MIN_PAPER), 0.0, 1.0).astype(np.float32)
+
+
+def in_every_window(mask: np.ndarray, size: int) -> bool:
+    """Whether every `size` x `size` window (centred on a pixel, cut at the image edge) of
+    `mask` (H, W) bool holds a True pixel: then a maximum filter of that size over an image
+    whose maximum is where `mask` is True is that maximum everywhere.
+
+    Tiles of (size + 1) // 2 px a side suffice to decide it: every window, cut at the edge
+    or not, contains a whole tile (the last tile of a row or column may be shorter)."""
+    step = (size + 1) // 2
+    rows = np.logical_or.reduceat(mask, np.arange(0, mask.shape[0], step), axis=0)
+    tiles = np.logical_or.reduceat(rows, np.arange(0, mask.shape[1], step), axis=1)
+    return bool(tiles.all())
 
 
 def paper_noise_floor(gray: np.ndarray) -> float | None:
@@ -105,6 +124,11 @@ def paper_noise_floor(gray: np.ndarray) -> float | None:
     the paper, with sigma from the lower quartile (a line drawing is mostly paper; the
     upper half may be clipped at white). None when the lower quartile is not paper grain
     (more than a quarter of the image is dark: a frame, a heavy drawing)."""
+    top, count = gray.max(), gray.size
+    if np.count_nonzero(gray == top) >= count - int(0.25 * (count - 1)):
+        # Three quarters of the image at its brightest level (clean paper): both quantiles
+        # are that level, sigma is 0, as np.percentile would find after sorting.
+        return float(top)
     q25, median = np.percentile(gray, [25, 50])
     sigma = (median - q25) / 0.6745
     if sigma > MAX_PAPER_SIGMA:
@@ -157,17 +181,21 @@ def ink_box(ink: np.ndarray, margin: int) -> tuple[slice, slice]:
             slice(max(int(cols[0]) - margin, 0), int(cols[-1]) + margin + 1))
 
 
-def frame_labels(labels: np.ndarray, count: int) -> np.ndarray:
+def frame_labels(labels: np.ndarray, count: int, longest: int | None = None) -> np.ndarray:
     """Labels of dark frame pieces: ink that touches the image edge and is thicker than any
     line (inscribed radius over `FRAME_RADIUS` of the longest side), such as the table
-    around a photographed sheet or a scanner lid's shadow. (n,) int."""
+    around a photographed sheet or a scanner lid's shadow. (n,) int.
+
+    `labels` may be a crop of the image's labels grown by one row or column of paper on each
+    side that is not the image's edge (the paper rows then carry no label); `longest` is the
+    image's longest side (default: the longest side of `labels`)."""
     edge = np.unique(np.concatenate([labels[0], labels[-1], labels[:, 0], labels[:, -1]]))
     edge = edge[edge > 0]
     if edge.size == 0:
         return edge
     depth = ndimage.distance_transform_edt(np.isin(labels, edge))
     radii = ndimage.maximum(depth, labels, edge)
-    return edge[np.asarray(radii) > FRAME_RADIUS * max(labels.shape)]
+    return edge[np.asarray(radii) > FRAME_RADIUS * (longest or max(labels.shape))]
 
 
 def extract_ink(gray: np.ndarray, *, threshold: float | None) -> tuple[np.ndarray, float, float, bool]:
@@ -181,12 +209,30 @@ def extract_ink(gray: np.ndarray, *, threshold: float | None) -> tuple[np.ndarra
     """
     level = ink_threshold(gray, threshold)
     ink = gray < level
-    if not ink.any():
+    dark = np.count_nonzero(ink)
+    if not dark:
         raise InputError("no ink found: no pixel is darker than the threshold")
-    if ink.mean() > 0.6:
-        raise InputError(f"the image is {ink.mean():.0%} ink: it looks inverted or is not a line drawing")
+    if dark / ink.size > 0.6:
+        raise InputError(f"the image is {dark / ink.size:.0%} ink: it looks inverted or is not a line drawing")
+    # Everything below works on the ink's bounding box grown by one row or column of paper
+    # (where the image has one): beyond it there is only paper, connected to the image's
+    # edge around the box, so the pieces, the frame, the holes and the width are the same as
+    # over the whole image (see each step), at a fraction of the pixels.
+    box = ink_box(ink, 1)
+    kept, width, framed = _kept_ink(ink[box], max(ink.shape))
+    ink = np.zeros_like(ink)
+    ink[box] = kept
+    return ink, level, width, framed
+
+
+def _kept_ink(ink: np.ndarray, longest: int) -> tuple[np.ndarray, float, bool]:
+    """`extract_ink` on the crop `ink` (H, W) bool of the dark pixels around the ink (paper
+    or the image's edge on every side); longest: the image's longest side. Returns the kept
+    ink of the crop, the stroke width and whether a frame was ignored."""
+    # Label numbers follow the raster order of each piece's first pixel, the same in a crop.
     labels, count = ndimage.label(ink, structure=np.ones((3, 3)))
-    frame = frame_labels(labels, count)
+    # The crop's outer rows and columns are the image's edge or paper (no label).
+    frame = frame_labels(labels, count, longest)
     framed = 0 < frame.size < count  # a frame with nothing inside it stays: it is all there is
     if framed:
         ink &= ~np.isin(labels, frame)
@@ -200,7 +246,8 @@ def extract_ink(gray: np.ndarray, *, threshold: float | None) -> tuple[np.ndarra
     # A lookup by label (0: paper) is the same as np.isin and needs no sorting.
     ink = np.concatenate([[False], keep])[labels]
     # Holes are the 4-connected pieces of paper that do not reach the image edge (what
-    # `binary_fill_holes` fills), found with one labelling instead of its dilation loop.
+    # `binary_fill_holes` fills), found with one labelling instead of its dilation loop. A
+    # piece reaching the crop's edge reaches the paper around the crop, and so the image's.
     paper, count = ndimage.label(~ink)
     hole = np.ones(count + 1, dtype=bool)
     hole[0] = False  # ink
@@ -208,7 +255,7 @@ def extract_ink(gray: np.ndarray, *, threshold: float | None) -> tuple[np.ndarra
     small = np.bincount(paper.ravel()) < max(2.0, 0.5 * width * width)
     small &= hole
     ink |= small[paper]
-    return ink, level, width, framed
+    return ink, width, framed
 
 
 def paper_gray(image: np.ndarray, *, max_size: int, blur: float) -> tuple[np.ndarray, float]:
@@ -223,12 +270,15 @@ def ink_image(gray: np.ndarray, scale: float, *, threshold: float | None) -> Ink
     ink, level, width, framed = extract_ink(gray, threshold=threshold)
     # Whiten everything that is not kept ink (specks, a frame) and blacken filled holes, so
     # that the sub-pixel outline of the gray image matches the kept ink exactly.
-    near = np.zeros_like(ink)
-    box = ink_box(ink, 2)  # the dilation cannot reach beyond 2 px of the ink
-    near[box] = ndimage.binary_dilation(ink[box], iterations=2)
-    work = np.where(near, gray, 1.0).astype(np.float32)
-    work[(work < level) & ~ink] = 1.0
-    work[ink & (work >= level)] = 0.0
+    # Only the box around the ink changes: the dilation cannot reach beyond 2 px of the ink.
+    box = ink_box(ink, 2)
+    kept = ink[box]
+    near = ndimage.binary_dilation(kept, iterations=2)
+    part = np.where(near, gray[box], 1.0).astype(np.float32)
+    part[(part < level) & ~kept] = 1.0
+    part[kept & (part >= level)] = 0.0
+    work = np.ones(gray.shape, dtype=np.float32)
+    work[box] = part
     return InkImage(gray=work, ink=ink, threshold=level, scale=scale, stroke_width=width, frame=framed)
 
 

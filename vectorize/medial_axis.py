@@ -161,20 +161,24 @@ def _collapse_chains(xy: np.ndarray, radius: np.ndarray, edges: np.ndarray, sins
     graph = MedialGraph()
     ends = np.flatnonzero(degree != 2)
     node_of = np.full(n, -1, dtype=np.int64)
-    for vertex in ends.tolist():
-        node_of[vertex] = graph.add_node(xy[vertex], radius[vertex])
+    end_xy, end_radius = xy[ends], radius[ends].tolist()
+    for k, vertex in enumerate(ends.tolist()):
+        node_of[vertex] = graph.add_node(end_xy[k], end_radius[k])
     chain = np.flatnonzero(walked)
     chain = chain[np.lexsort((rank[chain], head[chain]))]
     cuts = np.flatnonzero(np.diff(head[chain])) + 1
-    firsts = np.concatenate([[0], cuts]).tolist() if len(chain) else []  # no chain: all closed
-    stops = np.concatenate([cuts, [len(chain)]]).tolist()
-    path_all = target[chain]
-    edges_all = edge_of[chain]
-    for lo, hi in zip(firsts, stops):
-        first = chain[lo]
-        path = np.concatenate([[source[first]], path_all[lo:hi]])
-        graph.add_branch(Branch(int(node_of[path[0]]), int(node_of[path[-1]]), xy[path], radius[path],
-                                sins[edges_all[lo:hi]]))
+    firsts = np.concatenate([[0], cuts]) if len(chain) else np.zeros(0, dtype=np.int64)  # no chain: all closed
+    # Every chain's vertices in one gather: chain k's path (its first half-edge's source,
+    # then each half-edge's target) is path[firsts[k] + k: stops[k] + k + 1]; its branch
+    # holds views of the gathered arrays (branches never change their arrays).
+    path = np.insert(target[chain], firsts, source[chain[firsts]])
+    points, radii, sines = xy[path], radius[path], sins[edge_of[chain]]
+    stops = np.append(firsts[1:], len(chain))
+    shift = np.arange(len(firsts))
+    starts, finals = (firsts + shift).tolist(), (stops + shift).tolist()
+    a_nodes, b_nodes = node_of[path[starts]].tolist(), node_of[path[finals]].tolist()
+    for lo, hi, first, final, a, b in zip(firsts.tolist(), stops.tolist(), starts, finals, a_nodes, b_nodes):
+        graph.add_branch(Branch(a, b, points[first:final + 1], radii[first:final + 1], sines[lo:hi]))
     # What is left are closed chains of degree-2 vertices: each gets a node at the first
     # vertex of its lowest edge and is read from there along that edge.
     seen = np.zeros(count, dtype=bool)
