@@ -170,6 +170,11 @@ def test_multi_stroke_mode_and_a_bad_threshold(client):
     multi = client.post("/api/state", json={"edits": dict(edits, multi=True)}).json()
     assert multi["settings"]["multi"] is True and multi["report"]["strokes"] >= 1
     assert multi["edits"]["multi"] is True
+    # The threshold in use: Li's level when automatic, the given one otherwise.
+    li = client.get("/api/state").json()["report"]["threshold"]
+    assert 0 < li < 1 and multi["report"]["threshold"] == li
+    given = client.post("/api/state", json={"edits": dict(edits, threshold=0.42)}).json()
+    assert given["report"]["threshold"] == 0.42 and given["settings"]["threshold"] == 0.42
     answer = client.post("/api/state", json={"edits": dict(edits, threshold=1.5)})
     assert answer.status_code == 400 and "threshold" in answer.json()["error"]
 

@@ -93,6 +93,10 @@ def test_click_a_junction_through_its_pairings_undo_redo_and_play(page):
 
 def test_sliders_dragged_show_busy_and_the_latest_value_wins(page):
     at = page.evaluate("window.studio.at")
+    # Automatic: the slider rests on the level Li's method chose, and says it.
+    li = page.evaluate(f"{STATE}.report.threshold")
+    assert 0 < li < 1 and page.inner_text("#threshold-value") == f"auto {li:.2f}"
+    assert float(page.eval_on_selector("#threshold", "e => e.value")) == pytest.approx(li, abs=0.005)
     # Threshold: dragging it leaves the automatic threshold and re-runs from binarization,
     # with a visible busy state until the answer is drawn.
     drag_slider(page, "#threshold", 0.45)
@@ -135,7 +139,7 @@ def test_sliders_dragged_show_busy_and_the_latest_value_wins(page):
     # Back to the automatic threshold; blur by dragging; multi-stroke by its checkbox.
     page.click("#auto-threshold")
     settle(page, extra=f"{STATE}.settings.threshold === null")
-    assert page.inner_text("#threshold-value") == "auto"
+    assert page.inner_text("#threshold-value") == f"auto {li:.2f}"
     drag_slider(page, "#blur", 0.25)
     assert page.is_visible("#rerun")
     settle(page, extra=f"{STATE}.settings.blur === 1")

@@ -117,3 +117,25 @@ def test_pruned_axis_keeps_the_drawing_and_its_lengths_exact():
         assert len(branch.sins) == len(branch.points) - 1 == len(branch.radii) - 1
         assert branch.length == _fresh(branch).length
         assert copy.branches[bid].length == branch.length and copy.branches[bid] is not branch
+
+
+def test_slot_directions_from_kept_arc_lengths_are_the_direct_ones():
+    """Directions at every junction of a pruned drawing, from the branches' kept arc lengths,
+    equal the chord computed afresh from the points (numpy's norm, diff, cumsum, interp)."""
+    from vectorize.pruning import prune
+    from vectorize.simplify import slot_direction, slot_points, slots
+
+    graph, width = _axis("hershey-HersheySans1-ampersand.png")
+    prune(graph, threshold=0.95, stroke_width=width)
+    checked = 0
+    for node in [n for n in graph.incident if graph.degree(n) >= 3]:
+        for slot in slots(graph, node):
+            points = slot_points(graph, slot)
+            arc = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(points, axis=0), axis=1))])
+            for reach in (0.5 * width, 2.5 * width, 9.0 * width, 1e6):
+                target = min(reach, arc[-1])
+                chord = np.array([np.interp(target, arc, points[:, 0]), np.interp(target, arc, points[:, 1])]) - points[0]
+                expected = chord / np.linalg.norm(chord)
+                assert np.array_equal(slot_direction(graph, slot, reach), expected)
+                checked += 1
+    assert checked >= 40

@@ -35,6 +35,16 @@ class Branch:
         return edge_lengths(self.points)
 
     @cached_property
+    def arc(self) -> np.ndarray:
+        """(M,) px: arc length at each point, from `a`."""
+        return np.concatenate([[0.0], np.cumsum(self.edge_lengths)])
+
+    @cached_property
+    def arc_back(self) -> np.ndarray:
+        """(M,) px: arc length at each point of the branch read from `b` (points[::-1])."""
+        return np.concatenate([[0.0], np.cumsum(self.edge_lengths[::-1])])
+
+    @cached_property
     def length(self) -> float:
         return float(self.edge_lengths.sum())
 

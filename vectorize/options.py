@@ -54,8 +54,9 @@ class VectorizeReport:
     out-and-back features kept; dropped_components: ink pieces left out (single-line mode);
     gaps_bridged: pen gaps joined across (single-line mode, `gaps.py`);
     high_degree_junctions: nodes where three or more strokes meet (not resolved);
-    scale: working px per input px (< 1 when downscaled); seconds: wall time per stage;
-    cpu_seconds: CPU time of the process (all threads) per stage.
+    scale: working px per input px (< 1 when downscaled); threshold: the ink/paper gray
+    level used, in [0, 1] (Li's when none was given; None for an SVG of strokes); seconds:
+    wall time per stage; cpu_seconds: CPU time of the process (all threads) per stage.
     """
 
     strokes: int = 0
@@ -67,6 +68,7 @@ class VectorizeReport:
     retries: int = 0
     scale: float = 1.0
     stroke_width: float = 0.0
+    threshold: float | None = None
     warnings: tuple[str, ...] = ()
     seconds: dict = field(default_factory=dict)
     cpu_seconds: dict = field(default_factory=dict)

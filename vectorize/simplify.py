@@ -41,13 +41,14 @@ def slot_points(graph: MedialGraph, slot: Slot) -> np.ndarray:
 
 def slot_direction(graph: MedialGraph, slot: Slot, reach: float) -> np.ndarray:
     """Unit tangent leaving the node along the slot: chord to the point `reach` px along it."""
-    points = slot_points(graph, slot)
-    steps = np.linalg.norm(np.diff(points, axis=0), axis=1)
-    arc = np.concatenate([[0.0], np.cumsum(steps)])
+    bid, end = slot
+    branch = graph.branches[bid]
+    # The branch's own arc lengths (kept: every stage asks for the directions at its nodes).
+    points, arc = (branch.points, branch.arc) if end == "a" else (branch.points[::-1], branch.arc_back)
     target = min(reach, arc[-1])
     at = np.array([np.interp(target, arc, points[:, 0]), np.interp(target, arc, points[:, 1])])
     chord = at - points[0]
-    norm = np.linalg.norm(chord)
+    norm = np.sqrt(chord.dot(chord))  # what np.linalg.norm computes for one vector
     return chord / norm if norm > 1e-9 else np.array([1.0, 0.0])
 
 

@@ -478,7 +478,8 @@ def run_pipeline(image: np.ndarray, options: VectorizeOptions, *,
         strokes=len(strokes), intersections=len(simple.crossings), y_junctions=len(simple.y_feet),
         dropped_components=dropped, gaps_bridged=len(bridges), high_degree_junctions=len(simple.unresolved),
         retries=tried - 1,
-        scale=scale, stroke_width=w / scale, warnings=tuple(warnings), seconds=clock.seconds,
+        scale=scale, stroke_width=w / scale, threshold=float(ink.threshold), warnings=tuple(warnings),
+        seconds=clock.seconds,
         cpu_seconds=clock.cpu_seconds)
     if stages is not None:
         stages.update(simplified=graph, simple=simple, junctions=junctions, verdicts=verdicts,

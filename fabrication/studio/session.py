@@ -194,6 +194,7 @@ class StudioSession:
             "graph": result.graph.to_dict() if result.graph is not None else {"junctions": [], "branches": []},
             "report": {"strokes": report.strokes, "intersections": report.intersections,
                        "dropped": report.dropped_components, "warnings": list(report.warnings),
+                       "threshold": None if report.threshold is None else round(float(report.threshold), 3),
                        "seconds": round(float(report.total_seconds), 3)},
             "settings": {"threshold": settings.threshold, "blur": settings.blur, "multi": settings.multi},
             "edits": edits.to_dict(),

@@ -441,9 +441,13 @@ function show(state) {
   // value mid-drag would move the thumb away from the pointer.
   const st = state.settings;
   if (studio.holding !== "threshold") {
+    // Automatic: the slider rests on the level Li's method chose, so a drag (or unticking
+    // "automatic") starts from the threshold in use.
+    const used = st.threshold === null ? r.threshold : st.threshold;
     $("auto-threshold").checked = st.threshold === null;
-    if (st.threshold !== null) $("threshold").value = st.threshold;
-    $("threshold-value").textContent = st.threshold === null ? "auto" : Number(st.threshold).toFixed(2);
+    if (used !== null && used !== undefined) $("threshold").value = used;
+    $("threshold-value").textContent = st.threshold !== null ? Number(st.threshold).toFixed(2)
+      : used === null || used === undefined ? "auto" : `auto ${Number(used).toFixed(2)}`;
   }
   if (studio.holding !== "blur") { $("blur").value = st.blur; $("blur-value").textContent = st.blur; }
   $("multi").checked = st.multi;
