@@ -36,6 +36,7 @@ from benchmarks.metrics import (
     dont_care_mask,
     merged_without_crossing,
     polyline_intersections,
+    tiny_loop_crossings,
 )
 from vectorize.drawing import Drawing
 from vectorize.stroke import Stroke
@@ -175,6 +176,7 @@ def handwriting_drawing(seed: int, index: int) -> GroundTruth:
                 if len(r) == 2 and len(runs[k - 1]) == 2 and np.array_equal(runs[k - 1][::-1], r)]
     dont_care = [g.buffer(width) for g in retraced] + _sharp_turns(clean_poly, False, width)
     dont_care += merged_without_crossing(clean, False, width, polyline_intersections([clean_poly], [False]).crossings)
+    dont_care += tiny_loop_crossings(stroke, False, width, inter.crossings)
     # crossings of the jittered passes of a retraced stem or a cusp are not crossings of the word
     real = ~dont_care_mask(inter.crossings, dont_care, max(MATCH_DISTANCE, width))
     crossings, angles = inter.crossings[real], inter.crossing_angles[real]

@@ -298,6 +298,38 @@ def hidden_crossings(stroke: Stroke, closed: bool, width: float, crossings: np.n
     return hidden
 
 
+def tiny_loop_crossings(stroke: Stroke, closed: bool, width: float, crossings: np.ndarray) -> list:
+    """Crossings whose loop is too small to leave paper inside it: no ink can show them.
+
+    A pen path that crosses itself encloses a loop between its two passes; a loop whose centre
+    line is L px long spans at most L / pi px, so with a line `width` px wide it holds no hole
+    (nothing tells the crossing from a blot or a corner) unless L > pi * width. Jittered corners
+    make such loops (a mouse trace's samples overshoot a sharp turn by a pixel or two and come
+    back across it). The loop's length is the arc between the passes through the crossing
+    (samples within 1 px of it). Returns shapely Points of those crossings.
+    """
+    w = float(width)
+    spacing = 0.25
+    points = stroke.sample_evenly(spacing)
+    tiny = []
+    for p in np.asarray(crossings, dtype=float).reshape(-1, 2):
+        near = np.flatnonzero(np.linalg.norm(points - p, axis=1) <= 1.0)
+        if not len(near):
+            continue
+        runs = np.split(near, np.flatnonzero(np.diff(near) > 1) + 1)
+        centres = np.array([run.mean() for run in runs]) * spacing
+        if len(runs) == 1:
+            loop = float((runs[0][-1] - runs[0][0]) * spacing)  # both passes within the same 1 px
+        else:
+            loops = np.diff(centres)
+            if closed:
+                loops = np.append(loops, len(points) * spacing - centres[-1] + centres[0])
+            loop = float(loops.min())
+        if loop < np.pi * w:
+            tiny.append(shapely.Point(*p))
+    return tiny
+
+
 def drawing_polylines(drawing: Drawing, tolerance: float = FLATTEN_TOLERANCE) -> tuple[list[np.ndarray], list[bool]]:
     """Flattened strokes and whether each is closed."""
     polys = [s.flatten(tolerance) for s in drawing.strokes]

@@ -8,7 +8,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.interpolate import splev, splprep
 
-from vectorize.ink_guard import MARGIN, InkGuard, curve_excess, keep_in_ink
+from vectorize.ink_guard import MARGIN, STEP, InkGuard, curve_excess, keep_in_ink
 from vectorize.retraces import Twin, mirror_flags, mirror_keep, rolled, share_pieces, twin_piece, valid_twins
 from vectorize.stroke import Stroke
 
@@ -145,23 +145,71 @@ def sharp_corners(xy: np.ndarray, stroke_width: float, *, closed: bool) -> np.nd
     return np.array(sorted(corners), dtype=int)
 
 
-def _corner_point(before: np.ndarray, after: np.ndarray, fallback: np.ndarray, limit: float) -> np.ndarray:
-    """Where the end tangent of `before` meets the start tangent of `after` (Bézier (K, 4, 2)).
+def _tangent_apex(before: np.ndarray, after: np.ndarray) -> np.ndarray | None:
+    """Where the end tangent of `before` meets the start tangent of `after` (Bézier (K, 4, 2)),
+    ahead of both; None when they are near parallel or meet behind either end.
 
     Near a sharp corner the medial axis bends away from the centre line (towards the
     inner corner's Voronoi region); the two straight-ish sides, extended, meet where the
-    pen turned. Falls back to `fallback` when the sides are near parallel or meet far away.
+    pen turned.
     """
     a, da = before[-1, 3], before[-1, 3] - before[-1, 2]
     b, db = after[0, 0], after[0, 1] - after[0, 0]
     matrix = np.column_stack([da, -db])
     if abs(np.linalg.det(matrix)) < 1e-9 * (np.linalg.norm(da) * np.linalg.norm(db) + 1e-12):
-        return fallback
+        return None
     s_a, s_b = np.linalg.solve(matrix, b - a)
-    point = a + s_a * da
-    if s_a < 0 or s_b > 0 or np.linalg.norm(point - fallback) > limit:
+    if s_a < 0 or s_b > 0:
+        return None
+    return a + s_a * da
+
+
+def _corner_point(before: np.ndarray, after: np.ndarray, fallback: np.ndarray, limit: float) -> np.ndarray:
+    """The tangents' meeting point (`_tangent_apex`), or `fallback` when there is none within
+    `limit` px of it."""
+    apex = _tangent_apex(before, after)
+    if apex is None or np.linalg.norm(apex - fallback) > limit:
         return fallback
-    return point
+    return apex
+
+
+def _tip_in_ink(xy: np.ndarray, at: int, guard: InkGuard, stroke_width: float, closed: bool) -> np.ndarray | None:
+    """Where the pen turned at the corner `xy[at]` of the traced centre line ((N, 2) px), read
+    from the ink: along the corner's outward bisector (away from both sides, as seen 1.5
+    widths along the line), half a width short of where the ink ends (the pen's round tip).
+    None when the ink does not end within 3 widths.
+
+    At a narrow cusp (the top of a handwritten i, n or u) both sides merge into one blob of
+    ink before the tip: the medial axis turns back a width or more short of it, and the two
+    sides' tangents, bent by that turn, meet short of the tip too; the ink still shows how
+    far the pen went. At an ordinary sharp corner the ink's round outer edge lies half a
+    width beyond the corner, so this finds the corner itself.
+    """
+    arc = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(xy, axis=0), axis=1))])
+    reach = 1.5 * stroke_width
+    sides = []
+    for target in (arc[at] - reach, arc[at] + reach):
+        if closed:
+            target = np.mod(target, arc[-1])
+        elif not 0.0 <= target <= arc[-1]:
+            return None
+        point = np.array([np.interp(target, arc, xy[:, 0]), np.interp(target, arc, xy[:, 1])])
+        chord = point - xy[at]
+        if np.linalg.norm(chord) < 1e-9:
+            return None
+        sides.append(chord / np.linalg.norm(chord))
+    inward = sides[0] + sides[1]
+    if np.linalg.norm(inward) < 1e-6:
+        return None  # the line runs straight through: no corner to extend
+    direction = -inward / np.linalg.norm(inward)
+    count = int(np.ceil(3.0 * stroke_width / (STEP / 2)))
+    steps = np.arange(1, count + 1) * (3.0 * stroke_width / count)
+    outside = guard.excess(xy[at] + steps[:, None] * direction) > 0.0
+    if not outside.any():
+        return None
+    # The first step found outside lies up to the guard's margin beyond the ink's edge.
+    edge = float(steps[int(np.argmax(outside))]) - guard.margin
+    return xy[at] + max(edge - 0.5 * stroke_width, 0.0) * direction
 
 
 def _open_fit(points: np.ndarray, sigma: float) -> np.ndarray:
@@ -273,16 +321,25 @@ def fit_stroke(traced: TracedPoints, *, closed: bool, sigma: float, stroke_width
         joints.append((len(pieces) - 1, 0, 0))
     for k, m, at in joints:
         before, after = pieces[k], pieces[m]
+        on_tangents = False
         if corner[at]:
             point = _corner_point(before, after, xy[at], 2.0 * stroke_width)
             # A corner point is held to the invariant's own slack (half width + 1 px), not to a
             # thin line's one-width margin: the image probe finds little ink around a faint
             # tip, and the centre-line point instead cuts the corner.
-            if guard is not None and guard.excess(point)[0] > MARGIN - guard.margin:
+            on_tangents = guard is None or guard.excess(point)[0] <= MARGIN - guard.margin
+            if not on_tangents:
                 point = xy[at]
+            # Where the ink shows the pen went further than the tangents say (a narrow cusp
+            # whose axis stops short), the tip goes there; the sides' handles follow it.
+            tip = _tip_in_ink(xy, at, guard, stroke_width, closed) if guard is not None else None
+            # Only a tip beyond the corner point by more than the invariant's slack moves it: a
+            # sharp corner whose sides' tangents meet in the ink is already where the pen turned.
+            if tip is not None and np.linalg.norm(tip - xy[at]) > np.linalg.norm(point - xy[at]) + MARGIN:
+                point, on_tangents = tip, False
         else:
             point = (before[-1, 3] + after[0, 0]) / 2.0
-        if not corner[at] or np.array_equal(point, xy[at]):
+        if not on_tangents or np.array_equal(point, xy[at]):
             # Elsewhere move the inner handles along, keeping both end tangents; at a
             # corner the point lies on the tangents already.
             before[-1, 2] += point - before[-1, 3]
