@@ -99,10 +99,12 @@ def flatten_paper(gray: np.ndarray) -> np.ndarray:
     if in_every_window(gray == top, size):
         # Paper at one level (a clean drawing): the closing is that level everywhere, and so
         # is its smoothing, which the filter computes alike for any constant image.
-        paper = np.full((1, 1), top, dtype=np.float64)
+        paper = ndimage.uniform_filter(np.full((1, 1), top, dtype=np.float64), size=size, mode="nearest")
+        if paper[0, 0] == 1.0:  # white paper: the division changes nothing
+            return np.clip(gray, 0.0, 1.0).astype(np.float32, copy=False)
     else:
         paper = ndimage.grey_closing(gray, size=(size, size), mode="nearest").astype(np.float64)
-    paper = ndimage.uniform_filter(paper, size=size, mode="nearest")
+        paper = ndimage.uniform_filter(paper, size=size, mode="nearest")
     return np.clip(gray / np.maximum(paper, MIN_PAPER), 0.0, 1.0).astype(np.float32)
 
 
