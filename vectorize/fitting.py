@@ -173,11 +173,12 @@ def _corner_point(before: np.ndarray, after: np.ndarray, fallback: np.ndarray, l
     return apex
 
 
-def _tip_in_ink(xy: np.ndarray, at: int, guard: InkGuard, stroke_width: float, closed: bool) -> np.ndarray | None:
-    """Where the pen turned at the corner `xy[at]` of the traced centre line ((N, 2) px), read
-    from the ink: along the corner's outward bisector (away from both sides, as seen 1.5
-    widths along the line), half a width short of where the ink ends (the pen's round tip).
-    None when the ink does not end within 3 widths.
+def _tip_in_ink(xy: np.ndarray, arc: np.ndarray, at: int, guard: InkGuard, stroke_width: float,
+                closed: bool) -> np.ndarray | None:
+    """Where the pen turned at the corner `xy[at]` of the traced centre line ((N, 2) px;
+    `arc` (N,) px: arc length at each point), read from the ink: along the corner's outward
+    bisector (away from both sides, as seen 1.5 widths along the line), half a width short of
+    where the ink ends (the pen's round tip). None when the ink does not end within 3 widths.
 
     At a narrow cusp (the top of a handwritten i, n or u) both sides merge into one blob of
     ink before the tip: the medial axis turns back a width or more short of it, and the two
@@ -185,7 +186,6 @@ def _tip_in_ink(xy: np.ndarray, at: int, guard: InkGuard, stroke_width: float, c
     far the pen went. At an ordinary sharp corner the ink's round outer edge lies half a
     width beyond the corner, so this finds the corner itself.
     """
-    arc = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(xy, axis=0), axis=1))])
     reach = 1.5 * stroke_width
     sides = []
     for target in (arc[at] - reach, arc[at] + reach):
@@ -275,6 +275,7 @@ def fit_stroke(traced: TracedPoints, *, closed: bool, sigma: float, stroke_width
         closed = False
         twins = valid_twins(xy, twins)
     # Around a corner the axis is off the centre line for about a stroke width: leave it out.
+    # (The corner joints below read the tip along this arc too.)
     arc = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(xy, axis=0), axis=1))])
     for i in np.flatnonzero(corner):
         keep &= np.abs(arc - arc[i]) > stroke_width
@@ -332,7 +333,7 @@ def fit_stroke(traced: TracedPoints, *, closed: bool, sigma: float, stroke_width
                 point = xy[at]
             # Where the ink shows the pen went further than the tangents say (a narrow cusp
             # whose axis stops short), the tip goes there; the sides' handles follow it.
-            tip = _tip_in_ink(xy, at, guard, stroke_width, closed) if guard is not None else None
+            tip = _tip_in_ink(xy, arc, at, guard, stroke_width, closed) if guard is not None else None
             # Only a tip beyond the corner point by more than the invariant's slack moves it: a
             # sharp corner whose sides' tangents meet in the ink is already where the pen turned.
             if tip is not None and np.linalg.norm(tip - xy[at]) > np.linalg.norm(point - xy[at]) + MARGIN:
