@@ -2,7 +2,7 @@
 // (the library's), the page only draws, keeps the edits history and sends edits back.
 "use strict";
 import { $, busy, call, report } from "./api.js";
-import { refreshPanel, setupPanels } from "./panels.js";
+import { fieldNames, refreshPanel, setupPanels } from "./panels.js";
 
 const PAIRINGS = ["crossing", "touching", "third"];
 const COLORS = { crossing: "#1565c0", touching: "#ef6c00", third: "#8e24aa", other: "#757575", start: "#2e7d32",
@@ -615,7 +615,9 @@ function show(state) {
     list.appendChild(li);
   }
   const warnings = $("warnings"); warnings.innerHTML = "";
-  for (const w of r.warnings) { const li = document.createElement("li"); li.textContent = w; warnings.appendChild(li); }
+  for (const w of r.warnings) {
+    const li = document.createElement("li"); li.textContent = fieldNames(w, null); warnings.appendChild(li);
+  }
   // The controls show the state's settings, except a slider the user holds: writing its
   // value mid-drag would move the thumb away from the pointer.
   const st = state.settings;
