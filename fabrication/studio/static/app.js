@@ -568,7 +568,12 @@ function show(state) {
         `${j.fixed ? " · fixed by you" : ""} · ${offered}, likeliest first:`);
       li.appendChild(passChoice(j));
     } else {
-      li.textContent = `${where} ${j.decision} · CNN p(cross) ${(j.p_crossing * 100).toFixed(0)}%` +
+      // The marker's figure is the confidence (how far the classifier's views agree), not the
+      // probability: "touching 100%" beside p(cross) 19% reads as a contradiction unless both are named.
+      li.title = "confidence: the share of the classifier's 8 turned and mirrored views of this junction " +
+        "that agree (the figure on the marker); p(crossing): their mean probability that two strokes cross here";
+      li.textContent = `${where} ${j.decision} · confidence ${Math.round(100 * (j.confidence || 0))}% · ` +
+        `CNN p(crossing) ${(j.p_crossing * 100).toFixed(0)}%` +
         (j.fixed ? " · fixed by you" : "");
     }
     list.appendChild(li);
@@ -851,6 +856,9 @@ function setup() {
   setupView();
   $("undo").onclick = undo; $("redo").onclick = redo;
   document.addEventListener("keydown", (e) => {
+    // Space plays and pauses the pen (as in the player), unless a control has the key.
+    if (e.key === " " && !e.ctrlKey && !["INPUT", "BUTTON", "SELECT", "TEXTAREA", "LABEL"].includes(e.target.tagName) &&
+        !$("tab-refine").hidden) { e.preventDefault(); play(); return; }
     if (!(e.ctrlKey || e.metaKey) || e.target.tagName === "INPUT") return;
     if (e.key === "z" && !e.shiftKey) { e.preventDefault(); undo(); }
     if (e.key === "y" || (e.key === "z" && e.shiftKey)) { e.preventDefault(); redo(); }
