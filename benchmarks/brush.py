@@ -108,7 +108,7 @@ def kana_set(count: int, seed: int = 0) -> list[GroundTruth]:
             break
         name = names[(k + seed) % len(names)]
         rng = np.random.default_rng([seed, k, 41])
-        width = float(np.round(rng.uniform(6.0, 16.0) * 4) / 4)
+        width = float(np.round(rng.uniform(10.0, 36.0) * 4) / 4)
         glyph = kana_glyph(name)
         gt = (glyph_ground_truth(glyph, width, close_gaps=True, fit=rng.uniform(0.6, 1.0))
               or glyph_ground_truth(glyph, width, ambiguous=True, close_gaps=True, fit=rng.uniform(0.6, 1.0)))
@@ -132,7 +132,7 @@ def capital_set(count: int, seed: int = 0) -> list[GroundTruth]:
         if g.unicode in letters and len(letters) < 26:
             continue
         grng = np.random.default_rng([seed, int(k), 47])
-        width = float(np.round(grng.uniform(6.0, 16.0) * 4) / 4)
+        width = float(np.round(grng.uniform(8.0, 24.0) * 4) / 4)
         fit = grng.uniform(0.6, 1.0)
         gt = (glyph_ground_truth(g, width, close_gaps=True, fit=fit)
               or glyph_ground_truth(g, width, ambiguous=True, close_gaps=True, fit=fit))
