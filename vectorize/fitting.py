@@ -287,8 +287,14 @@ def fit_stroke(traced: TracedPoints, *, closed: bool, sigma: float, stroke_width
     # Around a corner the axis is off the centre line for about a stroke width: leave it out.
     # (The corner joints below read the tip along this arc too.)
     arc = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(xy, axis=0), axis=1))])
-    for i in np.flatnonzero(corner):
-        keep &= np.abs(arc - arc[i]) > stroke_width
+    at = arc[np.flatnonzero(corner)]  # ascending, as the arc is
+    if at.size:
+        # the distance along the line to the nearest corner, either side (one pass, not one
+        # per corner: TSP art has thousands)
+        k = np.searchsorted(at, arc)
+        after = np.abs(at[np.minimum(k, at.size - 1)] - arc)
+        before = np.abs(arc - at[np.maximum(k - 1, 0)])
+        keep &= np.minimum(before, after) > stroke_width
     mirror_keep(twins, keep)
     cuts = [0] + [int(i) for i in np.flatnonzero(split) if 0 < i < len(xy) - 1] + [len(xy) - 1]
     pieces = []
