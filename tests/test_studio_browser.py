@@ -82,6 +82,25 @@ def test_click_a_junction_through_its_pairings_undo_redo_and_play(page):
     assert 0.2 < pen < 0.8 and coloured_pixels(page) < full
     assert "/" in page.inner_text("#where")
     page.screenshot(path=str(ARTIFACTS / "studio-3-playing.png"))
+    # The paused pen keeps its place on the drawing through later edits: put it on the first
+    # stroke away from every junction, reverse that stroke (its share of the length turns
+    # over), undo (back).
+    share = page.evaluate(f"""(() => {{ const t = window.studio.line, n = {STATE}.strokes[0].points.length;
+        for (let i = Math.floor(n / 5); i < n; i++) if ({STATE}.graph.junctions.every(j =>
+            Math.hypot(j.at[0] - t.pts[i][0], j.at[1] - t.pts[i][1]) > 40)) return t.cum[i] / t.total; }})()""")
+    page.eval_on_selector("#scrub", f"e => {{ e.value = {round(share * 1000)}; e.dispatchEvent(new Event('input')); }}")
+    spot, pen = page.evaluate("window.studio.penPoint()"), page.evaluate("window.studio.pen")
+    first = page.evaluate(f"{STATE}.strokes[0].length") / page.evaluate("window.studio.line.total")
+    page.click("#reverse-all")
+    settle(page, count + 2)
+    moved = page.evaluate("window.studio.penPoint()")
+    assert abs(moved[0] - spot[0]) < 2.5 and abs(moved[1] - spot[1]) < 2.5, (spot, moved)
+    assert page.evaluate("window.studio.pen") == pytest.approx(first - pen, abs=0.003)
+    assert page.evaluate("Number(document.getElementById('scrub').value)") == round(page.evaluate("window.studio.pen") * 1000)
+    page.click("#undo")
+    settle(page, count + 1)
+    assert page.evaluate("window.studio.penPoint()") == spot
+    assert page.evaluate("window.studio.pen") == pytest.approx(pen, abs=0.001)
     # The scrubber, dragged with the mouse, puts the pen where it is let go.
     drag_slider(page, "#scrub", 0.25)
     assert abs(page.evaluate("window.studio.pen") - 0.25) < 0.03
@@ -188,6 +207,49 @@ def test_split_merge_start_and_reverse_by_clicking(page):
     assert abs(last[0] - end[0]) < 3 and abs(last[1] - end[1]) < 3
     page.screenshot(path=str(ARTIFACTS / "studio-7-after-edits.png"))
     page.check("input[name=tool][value=pairing]")
+
+
+def test_split_halves_a_pixel_apart_are_drawn_apart_and_each_clicks(page):
+    """Split at (597, 366) leaves two unresolved degree-3 nodes 1 px apart: their markers
+    fan out (each tied to its junction), each has its label, and a click on each says which
+    it is and offers to merge it back or to undo the split."""
+    before = page.evaluate(f"{STATE}.edits.edits.length")
+    page.check("input[name=tool][value=split]")
+    click_at(page, junction_near(page, (597, 366))["at"])
+    # (a pairing chosen there by the first test goes with the split)
+    settle(page, extra=f"{STATE}.edits.edits.some(e => e.kind === 'split' && Math.abs(e.at[0] - 597) < 3)")
+    count = page.evaluate(f"{STATE}.edits.edits.length")
+    assert count in (before, before + 1)
+    halves = page.evaluate(f"{STATE}.graph.junctions.filter(j => j.role === 'unresolved')")
+    assert len(halves) == 2 and abs(halves[0]["at"][0] - halves[1]["at"][0]) < 3
+    places = [page.evaluate(f"window.studio.markerAt({j['id']})") for j in halves]
+    assert abs(places[0][0] - places[1][0]) + abs(places[0][1] - places[1][1]) > 2 * 9  # apart: radius 7 + ring
+    labels = page.evaluate("window.studio.placed.filter(p => p.text === 'unresolved').map(p => p.box)")
+    assert len(labels) == 2
+    a, b = labels
+    assert a[0] + a[2] <= b[0] or b[0] + b[2] <= a[0] or a[1] + a[3] <= b[1] or b[1] + b[3] <= a[1]  # no overlap
+    x, y = page.evaluate(f"window.studio.toScreen(597, 366)")
+    page.screenshot(path=str(ARTIFACTS / "studio-7b-split-unresolved.png"), clip={"x": x - 160, "y": y - 90,
+                                                                                  "width": 320, "height": 180})
+    page.check("input[name=tool][value=pairing]")
+    for j, place in zip(halves, places):
+        page.mouse.click(*place)
+        page.wait_for_function("!document.getElementById('hint').hidden")
+        assert f"({j['at'][0]:.0f}, {j['at'][1]:.0f}) unresolved" in page.inner_text("#hint")
+        assert page.locator("#hint button").count() == 2  # merge back, undo the split
+    assert page.evaluate(f"{STATE}.edits.edits.length") == count  # a click there only explains
+    page.screenshot(path=str(ARTIFACTS / "studio-7c-unresolved-hint.png"))
+    page.click("#hint .merge-here")
+    settle(page, count + 1)
+    assert page.evaluate(f"{STATE}.edits.edits.slice(-1)[0].kind") == "merge"
+    assert not page.evaluate(f"{STATE}.graph.junctions.filter(j => j.role === 'unresolved').length")
+    assert junction_near(page, (597, 366))["role"] == "crossing" and page.is_hidden("#hint")
+    # From the junction list, "undo the split here" drops the split instead.
+    page.click("#undo")
+    settle(page, count)
+    page.click("#junctions li.unresolved .unsplit")
+    settle(page, count - 1)
+    assert junction_near(page, (597, 366))["role"] == "crossing"
 
 
 def test_zoom_pan_and_reverse_one_stroke(page):

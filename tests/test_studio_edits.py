@@ -106,6 +106,8 @@ def test_each_edit_kind_and_cached_replay_equal_fresh(loop_png):
     split = results["split"].graph
     assert not [j for j in split.junctions if j.role == "crossing"]
     bridge = min(split.branches, key=lambda b: (b.at[0] - junction.at[0]) ** 2 + (b.at[1] - junction.at[1]) ** 2)
+    # The branch names the two nodes it joins (the page merges an unresolved junction by them).
+    assert len(set(bridge.nodes)) == 2 and set(bridge.nodes) <= {j.id for j in split.junctions if j.degree == 3}
     # Merge by that branch: the crossing is back and the drawing is the automatic one again.
     merged = vectorize_file(loop_png, OPTIONS, edits=Edits(items=(Edit(kind="split", at=junction.at),
                                                                   Edit(kind="merge", at=bridge.at))), cache=cache)

@@ -160,11 +160,13 @@ class JunctionInfo:
 @dataclass(frozen=True)
 class BranchInfo:
     """A branch joining two degree-3 nodes (a merge candidate): at is its middle point
-    (x, y) output px, length in output px."""
+    (x, y) output px, length in output px; nodes: the ids of the two nodes it joins (the
+    `JunctionInfo.id`s: the page offers "merge" at an unresolved junction by them)."""
 
     id: int
     at: tuple[float, float]
     length: float
+    nodes: tuple[int, int] = ()
 
 
 @dataclass(frozen=True)
@@ -455,7 +457,8 @@ class Refinement:
         for bid, branch in sorted(graph.branches.items()):
             if _mergeable(graph, branch):
                 middle = branch.points[len(branch.points) // 2]
-                branches.append(BranchInfo(bid, self.to_output(middle), round(branch.length / self.scale, 3)))
+                branches.append(BranchInfo(bid, self.to_output(middle), round(branch.length / self.scale, 3),
+                                           (int(branch.a), int(branch.b))))
         ends = tuple(self.to_output(graph.positions[n]) for n in sorted(graph.incident) if graph.degree(n) == 1)
         gaps = tuple((self.to_output(a), self.to_output(b)) for a, b in bridges)
         return GraphView(tuple(nodes), tuple(branches), self._retraces(solution), ends, gaps,

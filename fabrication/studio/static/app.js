@@ -302,6 +302,7 @@ function placeLabels(g, more = []) {
   const boxes = studio.labels.map(({ x, y, gap }) => [x - gap, y - gap, 2 * gap, 2 * gap]).concat(more);
   const h = 13, c = $("canvas");
   const placed = [];
+  studio.placed = [];  // the texts drawn and their boxes (screen px)
   for (const { text, x, y, gap } of studio.labels) {
     // Two nodes a pixel or two apart (a split crossing) would print the same text twice.
     if (placed.some((q) => q.text === text && Math.hypot(q.x - x, q.y - y) < 12)) continue;
@@ -313,6 +314,7 @@ function placeLabels(g, more = []) {
     const [lx, ly] = spots.find(([sx, sy]) => inside(sx, sy) && !boxes.some((b) => covers(sx, sy, b))) ||
       spots.find(([sx, sy]) => inside(sx, sy)) || spots[0];
     boxes.push([lx, ly - h / 2, w, h]);
+    studio.placed.push({ text, box: [lx, ly - h / 2, w, h] });
     g.fillStyle = "rgba(255,255,255,0.8)"; g.fillRect(lx - 2, ly - h / 2, w + 4, h);
     g.strokeStyle = "rgba(255,255,255,0.9)"; g.lineWidth = 3; g.lineJoin = "round"; g.strokeText(text, lx, ly);
     g.fillStyle = "#222"; g.fillText(text, lx, ly);
@@ -320,6 +322,60 @@ function placeLabels(g, more = []) {
 }
 
 function samePasses(a, b) { return JSON.stringify(a) === JSON.stringify(b); }
+
+// Marker radii on screen, per junction role (a triple point's is drawn by tripleMarker).
+const MARKER_R = { triple: 22, crossing: 10, unresolved: 9 };
+
+// Where each junction's marker is drawn, in screen px: on its junction, except where
+// markers would cover each other (the two halves of a split crossing a pixel apart, a Y
+// beside a crossing): such a group is fanned out around its middle, each marker tied to
+// its junction by a thin line, so that each one reads and takes its own click.
+function markerPlaces() {
+  const ms = studio.state.graph.junctions.map((j) => {
+    const at = toScreen(...j.at);
+    return { j, at, x: at[0], y: at[1], r: MARKER_R[j.role] || 6 };
+  });
+  const group = ms.map((_, i) => i);
+  const root = (i) => (group[i] === i ? i : (group[i] = root(group[i])));
+  ms.forEach((a, i) => ms.forEach((b, k) => {
+    if (k > i && a.j.role !== "triple" && b.j.role !== "triple" &&
+        Math.hypot(a.x - b.x, a.y - b.y) < a.r + b.r + 2) group[root(i)] = root(k);
+  }));
+  const groups = new Map();
+  ms.forEach((m, i) => { const k = root(i); groups.set(k, (groups.get(k) || []).concat([m])); });
+  for (const members of groups.values()) {
+    const n = members.length;
+    if (n < 2) continue;
+    const cx = members.reduce((t, m) => t + m.at[0], 0) / n, cy = members.reduce((t, m) => t + m.at[1], 0) / n;
+    const spread = Math.max(...members.map((m) => m.r)) + 2;
+    const radius = spread / Math.sin(Math.PI / n);
+    // Around the middle in the order they lie (coinciding ones by id), turned so that the
+    // first keeps its own side.
+    const angle = (m) => Math.atan2(m.at[1] - cy, m.at[0] - cx);
+    members.sort((a, b) => angle(a) - angle(b) || a.j.id - b.j.id);
+    const first = Math.hypot(members[0].at[0] - cx, members[0].at[1] - cy) > 0.5 ? angle(members[0]) : Math.PI;
+    members.forEach((m, k) => {
+      const a = first + (2 * Math.PI * k) / n;
+      m.x = cx + radius * Math.cos(a); m.y = cy + radius * Math.sin(a); m.moved = true;
+    });
+  }
+  return ms;
+}
+
+// The marker under screen point (sx, sy) among these roles, or null.
+function markerHit(sx, sy, roles) {
+  let best = null, bestD = Infinity;
+  for (const m of studio.markers || []) {
+    const d = Math.hypot(m.x - sx, m.y - sy);
+    if (roles.includes(m.j.role) && d <= Math.max(18, m.r + 4) && d < bestD) { best = m.j; bestD = d; }
+  }
+  return best;
+}
+studio.markerAt = (id) => {
+  const m = (studio.markers || []).find((q) => q.j.id === id);
+  const r = $("canvas").getBoundingClientRect();
+  return m ? [r.left + m.x, r.top + m.y] : null;
+};
 
 function junctionMarkers(g) {
   const graph = studio.state.graph;
@@ -337,16 +393,27 @@ function junctionMarkers(g) {
       g.moveTo(x, y - 7); g.lineTo(x + 7, y); g.lineTo(x, y + 7); g.lineTo(x - 7, y); g.closePath(); g.fill();
     }
   }
-  for (const j of graph.junctions) {
-    const [x, y] = toScreen(...j.at);
+  studio.markers = markerPlaces();
+  for (const m of studio.markers) {
+    if (!m.moved) continue;
+    // A marker moved off its junction: a thin line from the junction (a dot) to it.
+    g.strokeStyle = "rgba(60,60,60,0.8)"; g.fillStyle = "rgba(60,60,60,0.9)"; g.lineWidth = 1.5;
+    g.beginPath(); g.moveTo(m.at[0], m.at[1]); g.lineTo(m.x, m.y); g.stroke();
+    g.beginPath(); g.arc(m.at[0], m.at[1], 2.5, 0, 2 * Math.PI); g.fill();
+  }
+  for (const { j, x, y } of studio.markers) {
     if (j.role === "triple") { tripleMarker(g, j); continue; }
     if (j.role !== "crossing") {
       // An unresolved junction (the warning's "three or more strokes seem to meet") is
-      // named where it is: the order there is the walk's guess.
+      // named where it is: the order there is the walk's guess. A click says what to do.
       const open = j.role === "unresolved";
-      g.strokeStyle = open ? COLORS.gap : COLORS.other; g.lineWidth = 2;
-      g.beginPath(); g.arc(x, y, open ? 8 : 5, 0, 2 * Math.PI); g.stroke();
-      if (open) label(g, "unresolved ?", x, y, 11);
+      g.strokeStyle = open ? COLORS.gap : COLORS.other; g.lineWidth = 2; g.fillStyle = "rgba(255,255,255,0.85)";
+      g.beginPath(); g.arc(x, y, open ? 7 : 5, 0, 2 * Math.PI); g.fill(); g.stroke();
+      if (open) {
+        g.fillStyle = COLORS.gap; g.font = "bold 10px sans-serif"; g.textAlign = "center"; g.textBaseline = "middle";
+        g.fillText("?", x, y + 0.5);
+        label(g, "unresolved", x, y, 10);
+      }
       continue;
     }
     const color = COLORS[j.decision] || COLORS.other;
@@ -361,10 +428,81 @@ function junctionMarkers(g) {
   }
 }
 
+// What an unresolved junction offers: merge it with the degree-3 node its shortest branch
+// leads to (one crossing again), and drop a split made there. Buttons, for the hint shown
+// on a click and the junction list.
+function unresolvedFixes(j) {
+  const s = studio.state, buttons = [];
+  const branch = s.graph.branches.filter((b) => (b.nodes || []).includes(j.id)).sort((a, b) => a.length - b.length)[0];
+  if (branch) {
+    const other = s.graph.junctions.find((o) => o.id === branch.nodes.find((n) => n !== j.id));
+    const button = document.createElement("button");
+    button.className = "merge-here";
+    button.textContent = other ? `merge with (${other.at[0].toFixed(0)}, ${other.at[1].toFixed(0)}): one crossing`
+      : "merge by its shortest branch";
+    button.title = `collapse the ${branch.length.toFixed(0)} px branch between them into a degree-4 crossing`;
+    button.onclick = () => { hint(""); apply(withEdit({ kind: "merge", at: branch.at }, false)); };
+    buttons.push(button);
+  }
+  const tol = currentEdits().tolerance;
+  const splits = currentEdits().edits.filter((e) => e.kind === "split" && dist(e.at, j.at) <= tol);
+  if (splits.length) {
+    const button = document.createElement("button");
+    button.className = "unsplit";
+    button.textContent = "undo the split here";
+    button.onclick = () => {
+      hint("");
+      const edits = JSON.parse(JSON.stringify(currentEdits()));
+      edits.edits = edits.edits.filter((e) => !(e.kind === "split" && dist(e.at, j.at) <= edits.tolerance));
+      apply(edits);
+    };
+    buttons.push(button);
+  }
+  return buttons;
+}
+
+function describeUnresolved(j) {
+  return `(${j.at[0].toFixed(0)}, ${j.at[1].toFixed(0)}) unresolved: ${j.degree} branches meet and none ` +
+    "is read as going on through it, so the line's order here is a guess";
+}
+
+// The pen's place through an edit: a paused (or playing) pen stays on the spot of the
+// drawing where it was, i.e. at the new curve's point nearest to it; where the new curve
+// passes that spot more than once (a crossing, a stretch drawn twice), on the pass whose
+// share of the length is nearest to the pen's old share. The part before it is then what
+// the new order draws before that spot. A pen at the end (nothing paused) stays there.
+function keepPen(before, after) {
+  if (!before || !after.pts.length || (studio.pen >= 1 && !studio.playing)) return;
+  const share = studio.pen;
+  const spot = before.pts[penIndex(before, share * before.total)];
+  const d = after.pts.map((q) => dist(q, spot));
+  const near = Math.min(...d) + PEN_SLACK;
+  // Each pass of the new curve by the spot: a run of points within `near`; on it, the
+  // point nearest the spot.
+  const passes = [];
+  after.pts.forEach((q, i) => {
+    if (d[i] > near) return;
+    const last = passes[passes.length - 1];
+    if (last && last.end === i - 1 && !q.first) { last.end = i; if (d[i] < d[last.at]) last.at = i; }
+    else passes.push({ at: i, end: i });
+  });
+  const shareOf = (i) => (after.total ? after.cum[i] / after.total : 0);
+  const pass = passes.reduce((a, b) => (Math.abs(shareOf(b.at) - share) < Math.abs(shareOf(a.at) - share) ? b : a));
+  studio.pen = shareOf(pass.at);
+  $("scrub").value = Math.round(studio.pen * 1000);
+}
+// px: a pass of the new curve this much farther from the spot than the nearest one still
+// goes through it (the curve is sampled every 2 px: CURVE_SPACING in session.py).
+const PEN_SLACK = 2.5;
+studio.penPoint = () => studio.line.pts[penIndex(studio.line, studio.pen * studio.line.total)].slice(0, 2);
+
+function penIndex(t, penAt) {
+  const i = t.cum.findIndex((c) => c >= penAt - 1e-9);
+  return i < 0 ? t.pts.length - 1 : i;
+}
+
 function penMarker(g, t, penAt) {
-  let i = t.cum.findIndex((c) => c >= penAt);
-  if (i < 0) i = t.pts.length - 1;
-  const [x, y] = toScreen(...t.pts[i]);
+  const [x, y] = toScreen(...t.pts[penIndex(t, penAt)]);
   g.fillStyle = "#d50000"; g.strokeStyle = "#fff"; g.lineWidth = 2;
   g.beginPath(); g.arc(x, y, 7, 0, 2 * Math.PI); g.fill(); g.stroke();
   $("where").textContent = `${Math.round(penAt)} / ${Math.round(t.total)} px`;
@@ -373,9 +511,11 @@ function penMarker(g, t, penAt) {
 // ---------------------------------------------------------------- showing a state
 function show(state) {
   const first = !studio.state;
+  const before = studio.line;
   studio.state = state;
   studio.line = timeline();
   if (first) fit();
+  else keepPen(before, studio.line);
   $("name").textContent = state.name;
   const r = state.report;
   $("summary").textContent = `${r.strokes} stroke${r.strokes === 1 ? "" : "s"}, ${r.intersections} crossing` +
@@ -398,6 +538,12 @@ function show(state) {
       li.textContent = `${where} ${j.decision} · CNN p(cross) ${(j.p_crossing * 100).toFixed(0)}%` +
         (j.fixed ? " · fixed by you" : "");
     }
+    list.appendChild(li);
+  }
+  for (const j of state.graph.junctions.filter((j) => j.role === "unresolved")) {
+    const li = document.createElement("li");
+    li.className = "unresolved";
+    li.append(describeUnresolved(j), ...unresolvedFixes(j));
     list.appendChild(li);
   }
   const gaps = state.graph.bridges || [];
@@ -509,22 +655,34 @@ const MISSED = {
     : "no pen gap was bridged in this drawing (single-line mode bridges them; multi-stroke none)",
 };
 
-function hint(text) { $("hint").textContent = text || ""; $("hint").hidden = !text; }
+function hint(text, buttons = []) {
+  $("hint").textContent = text || "";
+  for (const b of buttons) $("hint").append(" ", b);
+  $("hint").hidden = !text;
+}
 
 function onClick(event) {
   const s = studio.state;
   if (!s || studio.dragged) return;
   const r = $("canvas").getBoundingClientRect();
-  const p = toImage(event.clientX - r.left, event.clientY - r.top);
-  hint(clickTool(s, p) ? "" : MISSED[studio.tool]());
+  const sx = event.clientX - r.left, sy = event.clientY - r.top;
+  const p = toImage(sx, sy);
+  const done = clickTool(s, p, sx, sy);
+  if (done !== "hint") hint(done ? "" : MISSED[studio.tool]());
 }
 
-// The edit a click at image point p makes with the current tool (its request), or nothing.
-function clickTool(s, p) {
-  const crossings = s.graph.junctions.filter((j) => j.role === "crossing" || j.role === "triple");
+// The edit a click at image point p (screen point sx, sy) makes with the current tool (its
+// request), "hint" when it only explains, or nothing.
+function clickTool(s, p, sx, sy) {
   const tool = studio.tool;
+  if (tool === "pairing" || tool === "split" || tool === "merge") {
+    const open = markerHit(sx, sy, ["unresolved"]);
+    const fixes = open ? unresolvedFixes(open) : [];
+    if (open && tool === "merge" && fixes.length && fixes[0].className === "merge-here") return fixes[0].onclick() || true;
+    if (open && !markerHit(sx, sy, ["crossing", "triple"])) { hint(describeUnresolved(open) + ".", fixes); return "hint"; }
+  }
   if (tool === "pairing" || tool === "split") {
-    const j = nearest(crossings, p, 18);
+    const j = markerHit(sx, sy, ["crossing", "triple"]);
     if (!j) return;
     if (tool === "split") {
       // A pairing chosen at this junction has nothing left to act on once it is split.
