@@ -16,9 +16,14 @@ varies (meta "width_profile").
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
+import shapely
+import shapely.affinity
 
 from benchmarks.ground_truth import GroundTruth
+from vectorize.drawing import Drawing
 
 SEED_OFFSET = 5  # photo sources: a seed the other sets do not use
 # drawings per kind at the default count (40)
@@ -69,3 +74,23 @@ def kinds_set(count: int | None = None, seed: int = 0) -> list[GroundTruth]:
             if q and len(mixed) < count:
                 mixed.append(q.pop(0))
     return mixed
+
+
+def scaled(gt: GroundTruth, factor: float) -> GroundTruth:
+    """`gt` drawn `factor` times larger on a canvas `factor` times larger (a 3000-4000 px
+    page of the same drawing): geometry, widths, width profile and minimum length scaled."""
+    matrix = np.array([[factor, 0.0, 0.0], [0.0, factor, 0.0]])
+    d = gt.drawing
+    drawing = Drawing(tuple(s.transformed(matrix) for s in d.strokes), d.width * factor, d.height * factor,
+                      unit=d.unit, stroke_width=d.stroke_width * factor)
+    meta = {**gt.meta, "scale": factor}
+    if "width_profile" in meta:
+        knots, widths = meta["width_profile"]
+        meta["width_profile"] = (knots, np.asarray(widths) * factor)
+    if "min_length" in meta:
+        meta["min_length"] = meta["min_length"] * factor
+    zones = tuple(shapely.affinity.scale(z, factor, factor, origin=(0, 0)) if isinstance(z, shapely.Geometry)
+                  else np.asarray(z) * factor for z in gt.dont_care)
+    return replace(gt, name=f"{gt.name}-x{factor:g}", drawing=drawing, intersections=gt.intersections * factor,
+                   events=tuple(replace(e, point=np.asarray(e.point) * factor, radius=e.radius * factor)
+                                for e in gt.events), dont_care=zones, meta=meta)

@@ -170,14 +170,15 @@ def _too_close(points: np.ndarray, tour: np.ndarray, clearance: float) -> set[in
     return drop
 
 
-def tsp_tour(rng: np.random.Generator, count: int, width: float, box: float) -> np.ndarray:
-    """A legible closed tour (module doc) as a closed polyline (M + 1, 2) in px, in [0, box]^2."""
+def tsp_tour(rng: np.random.Generator, count: int, width: float, box: float, gap: float = 2.0) -> np.ndarray:
+    """A legible closed tour (module doc) as a closed polyline (M + 1, 2) in px, in [0, box]^2;
+    `gap`: px of paper kept between the ink of two passes (centre lines width + gap apart)."""
     size = int(box / CELL)
     points = stipple(rng, tone_image(rng, size), count) * CELL
     tour = two_opt(points, nearest_neighbour_tour(points))
     for _ in range(50):
         tour = uncross(points, tour)
-        drop = _too_close(points, tour, width + 2.0)
+        drop = _too_close(points, tour, width + gap)
         if not drop:
             poly = points[tour]
             return np.vstack([poly, poly[:1]])

@@ -370,6 +370,9 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--condition", default="clean", choices=CONDITIONS,
                     help="degrade each rendered page like a real input (see benchmarks/conditions.py)")
+    ap.add_argument("--scale", type=float, default=1.0,
+                    help="draw every drawing this many times larger on a canvas as much larger (e.g. 3.5: "
+                         "3500 px pages; the vectorizer's max_size still applies)")
     ap.add_argument("--jobs", type=int, default=1, help="drawings in parallel (timing is cleanest with 1)")
     ap.add_argument("--csv", type=Path, default=None, help="write one row per drawing here")
     ap.add_argument("--plot", type=Path, default=None, metavar="DIR",
@@ -394,6 +397,10 @@ def main(argv: list[str] | None = None) -> int:
         count = args.count if args.count is not None else DEFAULT_COUNTS.get(
             name, KINDS_COUNT if name == "kinds" else HELDOUT_COUNT)
         gts = build_set(name, count, args.seed)
+        if args.scale != 1.0:
+            from benchmarks.kinds import scaled
+
+            gts = [scaled(gt, args.scale) for gt in gts]
         TASKS.extend((name, gt) for gt in gts)
     t_gen = time.perf_counter() - t_start
 
