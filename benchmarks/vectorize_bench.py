@@ -50,10 +50,10 @@ if str(ROOT) not in sys.path:
 import numpy as np  # noqa: E402
 
 from benchmarks.conditions import CONDITIONS, condition_image  # noqa: E402
-from benchmarks.bench_tables import PSNR_CAP, print_failures, print_tables  # noqa: E402
+from benchmarks.bench_tables import PSNR_CAP, print_failures, print_fair_only, print_tables  # noqa: E402
 from benchmarks.drawings import generate_set  # noqa: E402
 from benchmarks.hershey import hershey_set  # noqa: E402
-from benchmarks.ink_metrics import ink_pieces, ink_scores  # noqa: E402
+from benchmarks.ink_metrics import ink_pieces, ink_scores, verdict  # noqa: E402
 from benchmarks.metrics import ORDER_THRESHOLD, evaluate, order_tolerance  # noqa: E402
 from benchmarks.relief import relief_set  # noqa: E402
 from benchmarks.render import render, render_truth, to_uint8  # noqa: E402
@@ -200,10 +200,11 @@ def _ink_row(gt, output, scores) -> dict:
     be read from the ink (meta "fair") the fair-retrace rule's (docs/benchmark.md)."""
     ink = ink_scores(gt, output, order_tolerance(gt.width))
     fair = bool(gt.meta.get("fair"))
-    correct = scores.correct or (fair and ink.fair_ok and scores.undetected == 0)
+    correct = verdict(gt, scores, ink)
     return {"excursion": ink.excursion, "excursion_w": ink.excursion_widths, "within": ink.within,
             "headroom": ink.headroom,
             "uncovered": ink.uncovered, "cover_tolerance": order_tolerance(gt.width), "fair": fair,
+            "fair_why": gt.meta.get("fair_why", "ambiguous" if fair else ""),
             "out_length": output.length, "min_length": gt.meta.get("min_length", float("nan")),
             "correct": bool(correct)}
 
@@ -368,6 +369,8 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--count", type=int, default=None, help="drawings per set (default: plain 42, touch 40, "
                                                             "hershey 40)")
     ap.add_argument("--seed", type=int, default=0)
+    ap.add_argument("--name", action="append", default=None, metavar="TEXT",
+                    help="only the drawings whose name contains TEXT (repeatable; the set is built as usual first)")
     ap.add_argument("--condition", default="clean", choices=CONDITIONS,
                     help="degrade each rendered page like a real input (see benchmarks/conditions.py)")
     ap.add_argument("--scale", type=float, default=1.0,
@@ -397,6 +400,8 @@ def main(argv: list[str] | None = None) -> int:
         count = args.count if args.count is not None else DEFAULT_COUNTS.get(
             name, KINDS_COUNT if name == "kinds" else HELDOUT_COUNT)
         gts = build_set(name, count, args.seed)
+        if args.name:
+            gts = [gt for gt in gts if any(text in gt.name for text in args.name)]
         if args.scale != 1.0:
             from benchmarks.kinds import scaled
 
@@ -461,6 +466,7 @@ def main(argv: list[str] | None = None) -> int:
     rows = run_tasks(jobs, args.ground_truth_as_output, max(1, args.jobs), args.timeout, progress)
     print_tables(rows)
     print_failures(rows)
+    print_fair_only(rows)
     errors = [r for r in rows if r.get("error")]
     if errors:
         print()
@@ -470,8 +476,8 @@ def main(argv: list[str] | None = None) -> int:
     if args.csv:
         keys = ["set", "classifier", "name", "kind", "width", "closed", "strokes", "order", "correct", "ssim",
                 "psnr", "length_ratio", "gt_intersections", "out_intersections", "matched", "seconds",
-                "peak_mb", "condition", "order_correct", "fair", "one_piece", "excursion", "excursion_w", "within",
-                "headroom", "uncovered",
+                "peak_mb", "condition", "order_correct", "fair", "fair_why", "one_piece", "excursion", "excursion_w",
+                "within", "headroom", "uncovered",
                 "cover_tolerance", "out_length", "min_length",
                 "error", "warnings"]
         args.csv.parent.mkdir(parents=True, exist_ok=True)

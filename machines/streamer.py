@@ -205,6 +205,13 @@ class GrblStreamer(StreamConnect, StreamStops):
             if not any(isinstance(r, Message) and "Enabled" in r.text for r in replies):
                 raise MachineError(f"{self.name} did not enter check mode ($C)")
         lines = list(program.lines) + [(0, DRAIN_LINE)]
+        # A line longer than GRBL's receive buffer never fits, whatever has been answered:
+        # character counting would wait for room forever. Refused before anything is sent.
+        for number, text in lines:
+            if len(text) + 1 > self.rx_buffer:
+                raise StreamError(f"line {number} is {len(text) + 1} bytes with its newline, more than the "
+                                  f"{self.rx_buffer}-byte receive buffer of {self.name}: GRBL can never take it; "
+                                  "nothing was sent", failed_line=number)
         try:
             result = self._stream_lines(lines, check=check, on_progress=on_progress, total=len(program))
         finally:

@@ -226,6 +226,16 @@ def test_garbage_bytes_on_the_line(tmp_path, emulator):
     assert_beam_off_after(emu)
 
 
+def test_a_line_longer_than_the_receive_buffer_is_refused_before_sending(tmp_path, emulator):
+    # Character counting waits for room in GRBL's buffer; a line bigger than the whole
+    # buffer never gets it (this hung the CLI and the studio's "Send" forever).
+    emu = emulator(rx_buffer=12)
+    result, errors = run_cli(tmp_path, emu, "G21\nG90\nG1X10.000Y10.000F1000\nM5\n")
+    assert result.exit_code == 1 and len(errors) == 1, result.output
+    assert "line 3 is 22 bytes" in errors[0] and "12-byte receive buffer" in errors[0] and "nothing was sent" in errors[0]
+    assert emu.executed == [] and not emu.beam_on
+
+
 def test_no_answer_at_connect(tmp_path, emulator):
     emu = emulator(faults=Faults(silent=True))
     result, errors = run_cli(tmp_path, emu, job_text(10))

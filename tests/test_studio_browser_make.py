@@ -60,6 +60,9 @@ def test_embroidery_downloads(page, studio, edited, tmp_path, kind, style, size,
     page.fill(f"{form} input[name=color]", color)
     page.press(f"{form} input[name=stitch_length]", "Tab")  # a typed field reports its change on leaving it
     settle(page, extra="document.getElementById('embroidery-stats').textContent.includes('stitches')")
+    # The hoop chosen is in the picture (drawn whole inside the preview), the design in it.
+    box = page.evaluate("window.studio.players.embroidery.frameBox()")
+    assert box and 0 <= box[0] < box[2] <= 1 and 0 <= box[1] < box[3] <= 1, box
     if kind == "pes":
         play_the_panel(page, "embroidery")
         page.screenshot(path=str(ARTIFACTS / "studio-make-embroidery.png"))
@@ -86,3 +89,24 @@ def test_gcode_download(page, studio, edited, tmp_path):
     assert data == cli_bytes("laser", studio[1], edited, tmp_path, ".gcode", "--size", "60mm", "--feed", "1200mm/min",
                              "--power", "35%", "--passes", "2", "--origin", "center", "--arcs")
     assert b"G2" in data or b"G3" in data  # the arcs box took effect
+
+
+def test_options_that_fail_name_the_field_and_dim_the_old_preview(page):
+    """A size the bed cannot hold: the error names the page's field ("Size", not the CLI's
+    --size), the toolpath still shown is dimmed and said to be the last one that worked;
+    a good value brings it back."""
+    page.click("nav .tab[data-tab=laser]")
+    settle(page, extra="document.getElementById('laser-time').textContent.includes('estimated')")
+    size = page.input_value("#laser-form input[name=size]")
+    page.fill("#laser-form input[name=size]", "900mm")
+    page.press("#laser-form input[name=size]", "Tab")
+    page.wait_for_function("document.getElementById('laser-stale').textContent.includes('does not fit the bed')")
+    text = page.inner_text("#laser-stale")
+    assert 'a smaller "Size"' in text and "--size" not in text and "last options that worked" in text, text
+    assert page.is_visible("#laser-stale") and page.evaluate(
+        "getComputedStyle(document.getElementById('laser-player')).opacity") == "0.35"
+    page.screenshot(path=str(ARTIFACTS / "studio-make-laser-refused.png"))
+    page.fill("#laser-form input[name=size]", size)
+    page.press("#laser-form input[name=size]", "Tab")
+    page.wait_for_function("document.getElementById('laser-stale').hidden")
+    assert "does not fit" not in page.inner_text("#tab-laser")

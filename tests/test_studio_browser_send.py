@@ -74,6 +74,14 @@ def test_send_to_a_port_that_cannot_be_used(page):
     assert "/dev/ttyUSB97 does not exist" in text and "onestroke ports" in text, text
     assert page.is_enabled("#send")
     page.screenshot(path=str(ARTIFACTS / "studio-send-4-missing-port.png"))
+    # A controller whose receive buffer is smaller than a line of the job: refused at once,
+    # nothing sent (character counting used to wait for room forever, "connecting").
+    page.fill("#port", "sim://?rx=10")
+    page.click("#send")
+    page.wait_for_function(f"{STATUS}.dataset.state === 'failed' && {STATUS}.textContent.includes('rx=10')")
+    text = page.inner_text("#send-status")
+    assert "10-byte receive buffer" in text and "nothing was sent" in text, text
+    assert page.is_enabled("#send") and not page.is_enabled("#abort")
     # Another pyserial URL (it could reach the network) is refused before anything opens.
     page.fill("#port", "socket://192.0.2.1:23")
     page.click("#send")

@@ -17,6 +17,7 @@ from vectorize.binarize import (
     estimate_stroke_width,
     extract_ink,
     frame_labels,
+    ink_depth,
     ink_image,
     ink_threshold,
     paper_gray,
@@ -155,6 +156,34 @@ def test_the_paper_noise_floor_of_clean_paper_is_its_level():
             assert paper_noise_floor(gray.reshape(1, -1)) == by_percentiles(gray), (n, dark)
     page = paper_gray(_pages()[1][1], max_size=1000, blur=0.0)[0]
     assert paper_noise_floor(page) == by_percentiles(page) == float(page.max())
+
+
+def _scipy_width(ink: np.ndarray) -> float:
+    """The stroke width by its definition: the distance transform and the 3 x 3 maximum
+    filter of scipy over the whole image."""
+    distance = ndimage.distance_transform_edt(ink)
+    values = distance[(distance >= ndimage.maximum_filter(distance, size=3) - 1e-6) & ink]
+    return 1.0 if values.size == 0 else float(max(1.0, 2.0 * np.median(values) - 0.5))
+
+
+@pytest.mark.parametrize("name, page", _pages(), ids=[name for name, _ in _pages()])
+def test_ink_depth_and_width_are_scipys(name, page):
+    gray, _ = paper_gray(page, max_size=1000, blur=0.0)
+    for level in (0.3, 0.5, 0.8):
+        ink = gray < level
+        assert np.array_equal(ink_depth(ink), ndimage.distance_transform_edt(ink)), (name, level)
+        assert estimate_stroke_width(ink) == _scipy_width(ink), (name, level)
+
+
+def test_ink_depth_on_small_masks_at_the_edges():
+    # Ink on the image's edges, all ink, no ink, one pixel, thin and wide shapes.
+    rng = np.random.default_rng(3)
+    masks = [np.ones((5, 7), bool), np.zeros((4, 4), bool), np.eye(6, dtype=bool), np.ones((1, 9), bool)]
+    masks += [rng.random((rng.integers(1, 25), rng.integers(1, 25))) < rng.random() for _ in range(200)]
+    for mask in masks:
+        assert np.array_equal(ink_depth(mask), ndimage.distance_transform_edt(mask))
+        if mask.any():
+            assert estimate_stroke_width(mask) == _scipy_width(mask)
 
 
 def test_a_phone_photo_becomes_gray_row_block_by_row_block():

@@ -7,6 +7,7 @@ from dataclasses import dataclass
 
 import numpy as np
 from scipy import ndimage
+from scipy.spatial import cKDTree
 
 from onestroke.errors import InputError
 
@@ -180,13 +181,59 @@ def estimate_stroke_width(ink: np.ndarray) -> float:
     # image has one) matters: every paper pixel beyond it is farther from the ink than the
     # paper row between them. The transform over the whole page costs 2-3 times more.
     ink = ink[ink_box(ink, 1)]
-    distance = ndimage.distance_transform_edt(ink)
-    # Ridge pixels: local maxima of the distance across the stroke.
-    ridge = (distance >= ndimage.maximum_filter(distance, size=3) - 1e-6) & ink
-    values = distance[ridge]
+    rows, cols = _pixels(ink)
+    distance = ink_depth(ink, rows, cols)
+    # Ridge pixels: local maxima of the distance across the stroke (a 3 x 3 maximum filter,
+    # its edges reflected as `ndimage.maximum_filter` does, read at the ink pixels only).
+    h, w = ink.shape
+    depth = distance[rows, cols]
+    around = depth.copy()
+    for dr in (-1, 0, 1):
+        r = np.clip(rows + dr, 0, h - 1)
+        for dc in (-1, 0, 1):
+            if dr or dc:
+                np.maximum(around, distance[r, np.clip(cols + dc, 0, w - 1)], out=around)
+    values = depth[depth >= around - 1e-6]
     if values.size == 0:
         return 1.0
     return float(max(1.0, 2.0 * np.median(values) - 0.5))
+
+
+def ink_depth(ink: np.ndarray, rows: np.ndarray | None = None, cols: np.ndarray | None = None) -> np.ndarray:
+    """Distance from each ink pixel of `ink` (H, W) bool to the nearest paper pixel, 0 on
+    paper: (H, W) float64, equal to `ndimage.distance_transform_edt(ink)`; rows, cols: the
+    ink pixels (as `np.nonzero(ink)` gives them), when the caller has them.
+
+    The nearest paper pixel of an ink pixel has an ink pixel beside it (a paper pixel with
+    paper on all four sides has a neighbour nearer that ink pixel), so a k-d tree of those
+    edge pixels, asked only at the ink, gives the transform; a line drawing's box is mostly
+    paper, which the transform's full pass over the box spends most of its time on.
+    """
+    if rows is None or cols is None:
+        rows, cols = _pixels(ink)
+    edge = np.zeros_like(ink)
+    edge[1:] |= ink[:-1]
+    edge[:-1] |= ink[1:]
+    edge[:, 1:] |= ink[:, :-1]
+    edge[:, :-1] |= ink[:, 1:]
+    edge &= ~ink
+    paper = np.column_stack(_pixels(edge))
+    if not len(paper) or not len(rows):
+        return ndimage.distance_transform_edt(ink)
+    inside = np.column_stack([rows, cols])
+    _, nearest = cKDTree(paper).query(inside)
+    # The same arithmetic as the transform: squared offsets (whole numbers) summed, rooted.
+    offset = (paper[nearest] - inside).astype(np.float64)
+    np.multiply(offset, offset, offset)
+    distance = np.zeros(ink.shape)
+    distance[rows, cols] = np.sqrt(offset[:, 0] + offset[:, 1])
+    return distance
+
+
+def _pixels(mask: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Rows and columns of the True pixels of `mask` (H, W), in raster order: `np.nonzero`,
+    at a third of its cost on a mostly empty box."""
+    return np.divmod(np.flatnonzero(mask), max(mask.shape[1], 1))
 
 
 def ink_box(ink: np.ndarray, margin: int) -> tuple[slice, slice]:

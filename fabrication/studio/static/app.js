@@ -2,7 +2,7 @@
 // (the library's), the page only draws, keeps the edits history and sends edits back.
 "use strict";
 import { $, busy, call, report } from "./api.js";
-import { refreshPanel, setupPanels } from "./panels.js";
+import { fieldNames, refreshPanel, setupPanels } from "./panels.js";
 
 const PAIRINGS = ["crossing", "touching", "third"];
 const COLORS = { crossing: "#1565c0", touching: "#ef6c00", third: "#8e24aa", other: "#757575", start: "#2e7d32",
@@ -95,12 +95,45 @@ studio.toScreen = (x, y) => {
   return [r.left + sx, r.top + sy];
 };
 
+// Fit the view to the drawing: the ink and the curve with a margin for the markers'
+// labels (a small drawing on a large sheet fills the view), else the whole image.
 function fit() {
   const s = studio.state, c = $("canvas");
   if (!s) return;
   const w = c.clientWidth, h = c.clientHeight;
-  const scale = 0.94 * Math.min(w / s.width, h / s.height);
-  studio.view = { scale, x: (w - s.width * scale) / 2, y: (h - s.height * scale) / 2 };
+  let box = [0, 0, s.width, s.height];
+  const points = s.strokes.flatMap((k) => k.points).concat(s.graph.junctions.map((j) => j.at));
+  if (points.length) {
+    const ink = studio.ink || [Infinity, Infinity, -Infinity, -Infinity];
+    box = [Math.min(ink[0], ...points.map((p) => p[0])), Math.min(ink[1], ...points.map((p) => p[1])),
+           Math.max(ink[2], ...points.map((p) => p[0])), Math.max(ink[3], ...points.map((p) => p[1]))];
+    const pad = Math.max(20, 0.06 * Math.max(box[2] - box[0], box[3] - box[1]));
+    box = [box[0] - pad, box[1] - pad, box[2] + pad, box[3] + pad];
+  }
+  const bw = Math.max(1, box[2] - box[0]), bh = Math.max(1, box[3] - box[1]);
+  const scale = Math.min(w / bw, h / bh);
+  studio.view = { scale, x: (w - bw * scale) / 2 - box[0] * scale, y: (h - bh * scale) / 2 - box[1] * scale };
+}
+
+// The ink's bounding box in image px (dark or opaque pixels of the input, read once from a
+// reduced copy), so that fitting also shows ink the line leaves out (pieces dropped).
+function inkBox(image) {
+  const k = Math.min(1, 600 / Math.max(image.naturalWidth, image.naturalHeight));
+  const cw = Math.max(1, Math.round(image.naturalWidth * k)), ch = Math.max(1, Math.round(image.naturalHeight * k));
+  const c = document.createElement("canvas");
+  c.width = cw; c.height = ch;
+  const g = c.getContext("2d", { willReadFrequently: true });
+  g.fillStyle = "#fff"; g.fillRect(0, 0, cw, ch); g.drawImage(image, 0, 0, cw, ch);
+  const d = g.getImageData(0, 0, cw, ch).data;
+  let x0 = Infinity, y0 = Infinity, x1 = -Infinity, y1 = -Infinity;
+  for (let y = 0; y < ch; y++) for (let x = 0; x < cw; x++) {
+    const i = 4 * (y * cw + x);
+    if (d[i] + d[i + 1] + d[i + 2] < 3 * 128) { x0 = Math.min(x0, x); x1 = Math.max(x1, x); y0 = Math.min(y0, y); y1 = Math.max(y1, y); }
+  }
+  if (x0 === Infinity) return null;
+  const sx = (studio.state ? studio.state.width : image.naturalWidth) / cw;
+  const sy = (studio.state ? studio.state.height : image.naturalHeight) / ch;
+  return [x0 * sx, y0 * sy, (x1 + 1) * sx, (y1 + 1) * sy];
 }
 
 // Points of all strokes in drawing order with cumulative length, for colour and the pen.
@@ -582,7 +615,9 @@ function show(state) {
     list.appendChild(li);
   }
   const warnings = $("warnings"); warnings.innerHTML = "";
-  for (const w of r.warnings) { const li = document.createElement("li"); li.textContent = w; warnings.appendChild(li); }
+  for (const w of r.warnings) {
+    const li = document.createElement("li"); li.textContent = fieldNames(w, null); warnings.appendChild(li);
+  }
   // The controls show the state's settings, except a slider the user holds: writing its
   // value mid-drag would move the thumb away from the pointer.
   const st = state.settings;
@@ -754,11 +789,11 @@ function setupView() {
     if (!drag) return;
     const dx = e.clientX - drag.x, dy = e.clientY - drag.y;
     if (Math.abs(dx) + Math.abs(dy) > 4) studio.dragged = true;
-    if (studio.dragged) { studio.view.x = drag.vx + dx; studio.view.y = drag.vy + dy; draw(); }
+    if (studio.dragged) { studio.view.x = drag.vx + dx; studio.view.y = drag.vy + dy; studio.moved = true; draw(); }
   });
   window.addEventListener("mouseup", () => { drag = null; });
   c.addEventListener("click", onClick);
-  c.addEventListener("dblclick", () => { fit(); draw(); });
+  c.addEventListener("dblclick", () => { studio.moved = false; fit(); draw(); });
   c.addEventListener("wheel", (e) => {
     e.preventDefault();
     const r = c.getBoundingClientRect();
@@ -766,6 +801,7 @@ function setupView() {
     const [ix, iy] = toImage(sx, sy);
     const factor = Math.exp(-e.deltaY * 0.0015);
     studio.view.scale = Math.min(50, Math.max(0.05, studio.view.scale * factor));
+    studio.moved = true;
     studio.view.x = sx - ix * studio.view.scale; studio.view.y = sy - iy * studio.view.scale;
     draw();
   }, { passive: false });
@@ -857,12 +893,19 @@ function setup() {
     if (data !== undefined) apply(data);
     $("open").value = "";
   };
-  studio.image.onload = draw;
+  // The first view fits the ink too: the first state is drawn once the image is read.
+  const loaded = new Promise((done) => {
+    studio.image.onload = () => {
+      try { studio.ink = inkBox(studio.image); } catch (error) { studio.ink = null; }
+      done(); draw();
+    };
+    studio.image.onerror = done;
+  });
   studio.image.src = "api/image";
   (async () => {
     busy(true);
     try {
-      const state = await call("api/state");
+      const [state] = await Promise.all([call("api/state"), loaded]);
       studio.history = [state.edits]; studio.at = 0; studio.shown = state.edits; updateButtons();
       show(state);
     } catch (error) { report(error); } finally { busy(false); }

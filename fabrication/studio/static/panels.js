@@ -32,11 +32,38 @@ export async function refreshPanel() {
     const data = await call(`api/${tab}`, { edits: edits(), options: panelOptions(tab) });
     if (ticket !== panelTicket) return;
     if (tab === "embroidery") showStitches(data); else showToolpath(data);
+    stale(tab, false);
   } catch (error) {
-    report(error, `${tab}-warnings`);
+    if (ticket !== panelTicket) return;
+    stale(tab, true, fieldNames(error.message, `${tab}-form`));
   } finally {
     busy(false);
   }
+}
+
+// The options in the form failed: the preview and figures still shown are those of the last
+// options that worked, dimmed and said so, never taken for the new ones.
+function stale(tab, on, message = "") {
+  $(`tab-${tab}`).classList.toggle("stale", on);
+  $(`${tab}-stale`).hidden = !on;
+  if (!on) return;
+  const shown = !players[tab] ? "" : tab === "laser" ? " The toolpath below is from the last options that worked."
+    : " The stitches below are from the last options that worked.";
+  $(`${tab}-stale`).textContent = `error: ${message}.${shown}`.replace(/\.\./, ".");
+  $(`${tab}-warnings`).innerHTML = "";
+}
+
+// The library names options as the CLI spells them ("--stitch-length"); on the page they
+// are the form's fields ("Stitch length").
+export function fieldNames(message, formId) {
+  return message.replace(/--([a-z][a-z-]*)/g, (flag, name) => {
+    // A form's field, or a control of the Refine panel by its id ("--multi": "multi-stroke drawing").
+    const field = (formId && $(formId).elements[name.replace(/-/g, "_")]) || $(name);
+    const label = field && field.closest("label");
+    const text = label && [...label.childNodes].filter((n) => n.nodeType === Node.TEXT_NODE)
+      .map((n) => n.textContent.trim()).join(" ").trim();
+    return text ? `"${text}"` : flag;
+  });
 }
 
 // Stitches and laser moves play in the project's player (fabrication/player), one per panel.
@@ -75,7 +102,8 @@ async function download(kind) {
     document.body.appendChild(a); a.click(); a.remove();
     setTimeout(() => URL.revokeObjectURL(a.href), 10000);
   } catch (error) {
-    report(error, tab === "refine" ? "warnings" : `${tab}-warnings`);  // beside the button clicked
+    const message = tab === "refine" ? error.message : fieldNames(error.message, `${tab}-form`);
+    report(new Error(message), tab === "refine" ? "warnings" : `${tab}-warnings`);  // beside the button clicked
   } finally {
     busy(false);
   }
@@ -94,7 +122,7 @@ async function sendAction(action) {
     if (action === "send") laserSent = laserShown;
     showSend(status);
   } catch (error) {
-    sendError(error.message);
+    sendError(fieldNames(error.message, "laser-form"));
   }
 }
 async function pollSend() {
