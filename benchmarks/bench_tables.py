@@ -253,3 +253,18 @@ def print_failures(rows: list[dict]) -> None:
                 f"{r['strokes']} strokes, order {r['order']:.3f}, excursion {r['excursion']:.1f} px "
                 f"/ {r['excursion_w']:.2f} w")
             print(f"    {r['set']}/{r['classifier']}/{r['name']}: {detail}")
+
+
+def print_fair_only(rows: list[dict]) -> None:
+    """The drawings counted correct by the fair-retrace rule alone (order score below the
+    threshold): one stroke, in the ink, covering it, at the minimum length, every crossing
+    matched, but a different retrace or start than the ground truth's."""
+    fair = [r for r in rows if r.get("correct") and not r.get("order_correct")]
+    if not fair:
+        return
+    print()
+    print(f"correct by the fair-retrace rule only ({len(fair)}; set/classifier/name: why fair, order, "
+          "output / minimum length px):")
+    for r in fair:
+        print(f"  {r['set']}/{r['classifier']}/{r['name']}: {r.get('fair_why') or 'ambiguous'}, order {r['order']:.3f}, "
+              f"{r['out_length']:.0f} / {r['min_length']:.0f}")

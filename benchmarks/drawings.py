@@ -44,6 +44,7 @@ import numpy as np
 
 from benchmarks.drawing_rules import validate
 from benchmarks.ground_truth import CANVAS, MARGIN, Event, GroundTruth, Rejected  # noqa: F401 (re-exported)
+from benchmarks.ink_metrics import fair_meta
 from vectorize.drawing import Drawing
 from vectorize.stroke import Stroke
 
@@ -297,6 +298,10 @@ def drawing_width(index: int, seed: int) -> float:
     return float(np.round((2.0 + 10.0 * frac) * 4) / 4)
 
 
+FLATTEN_TOLERANCE = 0.05  # px: the pen path the fair-retrace facts are read from (a spike's straight
+# out-and-back segments flatten to the same two points both ways, so the merged graph sees one edge)
+
+
 def generate_drawing(kind: str, seed: int = 0, index: int = 0) -> GroundTruth:
     """One validated drawing of `kind`, determined by (seed, index, kind)."""
     if kind not in ALL_KINDS:
@@ -333,7 +338,8 @@ def generate_drawing(kind: str, seed: int = 0, index: int = 0) -> GroundTruth:
         return GroundTruth(name=f"{kind}-{seed}-{index}", kind=kind, drawing=drawing, closed=closed,
                            intersections=np.asarray(crossings).reshape(-1, 2), events=tuple(events),
                            dont_care=tuple(dont_care),
-                           meta={"seed": seed, "index": index, "attempts": attempt + 1, "width": width})
+                           meta={"seed": seed, "index": index, "attempts": attempt + 1, "width": width,
+                                 **fair_meta(stroke.flatten(FLATTEN_TOLERANCE))})
     raise RuntimeError(f"no valid {kind} drawing after {MAX_ATTEMPTS} attempts (last: {last})")
 
 

@@ -29,7 +29,7 @@ import shapely
 from benchmarks.drawings import _hermite, _Waypoint
 from benchmarks.ground_truth import CANVAS, MARGIN, Event, GroundTruth
 from benchmarks.hershey import _sharp_turns
-from benchmarks.ink_metrics import ink_graph, min_traversal_length
+from benchmarks.ink_metrics import fair_meta
 from benchmarks.metrics import (
     MATCH_DISTANCE,
     ambiguous_junctions,
@@ -169,8 +169,7 @@ def handwriting_drawing(seed: int, index: int) -> GroundTruth:
                                      for a, b in zip([0] + ends[:-1], ends)])
     trace = _mouse_trace(rng, clean, run_lengths[1:-1] * clean.length / run_lengths[-1], width)
     stroke = Stroke.from_polyline(trace)
-    graph = ink_graph(clean_poly)
-    min_length = min_traversal_length(graph) * stroke.length / clean.length
+    fair = fair_meta(clean_poly, ambiguous=bool(ambiguous_junctions(clean_poly)), scale=stroke.length / clean.length)
     inter = polyline_intersections([trace], [False])
     retraced = [shapely.LineString(r) for k, r in enumerate(runs[1:], 1)
                 if len(r) == 2 and len(runs[k - 1]) == 2 and np.array_equal(runs[k - 1][::-1], r)]
@@ -185,8 +184,7 @@ def handwriting_drawing(seed: int, index: int) -> GroundTruth:
     return GroundTruth(name=f"hand-{word}-{seed}-{index}", kind="handwriting", drawing=drawing, closed=False,
                        intersections=crossings.reshape(-1, 2), events=events, dont_care=tuple(dont_care),
                        meta={"seed": seed, "index": index, "word": word, "width": width, "x_height": scale,
-                             "retraces": len(retraced), "fair": bool(ambiguous_junctions(clean_poly)),
-                             "min_length": min_length, "clean_length": clean.length})
+                             "retraces": len(retraced), **fair, "clean_length": clean.length})
 
 
 def handwriting_set(count: int = 40, seed: int = 0) -> list[GroundTruth]:

@@ -28,7 +28,7 @@ import shapely
 import svgelements
 
 from benchmarks.drawings import CANVAS, Event, GroundTruth
-from benchmarks.ink_metrics import ink_graph, min_traversal_length
+from benchmarks.ink_metrics import fair_meta
 from benchmarks.metrics import ambiguous_junctions, hidden_crossings, merged_without_crossing, polyline_intersections
 from vectorize.drawing import Drawing
 from vectorize.stroke import Stroke
@@ -200,17 +200,16 @@ def glyph_ground_truth(glyph: Glyph, width: float, *, ambiguous: bool = False,
     return GroundTruth(name=f"{glyph.font}-{label}", kind=kind, drawing=drawing, closed=closed,
                        intersections=inter.crossings.reshape(-1, 2), events=tuple(events),
                        dont_care=tuple(dont_care),
-                       meta={"font": glyph.font, "glyph": label, "width": width})
+                       meta={"font": glyph.font, "glyph": label, "width": width, **fair_meta(poly, near_width=width)})
 
 
 def _fair_ground_truth(glyph: Glyph, stroke: Stroke, poly: np.ndarray, closed: bool, width: float,
                        inter) -> GroundTruth | None:
     """An ambiguous glyph: its crossings must be reproduced, its order is judged by the
     fair-retrace rule against the minimum traversal of its ink graph."""
-    try:
-        min_length = min_traversal_length(ink_graph(poly))
-    except ValueError:
-        return None
+    fair = fair_meta(poly, ambiguous=True)
+    if not fair["fair"]:
+        return None  # too many odd junctions for the exact minimum
     events = tuple(Event("crossing", p, float(a)) for p, a in zip(inter.crossings, inter.crossing_angles))
     dont_care = [shapely.Point(*p).buffer(2 * width) for p in inter.touches] + list(inter.retraces)
     dont_care += _sharp_turns(poly, closed, width)
@@ -220,8 +219,8 @@ def _fair_ground_truth(glyph: Glyph, stroke: Stroke, poly: np.ndarray, closed: b
     return GroundTruth(name=f"{glyph.font}-{label}", kind="hershey-ambiguous", closed=closed,
                        drawing=Drawing((stroke,), CANVAS, CANVAS, unit="px", stroke_width=width),
                        intersections=inter.crossings.reshape(-1, 2), events=events, dont_care=tuple(dont_care),
-                       meta={"font": glyph.font, "glyph": label, "width": width, "fair": True,
-                             "min_length": min_length, "drawn_length": stroke.length})
+                       meta={"font": glyph.font, "glyph": label, "width": width, **fair,
+                             "drawn_length": stroke.length})
 
 
 def glyph_width(glyph: Glyph, seed: int, widths: tuple[float, float] = (3.0, 8.0)) -> float:

@@ -8,9 +8,11 @@
 - minimum traversal length: the shortest pen path that draws every part of the ground
   truth's ink graph at least once (route inspection / Chinese postman on the graph the
   centre line forms once noded and merged), the bar for the fair-retrace rule;
-- the fair-retrace rule: where the drawing order at a junction cannot be read from the ink,
-  an output that is one stroke, stays in the ink, covers it and is no longer than the
-  minimum traversal (within `FAIR_LENGTH_SLACK`) counts as correct.
+- the fair-retrace rule: where the drawing order cannot be read from the ink (an ambiguous
+  junction, or a ground truth that draws some stretch twice: which stretch is retraced, and
+  whether the pen started at a free end, shows in no ink), an output that is one stroke,
+  stays in the ink, covers it and is no longer than the minimum traversal (within
+  `FAIR_LENGTH_SLACK`) counts as correct (`fair_meta` marks such ground truths).
 
 docs/benchmark.md says exactly how each is measured.
 """
@@ -34,6 +36,7 @@ CENTRE_SPACING = 0.25  # px between ground-truth centre-line samples (distance e
 OUTPUT_SPACING = 0.5  # px between output samples
 FAIR_LENGTH_SLACK = (0.01, 2.0)  # (share of the minimum length, stroke widths) an output may exceed it by
 MAX_ODD_NODES = 20  # the exact pairing below is exponential in the odd nodes
+RETRACE_SLACK = 1.0  # px a pen path may exceed its merged ink graph by and still count as drawn once
 
 
 def _samples(drawing: Drawing, spacing: float) -> np.ndarray:
@@ -152,6 +155,120 @@ def min_traversal_length(graph: InkGraph) -> float:
     return total + _pairing_cost(dist, 2)
 
 
+REVERSAL_DEGREES = 140.0  # the pen turns back by more than this at a retrace's tip
+EXACT_PX = 0.5  # a retrace whose passes never part by more than this is already exact
+MIN_REACH = 3.0  # widths from the tip a near retrace reaches at least (a sharp V's tip merges less)
+MAX_PARTING = 0.5  # px the two passes of one band may part per px along it (2 sin 15 degrees)
+
+
+def _arc(poly: np.ndarray) -> np.ndarray:
+    return np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(poly, axis=0), axis=1))]
+
+
+def _at(poly: np.ndarray, s: np.ndarray, q: np.ndarray) -> np.ndarray:
+    return np.c_[np.interp(q, s, poly[:, 0]), np.interp(q, s, poly[:, 1])]
+
+
+def near_retraces(polyline: np.ndarray, width: float) -> list[tuple[float, float, float]]:
+    """Where the pen goes out and comes back beside itself, closer than one line width all
+    along (no paper between the two passes, so the ink shows one line).
+
+    A tip is where the direction over the `width` before a point and over the `width` after it
+    turn by more than `REVERSAL_DEGREES`, at the point where those two lie closest; from it the path is read at
+    equal arc lengths u before and after, while the two points lie within `width` and part by
+    at most `MAX_PARTING` px per px of u (beyond a retrace's base they part at the angle of
+    the branches there), and reaching at least `MIN_REACH` widths. Returns
+    (tip arc length, u at the last such pair, largest separation px) per tip, in path order,
+    non-overlapping.
+    """
+    poly = np.asarray(polyline, dtype=float)
+    s = _arc(poly)
+    w = float(width)
+    step = w / 4.0
+    q = np.arange(w, s[-1] - w, step)
+    if len(q) < 3:
+        return []
+    before = _at(poly, s, q) - _at(poly, s, q - w)
+    after = _at(poly, s, q + w) - _at(poly, s, q)
+    cos = np.einsum("ij,ij->i", before, after) / np.maximum(
+        np.linalg.norm(before, axis=1) * np.linalg.norm(after, axis=1), 1e-12)
+    # the tip: where the points a width before and after lie closest (zero on an exact retrace)
+    gap = np.linalg.norm(_at(poly, s, q + w) - _at(poly, s, q - w), axis=1)
+    tips = [k for k in range(len(q)) if cos[k] < np.cos(np.radians(REVERSAL_DEGREES))
+            and gap[k] <= gap[max(k - 1, 0)] and gap[k] < gap[min(k + 1, len(q) - 1)]]
+    out: list[tuple[float, float, float]] = []
+    for k in tips:
+        t = q[k]
+        v = int(np.argmin(np.abs(s - t)))
+        if abs(s[v] - t) <= step:  # the tip on the path's own vertex, where the pen turned
+            t = float(s[v])
+        u = np.arange(step, min(t, s[-1] - t), step)
+        if not len(u):
+            continue
+        d = np.linalg.norm(_at(poly, s, t - u) - _at(poly, s, t + u), axis=1)
+        # one band while the passes stay within a width and part slowly (under about 30
+        # degrees): past a junction's base they part at the branches' angle
+        apart = (d >= w) | (np.diff(d, prepend=d[0]) > MAX_PARTING * step)
+        n = int(np.argmax(apart)) if np.any(apart) else len(d)
+        if n == 0 or u[n - 1] < MIN_REACH * w or (out and t - u[n - 1] < out[-1][0] + out[-1][1]):
+            continue
+        out.append((float(t), float(u[n - 1]), float(d[:n].max())))
+    return out
+
+
+def snap_near_retraces(polyline: np.ndarray, width: float) -> np.ndarray:
+    """The pen path with each near retrace (`near_retraces`) made exact: the way back follows
+    the way out, then steps (less than a width) across to where the real way back leaves the
+    merged band. Retraces already exact are left as they are."""
+    poly = np.asarray(polyline, dtype=float)
+    s = _arc(poly)
+    pieces, cursor = [poly[:1]], 0.0
+    for t, u, sep in near_retraces(poly, width):
+        if sep <= EXACT_PX:
+            continue
+        # the way out cut at t - u, so that the way back runs over the very same points
+        out = np.vstack([_at(poly, s, np.array([t - u])), poly[(s > t - u) & (s < t)], _at(poly, s, np.array([t]))])
+        pieces += [poly[(s > cursor) & (s < t - u)], out, out[::-1][1:], _at(poly, s, np.array([t + u]))]
+        cursor = t + u
+    if len(pieces) == 1:
+        return poly
+    return np.vstack(pieces + [poly[s > cursor]])
+
+
+def fair_meta(polyline: np.ndarray, *, ambiguous: bool = False, scale: float = 1.0,
+              near_width: float | None = None) -> dict:
+    """The fair-retrace facts of a ground-truth pen path ((N, 2) px, exact where it retraces).
+
+    Returns meta entries: "retraced_length" (px the path draws beyond its merged ink graph,
+    i.e. the length it draws twice), "fair" (True when `ambiguous` or the path retraces more
+    than `RETRACE_SLACK`: then which stretch is drawn twice, or whether the pen started at a
+    free end, cannot be read from the ink), "fair_why" ("ambiguous", "retrace" or "") and,
+    when fair, "min_length" (the minimum traversal, px, times `scale`: a handwriting word's
+    graph is taken before jitter and scaled to the jittered length). A graph with more than
+    `MAX_ODD_NODES` odd junctions is not fair (no exact minimum). near_width (px, a glyph's
+    line width): also count a near retrace (`near_retraces`: out and back closer than the line
+    is wide) as a retrace, on the path `snap_near_retraces` makes (fair_why "near-retrace").
+    """
+    poly = np.asarray(polyline, dtype=float)
+    graph = ink_graph(poly)
+    retraced = float(_arc(poly)[-1] - graph.lengths.sum())
+    why = "ambiguous" if ambiguous else ("retrace" if retraced > RETRACE_SLACK else "")
+    if near_width is not None and why != "ambiguous":
+        snapped = snap_near_retraces(poly, near_width)
+        if snapped is not poly:
+            near_graph = ink_graph(snapped)
+            near = float(_arc(snapped)[-1] - near_graph.lengths.sum())
+            if near > retraced + RETRACE_SLACK:
+                graph, retraced, why = near_graph, near, "near-retrace"
+    meta: dict = {"retraced_length": retraced, "fair": False, "fair_why": ""}
+    if why:
+        try:
+            meta.update(fair=True, fair_why=why, min_length=min_traversal_length(graph) * scale)
+        except ValueError:
+            pass
+    return meta
+
+
 # -- per-drawing ink scores ----------------------------------------------------------------------
 
 @dataclass(frozen=True)
@@ -186,3 +303,12 @@ def ink_scores(gt, output: Drawing, cover_tolerance: float) -> InkScores:
     fair = bool(len(output.strokes) == 1 and within and unc <= cover_tolerance and min_length is not None
                 and output.length <= fair_length_limit(min_length, width))
     return InkScores(exc, exc / width if np.isfinite(exc) else float("nan"), within, unc, fair)
+
+
+def verdict(gt, scores, ink: InkScores) -> bool:
+    """Whether an output counts as correct: one stroke in the ground-truth order by the order
+    score (`scores`, a metrics.Scores), or, for a fair ground truth (meta "fair"), the
+    fair-retrace rule: `ink.fair_ok` (one stroke, in the ink, covering it, at the minimum
+    length) and every ground-truth crossing matched (a wrong turn at a crossing draws the same
+    ink at the same length, but turns the crossing into a touch)."""
+    return bool(scores.correct or (gt.meta.get("fair") and ink.fair_ok and scores.undetected == 0))

@@ -49,10 +49,10 @@ if str(ROOT) not in sys.path:
 import numpy as np  # noqa: E402
 
 from benchmarks.conditions import CONDITIONS, condition_image  # noqa: E402
-from benchmarks.bench_tables import PSNR_CAP, print_failures, print_tables  # noqa: E402
+from benchmarks.bench_tables import PSNR_CAP, print_failures, print_fair_only, print_tables  # noqa: E402
 from benchmarks.drawings import generate_set  # noqa: E402
 from benchmarks.hershey import hershey_set  # noqa: E402
-from benchmarks.ink_metrics import ink_pieces, ink_scores  # noqa: E402
+from benchmarks.ink_metrics import ink_pieces, ink_scores, verdict  # noqa: E402
 from benchmarks.metrics import ORDER_THRESHOLD, evaluate, order_tolerance  # noqa: E402
 from benchmarks.relief import relief_set  # noqa: E402
 from benchmarks.render import render, to_uint8  # noqa: E402
@@ -193,9 +193,10 @@ def _ink_row(gt, output, scores) -> dict:
     be read from the ink (meta "fair") the fair-retrace rule's (docs/benchmark.md)."""
     ink = ink_scores(gt, output, order_tolerance(gt.width))
     fair = bool(gt.meta.get("fair"))
-    correct = scores.correct or (fair and ink.fair_ok and scores.undetected == 0)
+    correct = verdict(gt, scores, ink)
     return {"excursion": ink.excursion, "excursion_w": ink.excursion_widths, "within": ink.within,
             "uncovered": ink.uncovered, "cover_tolerance": order_tolerance(gt.width), "fair": fair,
+            "fair_why": gt.meta.get("fair_why", "ambiguous" if fair else ""),
             "out_length": output.length, "min_length": gt.meta.get("min_length", float("nan")),
             "correct": bool(correct)}
 
@@ -360,6 +361,8 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--count", type=int, default=None, help="drawings per set (default: plain 42, touch 40, "
                                                             "hershey 40)")
     ap.add_argument("--seed", type=int, default=0)
+    ap.add_argument("--name", action="append", default=None, metavar="TEXT",
+                    help="only the drawings whose name contains TEXT (repeatable; the set is built as usual first)")
     ap.add_argument("--condition", default="clean", choices=CONDITIONS,
                     help="degrade each rendered page like a real input (see benchmarks/conditions.py)")
     ap.add_argument("--jobs", type=int, default=1, help="drawings in parallel (timing is cleanest with 1)")
@@ -385,6 +388,8 @@ def main(argv: list[str] | None = None) -> int:
     for name in sets:
         count = args.count if args.count is not None else DEFAULT_COUNTS.get(name, HELDOUT_COUNT)
         gts = build_set(name, count, args.seed)
+        if args.name:
+            gts = [gt for gt in gts if any(text in gt.name for text in args.name)]
         TASKS.extend((name, gt) for gt in gts)
     t_gen = time.perf_counter() - t_start
 
@@ -445,6 +450,7 @@ def main(argv: list[str] | None = None) -> int:
     rows = run_tasks(jobs, args.ground_truth_as_output, max(1, args.jobs), args.timeout, progress)
     print_tables(rows)
     print_failures(rows)
+    print_fair_only(rows)
     errors = [r for r in rows if r.get("error")]
     if errors:
         print()
@@ -454,7 +460,7 @@ def main(argv: list[str] | None = None) -> int:
     if args.csv:
         keys = ["set", "classifier", "name", "kind", "width", "closed", "strokes", "order", "correct", "ssim",
                 "psnr", "length_ratio", "gt_intersections", "out_intersections", "matched", "seconds",
-                "peak_mb", "condition", "order_correct", "fair", "one_piece", "excursion", "excursion_w", "within", "uncovered",
+                "peak_mb", "condition", "order_correct", "fair", "fair_why", "one_piece", "excursion", "excursion_w", "within", "uncovered",
                 "cover_tolerance", "out_length", "min_length",
                 "error", "warnings"]
         args.csv.parent.mkdir(parents=True, exist_ok=True)

@@ -369,6 +369,73 @@ def test_fair_retrace_rule_accepts_an_equal_stub_and_rejects_an_extra_retrace():
     assert not ink_scores(gt, gt.drawing.with_strokes(two), tol).fair_ok
 
 
+def _bowtie_with_spike():
+    """A closed bow-tie (one crossing, 90 degrees) with a spike drawn out and back from the middle
+    of its right side: the ink is a loop with a free stub, the ground truth retraces the stub."""
+    glyph = Glyph("test", "bowtie", "b", "M 0 0 L 100 100 L 100 50 L 140 50 L 100 50 L 100 0 L 0 100 L 0 0")
+    gt = glyph_ground_truth(glyph, 6.0)
+    assert gt is not None and gt.closed and len(gt.intersections) == 1
+    assert gt.meta["fair"] and gt.meta["fair_why"] == "retrace"
+    pts = {k: gt.stroke.control[i, 0] for i, k in enumerate(["a", "b", "base", "tip", "base2", "c", "d"])}
+    pts["x"] = gt.intersections[0]
+    return gt, pts
+
+
+def test_fair_retrace_rule_covers_any_retracing_ground_truth_but_not_a_wrong_turn():
+    from benchmarks.ink_metrics import ink_scores, verdict
+
+    gt, p = _bowtie_with_spike()
+    # the ground truth draws the spike twice: 40 of its 280 + 200 sqrt(2) font units
+    assert gt.meta["retraced_length"] == pytest.approx(gt.stroke.length * 40 / (280 + 200 * np.sqrt(2)), rel=1e-6)
+    assert gt.meta["min_length"] == pytest.approx(gt.stroke.length - gt.meta["retraced_length"], rel=1e-6)
+    tol = order_tolerance(gt.width)
+
+    def judged(*strokes):
+        out = gt.drawing.with_strokes([Stroke.from_polyline(np.array(s, dtype=float)) for s in strokes])
+        scores = evaluate(gt, out)
+        return scores, verdict(gt, scores, ink_scores(gt, out, tol))
+
+    # the minimal route: start at the spike's tip, round the loop (straight through the
+    # crossing), end at the spike's base; no ink shows that the pen did not start there
+    scores, ok = judged([p["tip"], p["base"], p["c"], p["d"], p["a"], p["b"], p["base"]])
+    assert scores.order < ORDER_THRESHOLD and scores.stroke_count == 1 and ok
+    # a wrong turn at the crossing: the same ink at the same length, the left lobe run backwards
+    # and the crossing turned into a touch: rejected
+    scores, ok = judged([p["tip"], p["base"], p["c"], p["x"], p["a"], p["d"], p["x"], p["b"], p["base"]])
+    assert scores.undetected == 1 and not ok
+    # an extra retrace (the left side drawn twice), a missing piece (the spike) and two strokes
+    assert not judged([p["tip"], p["base"], p["c"], p["d"], p["a"], p["d"], p["a"], p["b"], p["base"]])[1]
+    assert not judged([p["base"], p["c"], p["d"], p["a"], p["b"], p["base"]])[1]
+    assert not judged([p["tip"], p["base"]], [p["base"], p["c"], p["d"], p["a"], p["b"], p["base"]])[1]
+    # and the ground truth itself, by the order score
+    assert judged(gt.stroke.sample_evenly(2.0))[1]
+
+
+def test_a_near_retrace_narrower_than_the_line_counts_as_a_retrace():
+    from benchmarks.ink_metrics import fair_meta, near_retraces
+
+    # up a stem and down again 2 font units beside it (2.5 px at this scale, under the 6 px
+    # line: no paper between the passes), then on: the ink is one stem drawn twice
+    near = glyph_ground_truth(Glyph("test", "near", "n", "M 0 0 L 0 500 L 2 0 L 600 -200"), 6.0)
+    assert near is not None and not fair_meta(near.stroke.flatten(0.05))["fair"]  # exact noding sees none
+    assert near.meta["fair"] and near.meta["fair_why"] == "near-retrace"
+    (tip, reach, apart), = near_retraces(near.stroke.flatten(0.05), 6.0)
+    stem = near.stroke.length * 500 / (500 + np.hypot(2, 500) + np.hypot(598, 200))
+    assert tip == pytest.approx(stem, abs=1.0) and reach == pytest.approx(stem, abs=2.0) and 2.0 < apart < 6.0
+    # its minimum: the stem once (start at its tip), a step across, the rest
+    assert near.meta["min_length"] == pytest.approx(near.stroke.length - stem, abs=6.0)
+    # down again at 27 degrees: the passes part at once (a sharp V, two lines), not a retrace
+    vee = glyph_ground_truth(Glyph("test", "vee", "v", "M 0 0 L 0 500 L 250 0 L 600 -200"), 6.0)
+    assert vee is not None and not vee.meta["fair"] and not near_retraces(vee.stroke.flatten(0.05), 6.0)
+
+
+def test_generated_spikes_and_retracing_words_are_fair_and_others_are_not(loops_gt):
+    spike = D.generate_drawing("spike", 1, 11)  # closed, one spike
+    assert spike.meta["fair_why"] == "retrace" and spike.meta["retraced_length"] > 100
+    assert spike.meta["min_length"] < spike.stroke.length - spike.meta["retraced_length"] + 1.0
+    assert not loops_gt.meta["fair"] and abs(loops_gt.meta["retraced_length"]) < 1.0
+
+
 # -- the new sets ---------------------------------------------------------------------------------
 
 def test_triple_drawings_have_three_passes_through_a_point():
@@ -391,8 +458,9 @@ def test_handwriting_words_are_jittered_cursive_with_readable_or_flagged_order()
     np.testing.assert_array_equal(a.stroke.control, b.stroke.control)
     assert a.meta["word"] == "little" and a.meta["fair"] and a.meta["retraces"] == 4
     assert 3.0 <= a.width <= 8.0
-    clean = H.handwriting_drawing(0, 1)  # "ethic": order readable, a real retrace
-    assert not clean.meta["fair"] and clean.meta["retraces"] >= 1
+    assert a.meta["fair_why"] == "ambiguous"
+    clean = H.handwriting_drawing(0, 1)  # "ethic": order readable, a real retrace (so fair by retrace)
+    assert clean.meta["fair_why"] == "retrace" and clean.meta["retraces"] >= 1
     # jitter: the traced line wanders off the pen path, but by well under a width
     assert clean.drawing.length > 1.005 * clean.meta["clean_length"]
     assert evaluate(clean, clean.drawing).correct

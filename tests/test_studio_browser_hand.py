@@ -193,6 +193,8 @@ def test_a_bridged_gap_opened_closed_undone_and_both_pieces_kept(served, tmp_pat
     assert page.evaluate(f"{STATE}.report.dropped") == 1 and page.evaluate(f"{STATE}.report.strokes") == 1
     assert "the ink is in 2 pieces" in page.inner_text("#junctions") and page.is_visible("#keep-pieces")
     assert any("1 separate ink piece(s) dropped" in w for w in page.evaluate(f"{STATE}.report.warnings"))
+    # The page names its own control, not the CLI's flag.
+    assert '"multi-stroke drawing"' in page.inner_text("#warnings") and "--multi" not in page.inner_text("#warnings")
     page.screenshot(path=str(ARTIFACTS / "studio-hand-6-gap-opened.png"))
     _, svg = download(page, "[data-export=svg]")
     assert svg == cli_bytes("vectorize", drawing, page.evaluate(f"{STATE}.edits"), tmp_path, ".svg")

@@ -60,6 +60,9 @@ def test_embroidery_downloads(page, studio, edited, tmp_path, kind, style, size,
     page.fill(f"{form} input[name=color]", color)
     page.press(f"{form} input[name=stitch_length]", "Tab")  # a typed field reports its change on leaving it
     settle(page, extra="document.getElementById('embroidery-stats').textContent.includes('stitches')")
+    # The hoop chosen is in the picture (drawn whole inside the preview), the design in it.
+    box = page.evaluate("window.studio.players.embroidery.frameBox()")
+    assert box and 0 <= box[0] < box[2] <= 1 and 0 <= box[1] < box[3] <= 1, box
     if kind == "pes":
         play_the_panel(page, "embroidery")
         page.screenshot(path=str(ARTIFACTS / "studio-make-embroidery.png"))

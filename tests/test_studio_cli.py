@@ -82,3 +82,29 @@ def test_studio_refuses_bad_input(tmp_path):
     run = CliRunner().invoke(main, ["studio", str(ROOT / "examples" / "loops.png"), "--no-browser",
                                     "--edits", str(tmp_path / "bad.json")])
     assert run.exit_code == 2 and "not JSON" in run.output
+
+
+def test_studio_refuses_a_folder_a_non_image_and_bad_ports(tmp_path):
+    """One line each, exit 2, no traceback: a folder, a file that is no image, a port that
+    is no number or out of range, and a port in use (refused before the vectorization, and
+    without uvicorn's own log line)."""
+    import socket
+
+    loops = str(ROOT / "examples" / "loops.png")
+    (tmp_path / "notes.png").write_text("not an image")
+    busy = socket.socket()
+    busy.bind(("127.0.0.1", 0))
+    busy.listen()
+    taken = busy.getsockname()[1]
+    cases = [([str(tmp_path)], "is a directory, not an image"), ([str(tmp_path / "notes.png")], "is not an image"),
+             ([loops, "--port", "abc"], "is not a valid integer"), ([loops, "--port", "70000"], "between 0 and 65535"),
+             ([loops, "--port", str(taken)], f"cannot listen on 127.0.0.1:{taken}")]
+    try:
+        for args, message in cases:
+            run = subprocess.run([sys.executable, "-m", "fabrication.cli", "studio", *args, "--no-browser"],
+                                 capture_output=True, text=True, timeout=60, env={**os.environ, "NO_COLOR": "1"})
+            assert run.returncode == 2, (args, run.stdout, run.stderr)
+            assert message in run.stderr and len(run.stderr.strip().splitlines()) == 1, (args, run.stderr)
+            assert "Traceback" not in run.stderr + run.stdout and "vectoriz" not in run.stdout, (args, run.stdout)
+    finally:
+        busy.close()

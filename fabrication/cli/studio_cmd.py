@@ -39,9 +39,10 @@ def studio(source: str, port: int, no_browser: bool, edits_path: str | None, pro
 
         load_laser_profile(profile_path)  # a bad profile is refused now, not on the page
     session.saved_edits()  # a malformed edits file is refused now too
+    server = StudioServer(session, port=port)  # a port in use is refused now, before the work
     with console.status(f"vectorizing {session.drawing_path.name}"):
         session.vectorize(session.saved_edits())
-    server = StudioServer(session, port=port).start()
+    server.start()
     threading.Thread(target=session.warm, name="studio-warm", daemon=True).start()
     done(f"studio for {session.drawing_path.name} at {server.url}")
     console.print(f"edits are saved to {session.edits_path}; Ctrl-C stops the studio")

@@ -18,10 +18,20 @@ class StudioServer:
     """A running studio. `url` carries the token; `stop()` shuts it down."""
 
     def __init__(self, session: StudioSession, *, port: int = 0) -> None:
-        if port == 0:
-            with socket.socket() as probe:
-                probe.bind((HOST, 0))
-                port = probe.getsockname()[1]
+        # The socket is bound here, before any other work, and handed to uvicorn: a port in
+        # use is one line at once (uvicorn would log its own error, after the vectorization),
+        # and port 0's free port cannot be taken by someone else in between.
+        from onestroke.errors import InputError
+
+        self.socket = socket.socket()
+        self.socket.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)  # as uvicorn's own: a restart may reuse it
+        try:
+            self.socket.bind((HOST, port))
+        except OSError as error:
+            self.socket.close()
+            raise InputError(f"--port {port}: cannot listen on {HOST}:{port} ({error.strerror or error}); "
+                             "choose another port, or 0 for any free one") from None
+        port = self.socket.getsockname()[1]
         self.port = port
         self.token = secrets.token_urlsafe(24)
         hosts = {f"{HOST}:{port}", f"localhost:{port}"}
@@ -29,7 +39,8 @@ class StudioServer:
         config = uvicorn.Config(self.app, host=HOST, port=port, log_level="warning", access_log=False,
                                 lifespan="off")
         self.server = uvicorn.Server(config)
-        self.thread = threading.Thread(target=self.server.run, name="studio-server", daemon=True)
+        self.thread = threading.Thread(target=self.server.run, kwargs={"sockets": [self.socket]},
+                                       name="studio-server", daemon=True)
 
     @property
     def url(self) -> str:

@@ -64,6 +64,8 @@ class StudioSession:
                  profile: str | os.PathLike | None = None, classifier: str = "cnn",
                  precompute: bool = False) -> None:
         self.drawing_path = Path(drawing)
+        if self.drawing_path.is_dir():
+            raise InputError(f"input {str(drawing)!r} is a directory, not an image")
         if not self.drawing_path.is_file():
             raise InputError(f"input file {str(drawing)!r} does not exist")
         self.edits_path = Path(edits_path) if edits_path else self.drawing_path.with_suffix(".edits.json")

@@ -218,6 +218,15 @@ export function createPlayer(root, input, options = {}) {
       }
       if (any) break;
     }
+    // The frame (a hoop, a bed) too when it is about the design's size: which hoop the
+    // design sits in is part of the picture; a 400 mm bed around an 80 mm design is not.
+    if (d.frame && any) {
+      const [x0, y0, x1, y1] = d.frame;
+      const fy0 = d.yUp ? -y1 : y0, fy1 = d.yUp ? -y0 : y1;
+      if (Math.max(x1 - x0, fy1 - fy0) <= 3 * Math.max(xmax - xmin, ymax - ymin)) {
+        xmin = Math.min(xmin, x0); xmax = Math.max(xmax, x1); ymin = Math.min(ymin, fy0); ymax = Math.max(ymax, fy1);
+      }
+    }
     const w = dom.canvas.width, h = dom.canvas.height, pad = 0.05;
     const bw = Math.max(xmax - xmin, 1e-6), bh = Math.max(ymax - ymin, 1e-6);
     view.scale = fitScale = Math.min(w / (bw * (1 + 2 * pad)), h / (bh * (1 + 2 * pad)));
@@ -341,6 +350,15 @@ export function createPlayer(root, input, options = {}) {
       api.seekRow(k);
     },
     setSpeed(s) { speed = s; dom.speed.value = String(s); },
+    // Where the frame (hoop, bed) is drawn: [left, top, right, bottom] as fractions of the
+    // canvas (inside: 0..1), or null without one.
+    frameBox() {
+      if (!d || !d.frame) return null;
+      const [x0, y0, x1, y1] = d.frame, w = dom.canvas.width, h = dom.canvas.height;
+      const ya = d.yUp ? -y1 : y0, yb = d.yUp ? -y0 : y1;
+      return [(view.ox + x0 * view.scale) / w, (view.oy + ya * view.scale) / h,
+              (view.ox + x1 * view.scale) / w, (view.oy + yb * view.scale) / h];
+    },
     fit,
     zoom,
     load(data) {

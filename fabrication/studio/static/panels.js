@@ -57,7 +57,8 @@ function stale(tab, on, message = "") {
 // are the form's fields ("Stitch length").
 export function fieldNames(message, formId) {
   return message.replace(/--([a-z][a-z-]*)/g, (flag, name) => {
-    const field = $(formId).elements[name.replace(/-/g, "_")];
+    // A form's field, or a control of the Refine panel by its id ("--multi": "multi-stroke drawing").
+    const field = (formId && $(formId).elements[name.replace(/-/g, "_")]) || $(name);
     const label = field && field.closest("label");
     const text = label && [...label.childNodes].filter((n) => n.nodeType === Node.TEXT_NODE)
       .map((n) => n.textContent.trim()).join(" ").trim();
