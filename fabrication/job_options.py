@@ -143,9 +143,11 @@ def laser_settings(*, size: str | None = None, width: str | None = None, height:
                    rotate: float = 0.0, origin: str = "lower-left", feed: str = "1500mm/min",
                    power: str = "60%", passes: int = 1, tolerance: str = "0.02mm", arcs: bool = False,
                    keep_order: bool = False, profile_path: str | None = None,
-                   air_assist: bool | None = None, return_home: bool = False) -> LaserSettings:
+                   air_assist: bool | None = None, return_home: bool = False,
+                   profile: object | None = None) -> LaserSettings:
     """The toolpath and G-code options of `onestroke laser`'s option values; `InputError`
-    naming the flag for a bad value."""
+    naming the flag for a bad value. `profile`: an already loaded profile, used instead of
+    reading `profile_path` (the studio's profiles loaded from the page)."""
     from fabrication.laser.gcode_write import GcodeOptions
     from fabrication.laser.toolpath import ToolpathOptions
     from machines.laser_profile import load_laser_profile
@@ -161,7 +163,8 @@ def laser_settings(*, size: str | None = None, width: str | None = None, height:
     if passes < 1:
         raise InputError(f"--passes {passes} must be at least 1")
     placement = _placement(size, width, height, rotate)
-    profile = load_laser_profile(profile_path)
+    if profile is None:
+        profile = load_laser_profile(profile_path)
     toolpath_options = ToolpathOptions(placement=placement, origin=origin, tolerance=tol, arcs=arcs,
                                        optimize=not keep_order)
     gcode_options = GcodeOptions(feed=feed_mm, power=power_fraction, passes=passes, return_home=return_home,

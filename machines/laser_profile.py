@@ -174,12 +174,23 @@ def laser_profile_from_dict(data: dict, *, source: str = "profile") -> LaserProf
     return LaserProfile(**values)
 
 
+def laser_profile_from_text(text: str, *, source: str = "laser profile") -> LaserProfile:
+    """Parse and check the text of a laser profile TOML file; `source` names it in errors."""
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as error:
+        raise InputError(f"{source} is not valid TOML: {error}") from None
+    return laser_profile_from_dict(data, source=source)
+
+
+def bundled_laser_profiles() -> tuple[Path, ...]:
+    """The laser profiles shipped with onestroke (`profiles/laser-*.toml`), the default first."""
+    others = sorted(p for p in DEFAULT_PROFILE_PATH.parent.glob("laser-*.toml") if p != DEFAULT_PROFILE_PATH)
+    return (DEFAULT_PROFILE_PATH, *others)
+
+
 def load_laser_profile(path: str | os.PathLike | None = None) -> LaserProfile:
     """Read a laser profile TOML file; `None` gives the shipped default profile."""
     path = Path(path) if path is not None else DEFAULT_PROFILE_PATH
     text = read_text(path, what="laser profile", expect="a TOML file")
-    try:
-        data = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as error:
-        raise InputError(f"laser profile {str(path)!r} is not valid TOML: {error}") from None
-    return laser_profile_from_dict(data, source=f"laser profile {path.name!r}")
+    return laser_profile_from_text(text, source=f"laser profile {path.name!r}")

@@ -102,8 +102,17 @@ def test_previews(client):
     ("vp3", "embroider", {"color": "#c01020"}, ["--color", "#c01020"]),
     ("gcode", "laser", {"size": "40mm", "feed": "1200mm/min", "power": "35%", "passes": "2"},
      ["--size", "40mm", "--feed", "1200mm/min", "--power", "35%", "--passes", "2"]),
+    # A profile loaded in the page (K40_PROFILE, uploaded as text) = the CLI's --profile FILE.
+    ("gcode", "laser", {"size": "40mm", "power": "35%", "arcs": True, "profile": "K40"},
+     ["--size", "40mm", "--power", "35%", "--arcs", "--profile", "K40"]),
 ])
 def test_downloads_are_the_cli_bytes(client, drawing, tmp_path, kind, command, options, flags):
+    if options.get("profile") == "K40":
+        (tmp_path / "k40.toml").write_text(K40_PROFILE)
+        loaded = client.post("/api/profiles", json={"name": "k40.toml", "text": K40_PROFILE})
+        assert loaded.status_code == 200, loaded.text
+        options = dict(options, profile=loaded.json()["id"])
+        flags = [str(tmp_path / "k40.toml") if f == "K40" else f for f in flags]
     state = client.get("/api/state").json()
     junction = next(j for j in state["graph"]["junctions"] if j["role"] == "crossing")
     other = PAIRINGS[(PAIRINGS.index(junction["decision"]) + 1) % 3]
@@ -118,6 +127,55 @@ def test_downloads_are_the_cli_bytes(client, drawing, tmp_path, kind, command, o
                                     "-o", str(out), *flags])
     assert run.exit_code == 0, run.output
     assert page.content == out.read_bytes()
+
+
+K40_PROFILE = """name = "K40 test laser"
+[bed]
+size = "300x200mm"
+[laser]
+max_power = 255
+air_assist = true
+[motion]
+max_rate_x = "4000mm/min"
+acceleration_x = "300mm/s^2"
+acceleration_y = "250mm/s^2"
+"""
+
+
+def test_machine_profiles(client):
+    """The laser panel's profiles: the built-in one by default; a TOML loaded as text is
+    checked, offered and drives the preview; a bad or oversize one is refused in one line
+    and changes nothing."""
+    state = client.get("/api/state").json()
+    listed = client.get("/api/profiles").json()
+    assert listed["default"] == "built-in:laser-default"
+    assert [p["id"] for p in listed["profiles"]][0] == "built-in:laser-default"
+    options = {"size": "50mm"}
+    default = client.post("/api/laser", json={"edits": state["edits"], "options": options}).json()
+    chosen = client.post("/api/laser", json={"edits": state["edits"],
+                                             "options": dict(options, profile="built-in:laser-default")}).json()
+    assert default["profile"] == chosen["profile"] == "Generic GRBL 1.1 diode laser, 400 x 400 mm"
+    assert default["seconds"] == chosen["seconds"]
+
+    loaded = client.post("/api/profiles", json={"name": "k40.toml", "text": K40_PROFILE}).json()
+    assert loaded["name"] == "K40 test laser" and loaded["id"] in [p["id"] for p in loaded["profiles"]]
+    k40 = client.post("/api/laser", json={"edits": state["edits"], "options": dict(options, profile=loaded["id"])}).json()
+    assert k40["profile"] == "K40 test laser"
+    assert k40["seconds"] > default["seconds"]  # slower accelerations: a longer planner estimate
+    too_big = client.post("/api/laser", json={"edits": state["edits"],
+                                              "options": {"size": "250mm", "profile": loaded["id"]}})
+    assert too_big.status_code == 400 and "--profile" in too_big.json()["error"]  # the page names its select
+
+    before = client.get("/api/profiles").json()
+    for text, reason in [("name = \n[bed]", "not valid TOML"), ('[motion]\nmax_rate_z = "1mm/min"', "unknown key"),
+                         ("[laser]\nmax_power = -5", "max_power"), ("x" * (65 * 1024), "too large")]:
+        bad = client.post("/api/profiles", json={"name": "bad.toml", "text": text})
+        assert bad.status_code == 400 and reason in bad.json()["error"], bad.text
+        assert "\n" not in bad.json()["error"]
+    assert client.get("/api/profiles").json() == before  # the previous choices kept
+    assert client.post("/api/profiles", content=b"{" + b" " * MAX_BODY + b"}").status_code == 413
+    unknown = client.post("/api/laser", json={"edits": state["edits"], "options": {"profile": "/etc/passwd"}})
+    assert unknown.status_code == 400 and "not one of" in unknown.json()["error"]
 
 
 def test_send_to_the_emulator(client):

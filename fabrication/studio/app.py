@@ -5,7 +5,8 @@ session's random token (in the URL of the first load, then a SameSite cookie or 
 X-Studio-Token header) and a Host header naming this server, so neither another page
 in the browser nor another user on the machine can drive it; request bodies are
 bounded; files are read and written only where the command line said (the drawing, its
-edits file, a laser profile) and downloads are made in memory.
+edits file, a laser profile); a profile the user loads in the page arrives as text and is
+parsed in memory; downloads are made in memory.
 """
 
 from __future__ import annotations
@@ -206,6 +207,12 @@ def create_app(session: StudioSession, *, token: str, hosts: set[str]) -> Guard:
         session.sender = LaserSender(content.decode(), port=port, baud=baud, name=name).start()
         return JSONResponse(session.sender.status())
 
+    async def profiles(request: Request):
+        if request.method == "GET":
+            return JSONResponse(session.profile_list())
+        _, _, data = await payload(request)  # {"name": file name, "text": its TOML}: parsed, never a path
+        return JSONResponse(await run_in_threadpool(session.add_profile, data.get("name") or "", data.get("text")))
+
     async def ports(request: Request):
         from machines.ports import list_ports
 
@@ -234,5 +241,6 @@ def create_app(session: StudioSession, *, token: str, hosts: set[str]) -> Guard:
         Route("/api/send", api(send), methods=["GET", "POST"]),
         Route("/api/send/{action}", api(control), methods=["POST"]),
         Route("/api/ports", api(ports), methods=["GET"]),
+        Route("/api/profiles", api(profiles), methods=["GET", "POST"]),
     ]
     return Guard(Starlette(routes=routes), token=token, hosts=hosts)

@@ -29,7 +29,10 @@ EMBROIDERY_FIELDS = ("style", "size", "hoop", "fit", "stitch_length", "tolerance
                      "pull_comp", "repeats", "arrow_size", "min_stitch", "max_stitch", "trim_distance",
                      "lock_form", "color", "pes_version", "spm", "rotate")
 LASER_FIELDS = ("size", "rotate", "origin", "feed", "power", "passes", "tolerance", "arcs", "keep_order",
-                "air_assist", "return_home")
+                "air_assist", "return_home", "profile")
+# A profile loaded from the page: a real one is ~1.5 kB; at most this many kept per session.
+MAX_PROFILE_BYTES = 64 * 1024
+MAX_LOADED_PROFILES = 32
 # Points per px of curve sent to the page: enough for a smooth line, few enough to be quick.
 CURVE_SPACING = 2.0
 
@@ -70,6 +73,17 @@ class StudioSession:
             raise InputError(f"input file {str(drawing)!r} does not exist")
         self.edits_path = Path(edits_path) if edits_path else self.drawing_path.with_suffix(".edits.json")
         self.profile = str(profile) if profile else None
+        # The laser panel's choices: id -> (label, profile path or loaded LaserProfile). The
+        # built-in ones and the command line's are read from their path at each use (as the
+        # CLI does); those loaded from the page are kept parsed, never as a path.
+        self.profiles: dict[str, tuple[str, object]] = {}
+        from machines.laser_profile import bundled_laser_profiles, load_laser_profile
+
+        for path in bundled_laser_profiles():
+            self.profiles[f"built-in:{path.stem}"] = (f"built-in: {load_laser_profile(path).name}", path)
+        if self.profile:
+            self.profiles["command-line"] = (f"command line: {Path(self.profile).name}", Path(self.profile))
+        self.default_profile = "command-line" if self.profile else next(iter(self.profiles))
         self.options = VectorizeOptions(classifier=classifier)
         self.cache = StageCache()
         self.lock = threading.Lock()  # one vectorization at a time: the cache is not shared-safe
@@ -254,17 +268,55 @@ class StudioSession:
         return {"player": data.to_dict(), "stats": stats.lines(), "stitches": stats.stitches,
                 "seconds": stats.seconds, "warnings": list(settings.warnings) + list(result.warnings)}
 
+    # -- laser profiles --------------------------------------------------------------
+    def profile_list(self) -> dict:
+        """The laser panel's profile choices and the default one."""
+        return {"profiles": [{"id": key, "label": label} for key, (label, _) in self.profiles.items()],
+                "default": self.default_profile}
+
+    def add_profile(self, file_name: str, text: str) -> dict:
+        """Parse and check a profile TOML the page read from a file the user picked; offer it.
+        The file name only labels it: nothing is read from a path the page names."""
+        import hashlib
+
+        from machines.laser_profile import laser_profile_from_text
+
+        if not isinstance(text, str) or not isinstance(file_name, str):
+            raise InputError("a profile upload needs the file's name and text")
+        size = len(text.encode("utf-8", "replace"))
+        if size > MAX_PROFILE_BYTES:
+            raise InputError(f"profile file of {size} bytes is too large (at most {MAX_PROFILE_BYTES // 1024} kB)")
+        name = " ".join(Path(file_name.replace("\\", "/")).name.split())[:80] or "profile.toml"
+        try:
+            profile = laser_profile_from_text(text, source=f"laser profile {name!r}")
+        except InputError as error:
+            raise InputError(" ".join(str(error).split())) from None  # one line for the panel
+        key = "loaded:" + hashlib.sha256(text.encode("utf-8", "replace")).hexdigest()[:12]
+        if key not in self.profiles and sum(k.startswith("loaded:") for k in self.profiles) >= MAX_LOADED_PROFILES:
+            raise InputError(f"at most {MAX_LOADED_PROFILES} profiles can be loaded in one session")
+        self.profiles[key] = (f"{name}: {profile.name}", profile)
+        return dict(self.profile_list(), id=key, name=profile.name)
+
     def laser(self, edits: Edits, values: dict):
-        """(settings, program) of `onestroke laser` for these option values."""
+        """(settings, program) of `onestroke laser` for these option values; `profile`: the
+        id of one of `profiles` (default: as `onestroke studio` was started)."""
         from fabrication.laser.program import laser_program
 
         values = _clean(values, LASER_FIELDS)
+        key = str(values.pop("profile", self.default_profile))
+        if key not in self.profiles:
+            raise InputError(f"--profile {key!r} is not one of this studio's profiles")
+        source = self.profiles[key][1]
+        if isinstance(source, Path):
+            values["profile_path"] = str(source)
+        else:
+            values["profile"] = source
         if "passes" in values:
             try:
                 values["passes"] = int(str(values["passes"]))
             except ValueError:
                 raise InputError(f"--passes {values['passes']!r} is not a whole number") from None
-        settings = laser_settings(profile_path=self.profile, **values)
+        settings = laser_settings(**values)
         drawing = self.vectorize(edits).drawing
         program = laser_program(drawing, settings.profile, settings.toolpath, settings.gcode,
                                 name=self.drawing_path.name)

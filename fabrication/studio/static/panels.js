@@ -150,6 +150,37 @@ function showSend(s) {
   if (active && !sendTimer) sendTimer = setInterval(pollSend, 250);
   if (!active && sendTimer) { clearInterval(sendTimer); sendTimer = null; }
 }
+// ---------------------------------------------------------------- machine profiles
+// The select lists the built-in profiles, the command line's --profile and those loaded here;
+// a loaded file is sent as text and checked by the server's profile loader. A bad one leaves
+// the select as it was.
+function showProfiles(list, chosen) {
+  const select = $("profile");
+  const keep = chosen || select.value || list.default;
+  select.innerHTML = list.profiles.map((p) => `<option value="${escapeHtml(p.id)}">${escapeHtml(p.label)}</option>`).join("");
+  select.value = list.profiles.some((p) => p.id === keep) ? keep : list.default;
+}
+async function listProfiles() {
+  try { showProfiles(await call("api/profiles")); }
+  catch (error) { $("profile-status").textContent = "error: " + error.message; }
+}
+async function loadProfile(file) {
+  const status = $("profile-status");
+  status.dataset.state = "";
+  try {
+    if (file.size > 64 * 1024) throw new Error(`${file.name} is too large for a profile (at most 64 kB)`);
+    const answer = await call("api/profiles", { name: file.name, text: await file.text() });
+    showProfiles(answer, answer.id);
+    status.textContent = `loaded ${file.name}: ${answer.name}`;
+    refreshPanel();
+  } catch (error) {
+    status.textContent = `error: ${error.message} (the profile in use is unchanged)`;
+    status.dataset.state = "error";
+  } finally {
+    $("profile-file").value = "";  // picking the same file again loads it again
+  }
+}
+
 async function listPorts() {
   try {
     const found = (await call("api/ports")).ports;
@@ -170,6 +201,10 @@ export function setupPanels(currentEdits) {
   for (const form of ["embroidery-form", "laser-form"]) $(form).addEventListener("change", refreshPanel);
   for (const button of document.querySelectorAll("[data-export]")) button.onclick = () => download(button.dataset.export);
   for (const action of ["send", "pause", "resume", "abort"]) $(action).onclick = () => sendAction(action);
+  $("profile-file").addEventListener("change", (event) => {
+    if (event.target.files.length) loadProfile(event.target.files[0]);
+  });
+  listProfiles();
   listPorts();
   pollSend();  // a job started before this page was (re)loaded
 }
