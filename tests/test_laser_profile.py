@@ -4,7 +4,8 @@ from __future__ import annotations
 
 import pytest
 
-from machines.laser_profile import LaserProfile, load_laser_profile, parse_acceleration
+from machines.laser_profile import (DEFAULT_PROFILE_PATH, LaserProfile, bundled_laser_profiles, laser_profile_from_text,
+                                    load_laser_profile, parse_acceleration)
 from onestroke.errors import InputError
 
 
@@ -15,6 +16,14 @@ def test_default_profile_values():
     assert (p.junction_deviation, p.rx_buffer, p.planner_blocks) == (0.01, 128, 15)
     assert p.laser_mode and not p.air_assist
     assert p == LaserProfile(name=p.name)  # the TOML and the dataclass defaults agree
+
+
+def test_profile_from_text_is_the_file_loader():
+    """The studio parses a profile the page sends as text with the loader the CLI reads files with."""
+    assert bundled_laser_profiles()[0] == DEFAULT_PROFILE_PATH
+    assert laser_profile_from_text(DEFAULT_PROFILE_PATH.read_text()) == load_laser_profile()
+    with pytest.raises(InputError, match="^k40.toml is not valid TOML: .*line 1"):
+        laser_profile_from_text("name = \n[bed]", source="k40.toml")
 
 
 def test_units_are_converted(tmp_path):

@@ -110,3 +110,59 @@ def test_options_that_fail_name_the_field_and_dim_the_old_preview(page):
     page.press("#laser-form input[name=size]", "Tab")
     page.wait_for_function("document.getElementById('laser-stale').hidden")
     assert "does not fit" not in page.inner_text("#tab-laser")
+
+
+K40 = """name = "K40 studio test laser"
+[bed]
+size = "300x200mm"
+[laser]
+max_power = 255
+[motion]
+acceleration_x = "300mm/s^2"
+acceleration_y = "250mm/s^2"
+"""
+
+
+def test_load_a_machine_profile(page, studio, edited, tmp_path):
+    """"Load a profile…" through the file input: a bad file is refused in one line and the
+    profile in use kept; a good one is offered, chosen, named in the stats, drives the G-code
+    (the CLI's bytes with --profile FILE) and the bed check, whose error names the select."""
+    page.click("nav .tab[data-tab=laser]")
+    form = "#laser-form"
+    for name, value in (("size", "60mm"), ("feed", "1500mm/min"), ("power", "60%"), ("passes", "1")):
+        page.fill(f"{form} input[name={name}]", value)
+    page.select_option(f"{form} select[name=origin]", "lower-left")
+    page.uncheck(f"{form} input[name=arcs]")
+    settle(page, extra="document.getElementById('laser-time').textContent.includes('profile: Generic')")
+    before = page.input_value("#profile")
+    page.set_input_files("#profile-file", files=[{"name": "broken.toml", "mimeType": "text/plain",
+                                                  "buffer": b"[motion]\nmax_rate_x = \n"}])
+    page.wait_for_function("document.getElementById('profile-status').dataset.state === 'error'")
+    status = page.inner_text("#profile-status")
+    assert "not valid TOML" in status and "unchanged" in status and "\n" not in status, status
+    assert page.input_value("#profile") == before and "profile: Generic" in page.inner_text("#laser-time")
+    page.screenshot(path=str(ARTIFACTS / "studio-make-laser-profile-refused.png"))
+
+    (tmp_path / "k40.toml").write_text(K40)
+    page.set_input_files("#profile-file", str(tmp_path / "k40.toml"))
+    page.wait_for_function("document.getElementById('profile-status').textContent.startsWith('loaded k40.toml')")
+    settle(page, extra="document.getElementById('laser-time').textContent.includes('profile: K40 studio test laser')")
+    assert page.input_value("#profile") != before
+    page.screenshot(path=str(ARTIFACTS / "studio-make-laser-profile.png"))
+    name, data = download(page, "[data-export=gcode]")
+    assert data == cli_bytes("laser", studio[1], edited, tmp_path, ".gcode", "--size", "60mm", "--profile",
+                             str(tmp_path / "k40.toml"))
+    assert b"S153" in data  # 60 % of the loaded profile's max S 255
+
+    page.fill(f"{form} input[name=size]", "350mm")  # fits the default 400 mm bed, not this 300 x 200 mm one
+    page.press(f"{form} input[name=size]", "Tab")
+    page.wait_for_function("!document.getElementById('laser-stale').hidden && "
+                           "document.getElementById('laser-stale').textContent.includes('does not fit the bed')")
+    text = page.inner_text("#laser-stale")
+    assert '"Machine profile"' in text and "--profile" not in text, text
+    page.select_option("#profile", before)  # the built-in profile's bed holds it
+    page.wait_for_function("document.getElementById('laser-stale').hidden")
+    assert "profile: Generic" in page.inner_text("#laser-time")
+    page.fill(f"{form} input[name=size]", "60mm")
+    page.press(f"{form} input[name=size]", "Tab")
+    settle(page)

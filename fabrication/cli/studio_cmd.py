@@ -19,7 +19,8 @@ from onestroke.paths import check_distinct
 @click.option("--edits", "edits_path", default=None, type=click.Path(dir_okay=False, path_type=str),
               help="The edits file the page loads and saves [default: DRAWING.edits.json beside the drawing].")
 @click.option("--profile", "profile_path", default=None, type=click.Path(dir_okay=False, path_type=str),
-              help="Laser profile TOML for the laser panel; default: built-in 400x400 mm.")
+              help="Laser profile TOML: the laser panel's default machine profile (others can be "
+                   "loaded in the page); default: built-in 400x400 mm.")
 @click.option("--classifier", type=click.Choice(["cnn", "geometric"]), default="cnn", show_default=True,
               help="How crossings are told from touchings.")
 def studio(source: str, port: int, no_browser: bool, edits_path: str | None, profile_path: str | None,
