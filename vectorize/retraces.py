@@ -206,28 +206,3 @@ def share_pieces(twins: Sequence[Twin], cuts: Sequence[int], pieces: list[np.nda
             after = pieces[k + 1]
             after[0, 1] += pieces[k][-1, 3] - after[0, 0]
             after[0, 0] = pieces[k][-1, 3]
-
-
-# A branch whose ink is this much wider than the line (median radius over half the width,
-# minus 1) carries two passes side by side: the pen drew it twice, a unit beside itself.
-DOUBLE_BAND = 0.25
-DOUBLE_BAND_FLOOR = 0.5  # the cheapest a double band's retrace gets, as a share of its length
-
-
-def double_band_weights(graph: MedialGraph, w: float) -> dict[int, float]:
-    """Branch id -> factor below 1 on the retrace cost of branches whose ink is wider than one
-    line (away from their ends, where junctions widen it): a stretch drawn out and back a
-    little beside itself leaves a band up to twice the width, so the ink itself says that it
-    was drawn twice. factor = 1 - excess, at least `DOUBLE_BAND_FLOOR`, where excess = median
-    radius / (w / 2) - 1 exceeds `DOUBLE_BAND`."""
-    half = 0.5 * w
-    out = {}
-    for bid, branch in graph.branches.items():
-        arc = branch.arc
-        inner = branch.radii[(arc > 1.5 * w) & (arc < arc[-1] - 1.5 * w)]
-        if len(inner) < 3:
-            continue
-        excess = float(np.median(inner)) / half - 1.0
-        if excess > DOUBLE_BAND:
-            out[bid] = max(DOUBLE_BAND_FLOOR, 1.0 - excess)
-    return out

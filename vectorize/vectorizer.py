@@ -23,7 +23,7 @@ from vectorize.medial_axis import medial_axis
 from vectorize.outline import outline_rings
 from vectorize.options import InputFrame, VectorizeOptions, VectorizeReport, VectorizeResult
 from vectorize.pruning import prune, trim_free_ends
-from vectorize.retraces import Twin, double_band_weights, foot_is_retraced, twin_spans
+from vectorize.retraces import Twin, foot_is_retraced, twin_spans
 from vectorize.route_inspection import connect_pairings, plan_routes
 from vectorize.simplify import Simplified, is_t_shape, directions, simplify, slots
 from vectorize.stroke import Stroke
@@ -297,12 +297,8 @@ def _single_route(graph: MedialGraph, simple: Simplified, ranked: dict, costs: d
     end_cost = {n: 3.0 * w for n in v_tips}
     end_cost.update({n: _junction_end_cost(graph, n, dirs[n], w) for n in dirs})
     end_cost.update(start_at or {})
-    ink_weight = double_band_weights(graph, w)
-    if weight:
-        ink_weight = {b: ink_weight.get(b, 1.0) * f for b, f in weight.items()} | {
-            b: f for b, f in ink_weight.items() if b not in weight}
     routes = plan_routes(graph, {**simple.through, **pairing}, stroke_width=w, directions=dirs, end_cost=end_cost,
-                         weight=ink_weight)
+                         weight=weight)
     choice = tuple(pairing.get(n, ranked[n][0]) for n in simple.crossings)
     return Ordering(tuple(r.passes for r in routes), tuple(r.closed for r in routes), choice), tried
 
