@@ -41,6 +41,7 @@ def _summary(rows: list[dict]) -> dict:
         "hallucinated": 100.0 * (out_x - matched) / out_x if out_x else 0.0,
         "median_s": float(np.median(secs)) if secs else float("nan"),
         "p90_s": float(np.percentile(secs, 90)) if secs else float("nan"),
+        "max_s": max(secs) if secs else float("nan"),
         "peak_mb": max(peaks) if peaks else float("nan"),
         **_ink_summary(rows, ok),
     }
@@ -174,7 +175,8 @@ def print_tables(rows: list[dict]) -> None:
     print()
     print("by drawing kind:")
     print(f"{'set':<15}  {'classifier':<10}  {'kind':<17}  {'n':>3}  {'fail':>4}  {'correct %':>9}  "
-          f"{'strokes':>7}  {'order':>6}  {'undet %':>7}  {'hall %':>6}  {'med s':>6}")
+          f"{'strokes':>7}  {'order':>6}  {'undet %':>7}  {'hall %':>6}  {'med s':>6}  {'max s':>6}  "
+          f"{'peak MB':>7}  {'in %':>5}  {'exc w':>5}")
     kinds: dict = {}
     for r in rows:
         kinds.setdefault((r["set"], r["classifier"], r["kind"]), []).append(r)
@@ -186,7 +188,8 @@ def print_tables(rows: list[dict]) -> None:
         cells = [f"{set_name:<15}", f"{classifier:<10}", f"{kind:<17}", f"{s['n']:>3}", f"{s['fail']:>4}"]
         for key, width, fmt in (("correct", 9, "{:.1f}"), ("strokes", 7, "{:.2f}"), ("order", 6, "{:.3f}"),
                                 ("undetected", 7, "{:.1f}"), ("hallucinated", 6, "{:.1f}"),
-                                ("median_s", 6, "{:.2f}")):
+                                ("median_s", 6, "{:.2f}"), ("max_s", 6, "{:.2f}"), ("peak_mb", 7, "{:.0f}"),
+                                ("within", 5, "{:.1f}"), ("exc_max_w", 5, "{:.2f}")):
             v = s[key]
             cells.append(("-" if isinstance(v, float) and math.isnan(v) else fmt.format(v)).rjust(width))
         print("  ".join(cells))
@@ -210,7 +213,8 @@ def _print_headroom(rows: list[dict]) -> None:
     print()
     print(f"excursion headroom (half width + 1 px minus excursion), near miss: under {NEAR_MISS} px:")
     for (set_name, classifier), rs in groups.items():
-        room = np.array([excursion_bound(r["width"]) - r["excursion"] for r in rs])
+        room = np.array([r["headroom"] if not math.isnan(r.get("headroom", math.nan))
+                         else excursion_bound(r["width"]) - r["excursion"] for r in rs])
         near = sorted((float(h), r["name"]) for h, r in zip(room, rs) if h < NEAR_MISS)
         names = ", ".join(f"{name} {h:+.2f}" for h, name in near[:4]) + (" ..." if len(near) > 4 else "")
         print(f"  {set_name:<15} {classifier:<10} min {room.min():+.2f} px  p1 {np.percentile(room, 1):+.2f} px  "

@@ -14,7 +14,10 @@ real inputs are (seeded, one generator per drawing).
 - jpeg: the anti-aliased render saved as JPEG at quality 25-50 (ringing and 8x8 blocks
   along every edge);
 - breaks: a dry pen: three short breaks across the line, 1 px to 0.6 widths + 1 px long, at
-  random places of the line's middle 80 %.
+  random places of the line's middle 80 %;
+- photo: a phone photo of the page: uneven light, a soft shadow, paper texture, blur, noise,
+  colour and JPEG (benchmarks/photo.py; the perspective is in the ground truth of the
+  `kinds` set's photos, so this condition alone keeps the geometry).
 """
 
 from __future__ import annotations
@@ -27,7 +30,7 @@ from scipy import ndimage
 
 from benchmarks.render import render, to_uint8
 
-CONDITIONS = ("clean", "noisy", "scan", "pencil", "specks", "varwidth", "half", "gaps", "jpeg", "breaks")
+CONDITIONS = ("clean", "noisy", "scan", "pencil", "specks", "varwidth", "half", "gaps", "jpeg", "breaks", "photo")
 
 
 def _jpeg(image: np.ndarray, quality: int) -> np.ndarray:
@@ -97,4 +100,8 @@ def condition_image(drawing, gray: np.ndarray, condition: str,
             across = np.abs(dy * tangent[0] - dx * tangent[1])
             page[(along <= length / 2) & (across <= drawing.stroke_width / 2 + 1.5)] = 1.0
         return to_uint8(page), 1.0
+    if condition == "photo":
+        from benchmarks.photo import photo_image
+
+        return photo_image(gray, rng), 1.0
     raise ValueError(f"unknown condition {condition!r}; use one of {', '.join(CONDITIONS)}")

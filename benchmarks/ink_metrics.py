@@ -12,7 +12,10 @@
   junction, or a ground truth that draws some stretch twice: which stretch is retraced, and
   whether the pen started at a free end, shows in no ink), an output that is one stroke,
   stays in the ink, covers it and is no longer than the minimum traversal (within
-  `FAIR_LENGTH_SLACK`) counts as correct (`fair_meta` marks such ground truths).
+  `FAIR_LENGTH_SLACK`) counts as correct (`fair_meta` marks such ground truths);
+- where the ink width changes along the line (meta "width_profile": brushes, a photo's
+  perspective), the excursion bound is half the LOCAL width (at the nearest centre-line
+  point) + 1 px.
 
 docs/benchmark.md says exactly how each is measured.
 """
@@ -52,6 +55,25 @@ def excursion(gt: Drawing, output: Drawing) -> float:
         return float("nan")
     d, _ = cKDTree(_samples(gt, CENTRE_SPACING)).query(_samples(output, OUTPUT_SPACING))
     return float(d.max())
+
+
+def local_excursion(gt: Drawing, output: Drawing, profile) -> tuple[float, float, float]:
+    """Excursion against a width that changes along a one-stroke `gt` (`profile`: knot
+    fractions of its arc length and widths px, as benchmarks/render.py draws it).
+
+    Returns the largest distance (px), the largest distance over the local width at the
+    nearest centre-line point, and the smallest headroom to the local bound (half the local
+    width + 1 px; negative: outside). nan for an empty output.
+    """
+    if not output.strokes:
+        return float("nan"), float("nan"), float("nan")
+    from benchmarks.render import profile_widths
+
+    centre = gt.strokes[0].sample_evenly(CENTRE_SPACING)
+    widths = profile_widths(profile, np.linspace(0.0, 1.0, len(centre)))
+    d, nearest = cKDTree(centre).query(_samples(output, OUTPUT_SPACING))
+    local = widths[nearest]
+    return float(d.max()), float((d / local).max()), float((0.5 * local + EXCURSION_SLACK - d).min())
 
 
 def uncovered(gt: Drawing, output: Drawing) -> float:
@@ -273,8 +295,8 @@ def fair_meta(polyline: np.ndarray, *, ambiguous: bool = False, scale: float = 1
 
 @dataclass(frozen=True)
 class InkScores:
-    """excursion: px (nan without output); excursion_widths: the same over the stroke width;
-    within: excursion <= half width + 1 px; uncovered: px of ground truth farthest from the
+    """excursion: px (nan without output); excursion_widths: the same over the stroke width
+    (over the local width where it varies); within: excursion <= half the (local) width + 1 px; uncovered: px of ground truth farthest from the
     output; fair_ok: the fair-retrace rule's geometric part holds (one stroke, in the ink,
     covering it, no longer than the minimum traversal)."""
 
@@ -283,6 +305,7 @@ class InkScores:
     within: bool
     uncovered: float
     fair_ok: bool
+    headroom: float = float("nan")
 
 
 def fair_length_limit(min_length: float, width: float) -> float:
@@ -296,13 +319,19 @@ def ink_scores(gt, output: Drawing, cover_tolerance: float) -> InkScores:
     """Ink scores of `output` against a `GroundTruth` `gt`, given the distance (px) within which
     the ground truth counts as covered."""
     width = gt.drawing.stroke_width
-    exc = excursion(gt.drawing, output)
-    within = bool(exc <= excursion_bound(width))
+    profile = gt.meta.get("width_profile")
+    if profile is None:
+        exc = excursion(gt.drawing, output)
+        exc_w, headroom = exc / width, excursion_bound(width) - exc
+    else:  # the bound follows the local width (brushes, perspective)
+        exc, exc_w, headroom = local_excursion(gt.drawing, output, profile)
+    within = bool(headroom >= 0.0)
     unc = uncovered(gt.drawing, output)
     min_length = gt.meta.get("min_length")
     fair = bool(len(output.strokes) == 1 and within and unc <= cover_tolerance and min_length is not None
                 and output.length <= fair_length_limit(min_length, width))
-    return InkScores(exc, exc / width if np.isfinite(exc) else float("nan"), within, unc, fair)
+    return InkScores(exc, exc_w if np.isfinite(exc) else float("nan"), within, unc, fair,
+                     headroom if np.isfinite(exc) else float("nan"))
 
 
 def verdict(gt, scores, ink: InkScores) -> bool:

@@ -6,6 +6,10 @@ error is below 0.01 px), and its ink coverage is clip(w/2 - d + 1/2, 0, 1), the 
 straight edge covers in a unit pixel. This gives round caps and joins for free and, unlike a
 polygon rasterizer, does not depend on how finely the curve was cut into segments, so the
 ground truth and an output that follows the same curve render to the same pixels.
+
+`render_profile` draws one stroke whose width changes along it (a brush, a broad nib,
+foreshortening in a photo): coverage is the largest clip(w(s)/2 - d + 1/2) over the centre
+line, computed band by band of nearly equal width.
 """
 
 from __future__ import annotations
@@ -51,6 +55,53 @@ def render(drawing: Drawing, *, stroke_width: float | None = None, size: tuple[i
     coverage = np.clip(w / 2 - d + 0.5, 0.0, 1.0)
     image[r, c] = 1.0 - coverage
     return image
+
+
+WIDTH_BAND = 0.1  # px of width per band in `render_profile` (coverage error <= 0.05)
+
+
+def profile_widths(profile: tuple[np.ndarray, np.ndarray], fractions: np.ndarray) -> np.ndarray:
+    """Widths (px) at `fractions` (0-1) of the arc length, from a profile (knot fractions
+    (K,) increasing from 0 to 1, widths (K,) px)."""
+    knots, widths = profile
+    return np.interp(fractions, np.asarray(knots, dtype=float), np.asarray(widths, dtype=float))
+
+
+def render_profile(drawing: Drawing, profile: tuple[np.ndarray, np.ndarray]) -> np.ndarray:
+    """Render a one-stroke `drawing` (px) whose ink width follows `profile` (see
+    `profile_widths`) along its arc length: (H, W) float64 in [0, 1], 1 = paper."""
+    width, height = int(round(drawing.width)), int(round(drawing.height))
+    stroke = drawing.strokes[0]
+    samples = stroke.sample_evenly(SAMPLE_SPACING)
+    radii = profile_widths(profile, np.linspace(0.0, 1.0, len(samples))) / 2
+    coverage = np.zeros((height, width))
+    band = np.floor(radii / WIDTH_BAND).astype(int)
+    for b in np.unique(band):
+        pts = samples[band == b]
+        r = (b + 0.5) * WIDTH_BAND
+        reach = r + 1.5
+        cols, rows = np.floor(pts[:, 0]).astype(int), np.floor(pts[:, 1]).astype(int)
+        lo = np.maximum(np.floor(pts.min(axis=0) - reach - 1).astype(int), 0)
+        hi = np.minimum(np.ceil(pts.max(axis=0) + reach + 2).astype(int), (width, height))
+        if np.any(hi <= lo):
+            continue
+        seed = np.zeros((hi[1] - lo[1], hi[0] - lo[0]), dtype=bool)
+        inside = (cols >= lo[0]) & (cols < hi[0]) & (rows >= lo[1]) & (rows < hi[1])
+        seed[rows[inside] - lo[1], cols[inside] - lo[0]] = True
+        near = ndimage.distance_transform_edt(~seed) <= reach
+        rr, cc = np.nonzero(near)
+        d, _ = cKDTree(pts).query(np.c_[cc + lo[0] + 0.5, rr + lo[1] + 0.5], distance_upper_bound=reach + 1.0)
+        cov = np.clip(r - d + 0.5, 0.0, 1.0)
+        view = coverage[lo[1]:hi[1], lo[0]:hi[0]]
+        view[rr, cc] = np.maximum(view[rr, cc], cov)
+    return 1.0 - coverage
+
+
+def render_truth(gt) -> np.ndarray:
+    """A benchmark `GroundTruth` rendered: with its width profile (meta "width_profile")
+    when it has one, else at its constant stroke width."""
+    profile = gt.meta.get("width_profile")
+    return render(gt.drawing) if profile is None else render_profile(gt.drawing, profile)
 
 
 def to_uint8(gray: np.ndarray) -> np.ndarray:

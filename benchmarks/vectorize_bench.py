@@ -14,7 +14,8 @@ retraced branch cannot be told from the ink, fair-retrace rule), "relief" (Relie
 SingleLine glyphs), "triple" (three passes through a point), "handwriting" (jittered
 cursive words); "heldout" (not in "all"): glyphs, words and seeds no other set uses, under
 scan, JPEG, noise, pen-pressure, broken-line, half-resolution and pencil conditions
-(benchmarks/heldout.py). Classifier "auto" runs the CNN everywhere and the geometric rule on touch
+(benchmarks/heldout.py); "kinds" (not in "all"): TSP art, brush kana, broad-nib capitals and
+phone photos of pen drawings (benchmarks/kinds.py). Classifier "auto" runs the CNN everywhere and the geometric rule on touch
 too. See docs/benchmark.md for the columns.
 
 Each drawing is vectorized in a fresh process forked from this one (the vectorizer's
@@ -55,12 +56,13 @@ from benchmarks.hershey import hershey_set  # noqa: E402
 from benchmarks.ink_metrics import ink_pieces, ink_scores, verdict  # noqa: E402
 from benchmarks.metrics import ORDER_THRESHOLD, evaluate, order_tolerance  # noqa: E402
 from benchmarks.relief import relief_set  # noqa: E402
-from benchmarks.render import render, to_uint8  # noqa: E402
+from benchmarks.render import render, render_truth, to_uint8  # noqa: E402
 
 DEFAULT_COUNTS = {"plain": 42, "touch": 40, "hershey": 40, "hershey-retrace": 40, "relief": 40, "triple": 40,
                   "handwriting": 40}
 SETS = tuple(DEFAULT_COUNTS)
 HELDOUT_COUNT = 93  # --set heldout (benchmarks/heldout.py): not part of "all", which are the sets tuned on
+KINDS_COUNT = 40  # --set kinds (benchmarks/kinds.py): not part of "all" either
 
 
 def build_set(name: str, count: int, seed: int) -> list:
@@ -79,6 +81,10 @@ def build_set(name: str, count: int, seed: int) -> list:
         from benchmarks.heldout import heldout_set
 
         return heldout_set(count, seed)
+    if name == "kinds":
+        from benchmarks.kinds import kinds_set
+
+        return kinds_set(count, seed)
     return generate_set(name, count, seed)
 TASKS: list = []  # (set name, GroundTruth), inherited by the forked workers
 PLOT_DIR: list = []  # [Path] when --plot is given
@@ -147,11 +153,12 @@ def _run_one(index: int, classifier: str, oracle: bool, conn) -> None:
            "width": gt.width, "closed": gt.closed, "gt_intersections": len(gt.intersections),
            "error": ""}
     try:
-        gray = render(gt.drawing)
+        gray = render_truth(gt)
         condition = gt.meta.get("condition", CONDITION[0])  # the held-out set brings its own
         row["condition"] = condition
         image, back = condition_image(gt.drawing, gray, condition, np.random.default_rng(index))
-        row["one_piece"] = ink_pieces(image, gt.width / back) == 1
+        # a photo's shadow is darker than mid-gray: count the pieces of the ink as drawn
+        row["one_piece"] = ink_pieces(gray if condition == "photo" else image, gt.width / back) == 1
         if oracle:
             output, seconds, peak, method, report = gt.drawing, 0.0, float("nan"), "none", None
         else:
@@ -195,6 +202,7 @@ def _ink_row(gt, output, scores) -> dict:
     fair = bool(gt.meta.get("fair"))
     correct = verdict(gt, scores, ink)
     return {"excursion": ink.excursion, "excursion_w": ink.excursion_widths, "within": ink.within,
+            "headroom": ink.headroom,
             "uncovered": ink.uncovered, "cover_tolerance": order_tolerance(gt.width), "fair": fair,
             "fair_why": gt.meta.get("fair_why", "ambiguous" if fair else ""),
             "out_length": output.length, "min_length": gt.meta.get("min_length", float("nan")),
@@ -261,7 +269,7 @@ def whole_process(gts: list, timeout: float, classifier: str) -> None:
         for gt in gts:
             src = Path(tmp) / f"{gt.name}.png"
             out = Path(tmp) / f"{gt.name}.svg"
-            Image.fromarray(to_uint8(render(gt.drawing))).save(src)
+            Image.fromarray(to_uint8(render_truth(gt))).save(src)
             start, cpu_start = time.perf_counter(), child_cpu_seconds()
             try:
                 proc = subprocess.run(base + ["vectorize", str(src), "-o", str(out)] + extra, capture_output=True,
@@ -354,8 +362,8 @@ def _git_commit() -> str:
 
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[1], formatter_class=argparse.RawTextHelpFormatter)
-    ap.add_argument("--set", default="all", choices=[*SETS, "heldout", "all"],
-                    help="all: every set but heldout (the drawings and conditions no set tunes on)")
+    ap.add_argument("--set", default="all", choices=[*SETS, "heldout", "kinds", "all"],
+                    help="all: every set but heldout and kinds (the drawings and conditions no set tunes on)")
     ap.add_argument("--classifier", default="auto", choices=["auto", "cnn", "geometric", "both"],
                     help="auto: cnn on plain/hershey, both on touch")
     ap.add_argument("--count", type=int, default=None, help="drawings per set (default: plain 42, touch 40, "
@@ -365,6 +373,9 @@ def main(argv: list[str] | None = None) -> int:
                     help="only the drawings whose name contains TEXT (repeatable; the set is built as usual first)")
     ap.add_argument("--condition", default="clean", choices=CONDITIONS,
                     help="degrade each rendered page like a real input (see benchmarks/conditions.py)")
+    ap.add_argument("--scale", type=float, default=1.0,
+                    help="draw every drawing this many times larger on a canvas as much larger (e.g. 3.5: "
+                         "3500 px pages; the vectorizer's max_size still applies)")
     ap.add_argument("--jobs", type=int, default=1, help="drawings in parallel (timing is cleanest with 1)")
     ap.add_argument("--csv", type=Path, default=None, help="write one row per drawing here")
     ap.add_argument("--plot", type=Path, default=None, metavar="DIR",
@@ -386,10 +397,15 @@ def main(argv: list[str] | None = None) -> int:
         PLOT_DIR.append(args.plot)
     sets = list(SETS) if args.set == "all" else [args.set]
     for name in sets:
-        count = args.count if args.count is not None else DEFAULT_COUNTS.get(name, HELDOUT_COUNT)
+        count = args.count if args.count is not None else DEFAULT_COUNTS.get(
+            name, KINDS_COUNT if name == "kinds" else HELDOUT_COUNT)
         gts = build_set(name, count, args.seed)
         if args.name:
             gts = [gt for gt in gts if any(text in gt.name for text in args.name)]
+        if args.scale != 1.0:
+            from benchmarks.kinds import scaled
+
+            gts = [scaled(gt, args.scale) for gt in gts]
         TASKS.extend((name, gt) for gt in gts)
     t_gen = time.perf_counter() - t_start
 
@@ -427,7 +443,7 @@ def main(argv: list[str] | None = None) -> int:
         for classifier in sorted({c for _, c in jobs}):
             start = time.perf_counter()
             try:
-                vectorize_image(to_uint8(render(TASKS[0][1].drawing)), VectorizeOptions(classifier=classifier))
+                vectorize_image(to_uint8(render_truth(TASKS[0][1])), VectorizeOptions(classifier=classifier))
                 print(f"warm-up ({classifier}): {time.perf_counter() - start:.2f} s")
             except Exception as exc:  # noqa: BLE001
                 print(f"warm-up ({classifier}) failed: {type(exc).__name__}: {exc}")
@@ -460,7 +476,8 @@ def main(argv: list[str] | None = None) -> int:
     if args.csv:
         keys = ["set", "classifier", "name", "kind", "width", "closed", "strokes", "order", "correct", "ssim",
                 "psnr", "length_ratio", "gt_intersections", "out_intersections", "matched", "seconds",
-                "peak_mb", "condition", "order_correct", "fair", "fair_why", "one_piece", "excursion", "excursion_w", "within", "uncovered",
+                "peak_mb", "condition", "order_correct", "fair", "fair_why", "one_piece", "excursion", "excursion_w",
+                "within", "headroom", "uncovered",
                 "cover_tolerance", "out_length", "min_length",
                 "error", "warnings"]
         args.csv.parent.mkdir(parents=True, exist_ok=True)

@@ -106,6 +106,12 @@ def test_click_a_junction_through_its_pairings_undo_redo_and_play(page):
     assert abs(page.evaluate("window.studio.pen") - 0.25) < 0.03
     quarter = coloured_pixels(page)
     assert quarter < full * 0.45
+    # The space bar plays and pauses (focus on the drawing, not on a control).
+    page.click("#canvas", position={"x": 5, "y": 5})
+    page.keyboard.press("Space")
+    page.wait_for_function("window.studio.playing && window.studio.pen > 0.3", polling=50)
+    page.keyboard.press("Space")
+    assert not page.evaluate("window.studio.playing")
     drag_slider(page, "#scrub", 1.0)
     assert page.evaluate("window.studio.pen") == 1 and coloured_pixels(page) == full
 
@@ -300,6 +306,12 @@ def test_edits_file_save_load_and_open(page, studio, tmp_path):
     edits = page.evaluate(f"{STATE}.edits")
     assert edits["edits"], "the earlier tests left edits to save"
 
+    # Load before anything was saved: says so and keeps the edits (it used to apply "none").
+    steps = page.evaluate("window.studio.history.length")
+    page.click("#load")
+    page.wait_for_function("document.getElementById('hint').textContent.includes('no edits saved yet')")
+    page.wait_for_timeout(200)
+    assert page.evaluate(f"{STATE}.edits") == edits and page.evaluate("window.studio.history.length") == steps
     # Save writes the edits file named on the command line; the CLI replays it to the
     # page's SVG, byte for byte.
     page.click("#save")

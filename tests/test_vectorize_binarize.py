@@ -184,3 +184,26 @@ def test_ink_depth_on_small_masks_at_the_edges():
         assert np.array_equal(ink_depth(mask), ndimage.distance_transform_edt(mask))
         if mask.any():
             assert estimate_stroke_width(mask) == _scipy_width(mask)
+
+
+def test_a_phone_photo_becomes_gray_row_block_by_row_block():
+    # a 4000 x 3000 colour photo: the gray image is 48 MB; converting all channels to float
+    # at once took two 144 MB copies on the way (a 3500 px photo peaked over 600 MB)
+    import tracemalloc
+
+    from vectorize.binarize import GRAY_ROWS, _to_gray, to_gray
+
+    rng = np.random.default_rng(0)
+    small = (rng.random((GRAY_ROWS * 2 + 17, 50, 3)) * 255).astype(np.uint8)
+    assert np.array_equal(to_gray(small), _to_gray(small))  # same values as all at once
+    rgba = (rng.random((GRAY_ROWS + 3, 40, 4)) * 65535).astype(np.uint16)
+    assert np.array_equal(to_gray(rgba), _to_gray(rgba))
+    photo = np.full((3000, 4000, 3), 200, dtype=np.uint8)
+    tracemalloc.start()
+    try:
+        gray = to_gray(photo)
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    assert gray.shape == (3000, 4000) and gray.dtype == np.float32
+    assert peak < 48e6 + 30e6  # the result and a row block's float copies (was 288 MB)

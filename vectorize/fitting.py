@@ -3,6 +3,7 @@ B-splines with `scipy.interpolate.splprep`, and convert them to Bézier segments
 
 from __future__ import annotations
 
+import bisect
 from dataclasses import dataclass
 
 import numpy as np
@@ -139,9 +140,14 @@ def sharp_corners(xy: np.ndarray, stroke_width: float, *, closed: bool) -> np.nd
     narrow = _turn(xy, arc, 0.5 * stroke_width, closed)
     candidate = (wide > np.radians(40.0)) & (narrow > 0.6 * wide)
     corners: list[int] = []
+    taken: list[float] = []  # arc lengths of the corners kept so far, sorted
     for i in np.flatnonzero(candidate)[np.argsort(-wide[candidate], kind="stable")]:
-        if all(abs(arc[i] - arc[j]) > 2.0 * stroke_width for j in corners):
+        # the nearest kept corners on either side (TSP art has thousands of corners: a scan of
+        # all of them per candidate was most of its fitting time)
+        k = bisect.bisect_left(taken, arc[i])
+        if all(abs(arc[i] - taken[j]) > 2.0 * stroke_width for j in (k - 1, k) if 0 <= j < len(taken)):
             corners.append(int(i))
+            taken.insert(k, float(arc[i]))
     return np.array(sorted(corners), dtype=int)
 
 
@@ -193,7 +199,11 @@ def _tip_in_ink(xy: np.ndarray, arc: np.ndarray, at: int, guard: InkGuard, strok
             target = np.mod(target, arc[-1])
         elif not 0.0 <= target <= arc[-1]:
             return None
-        point = np.array([np.interp(target, arc, xy[:, 0]), np.interp(target, arc, xy[:, 1])])
+        # np.interp on the few points around the target: the same value as over the whole
+        # line, without copying the line at every corner (TSP art has thousands)
+        j = int(np.searchsorted(arc, target, side="right"))
+        near = slice(max(j - 2, 0), min(j + 2, len(arc)))
+        point = np.array([np.interp(target, arc[near], xy[near, 0]), np.interp(target, arc[near], xy[near, 1])])
         chord = point - xy[at]
         if np.linalg.norm(chord) < 1e-9:
             return None
@@ -277,8 +287,14 @@ def fit_stroke(traced: TracedPoints, *, closed: bool, sigma: float, stroke_width
     # Around a corner the axis is off the centre line for about a stroke width: leave it out.
     # (The corner joints below read the tip along this arc too.)
     arc = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(xy, axis=0), axis=1))])
-    for i in np.flatnonzero(corner):
-        keep &= np.abs(arc - arc[i]) > stroke_width
+    at = arc[np.flatnonzero(corner)]  # ascending, as the arc is
+    if at.size:
+        # the distance along the line to the nearest corner, either side (one pass, not one
+        # per corner: TSP art has thousands)
+        k = np.searchsorted(at, arc)
+        after = np.abs(at[np.minimum(k, at.size - 1)] - arc)
+        before = np.abs(arc - at[np.maximum(k - 1, 0)])
+        keep &= np.minimum(before, after) > stroke_width
     mirror_keep(twins, keep)
     cuts = [0] + [int(i) for i in np.flatnonzero(split) if 0 < i < len(xy) - 1] + [len(xy) - 1]
     pieces = []

@@ -39,8 +39,14 @@ PRUNE_SINGLE, PRUNE_MULTI = 0.95, 0.90
 # thousands, and simplifying those takes hours.
 MAX_OUTLINES, MAX_BRANCH_POINTS = 5000, 4000
 # Outline samples bound the Voronoi diagram's work: the example drawings have 4,500-18,000;
-# a 400 px square of noise has 367,000, which qhull takes minutes over.
+# a 400 px square of noise has 367,000 in 2,400 outlines, which qhull takes minutes over.
+# One long line is not noise: TSP art (a closed line 40,000-50,000 px long, 2-3 px wide,
+# outlined every 0.3 px) has 300,000 samples in a handful of outlines, and its medial axis
+# takes about 4 s. So past MAX_OUTLINE_SAMPLES the ink is refused only when it is also
+# broken into more than LONG_LINE_OUTLINES outlines, and always past MAX_LONG_LINE_SAMPLES.
 MAX_OUTLINE_SAMPLES = 150_000
+LONG_LINE_OUTLINES = 500
+MAX_LONG_LINE_SAMPLES = 600_000
 # Share of plausibility of the smoother touching pairing when the classifier says "touch".
 SMOOTHER_TOUCH = 0.85
 
@@ -332,8 +338,9 @@ def _axis(image: np.ndarray, options: VectorizeOptions, clock: _Clock, cache: St
     clock.lap("outline")
     _refuse_noise(len(rings), "outlines (pieces and holes)", MAX_OUTLINES, ink.threshold,
                   options.threshold is not None)
-    _refuse_noise(sum(len(ring) for ring in rings), "outline samples", MAX_OUTLINE_SAMPLES, ink.threshold,
-                  options.threshold is not None)
+    samples = sum(len(ring) for ring in rings)
+    _refuse_noise(samples, "outline samples", MAX_OUTLINE_SAMPLES if len(rings) > LONG_LINE_OUTLINES
+                  else MAX_LONG_LINE_SAMPLES, ink.threshold, options.threshold is not None)
     graph = medial_axis(rings, ink.gray, ink.threshold)
     clock.lap("medial axis")
     return ink, rings, graph

@@ -33,6 +33,7 @@ COOKIE = "onestroke_studio"  # + a digest of the token: cookies ignore ports, tw
 def cookie_name(token: str) -> str:
     return f"{COOKIE}_{hashlib.sha256(token.encode()).hexdigest()[:10]}"
 STATIC = {"app.js": "text/javascript", "api.js": "text/javascript", "panels.js": "text/javascript",
+          "view.js": "text/javascript", "marks.js": "text/javascript",
           "style.css": "text/css", "index.html": "text/html"}
 # The toolpath player's files, served from its own package (`fabrication.player`).
 PLAYER = {"player.js": "text/javascript", "player.css": "text/css"}
@@ -185,7 +186,8 @@ def create_app(session: StudioSession, *, token: str, hosts: set[str]) -> Guard:
         return JSONResponse({"saved": str(session.edits_path), "edits": edits.to_dict()})
 
     async def load_edits(request: Request):
-        return JSONResponse({"path": str(session.edits_path), "edits": session.saved_edits().to_dict()})
+        return JSONResponse({"path": str(session.edits_path), "exists": session.edits_path.is_file(),
+                             "edits": session.saved_edits().to_dict()})
 
     async def send(request: Request):
         from fabrication.studio.sender import LaserSender

@@ -2,31 +2,13 @@
 // (the library's), the page only draws, keeps the edits history and sends edits back.
 "use strict";
 import { $, busy, call, report } from "./api.js";
+import { arrows, bridges, drawPasses, junctionMarkers, markerHit, placeLabels, retraces, startMarkers,
+         startPlaces } from "./marks.js";
 import { fieldNames, refreshPanel, setupPanels } from "./panels.js";
+import { COLORS, dist, passRank, percent, samePasses, studio, toImage, toScreen } from "./view.js";
 
 const PAIRINGS = ["crossing", "touching", "third"];
-const COLORS = { crossing: "#1565c0", touching: "#ef6c00", third: "#8e24aa", other: "#757575", start: "#2e7d32",
-                 passes: "#00838f", retrace: "rgba(255, 179, 0, 0.55)", gap: "#c2185b" };
-// The three passes through a triple point, each in its own colour inside the marker.
-const PASS_COLORS = ["#d81b60", "#43a047", "#1e88e5", "#6d4c41"];
 
-const studio = {
-  state: null,            // last answer of /api/state
-  history: [],            // edits states (plain objects), for undo/redo
-  at: -1,                 // index of the current state in history
-  view: { scale: 1, x: 0, y: 0 },
-  pen: 1,                 // play position, fraction of the total length
-  playing: false,
-  tool: "pairing",
-  image: new Image(),
-  requests: 0,            // answers to ignore when a newer request was sent
-  shown: null,            // the edits of the state shown (what the panels and downloads use)
-  rerunning: 0,           // pending requests that re-run from binarization
-  holding: null,          // the slider the pointer holds ("threshold", "blur")
-  // This page's id: the server skips a queued state request once the page sent a newer one.
-  page: Math.random().toString(36).slice(2) + Date.now().toString(36),
-};
-window.studio = studio;
 
 // ---------------------------------------------------------------- edits and history
 function currentEdits() { return studio.history[studio.at]; }
@@ -85,15 +67,6 @@ function updateButtons() {
   $("redo").disabled = studio.at >= studio.history.length - 1;
 }
 
-// ---------------------------------------------------------------- geometry helpers
-function dist(a, b) { return Math.hypot(a[0] - b[0], a[1] - b[1]); }
-function toScreen(x, y) { const v = studio.view; return [x * v.scale + v.x, y * v.scale + v.y]; }
-function toImage(sx, sy) { const v = studio.view; return [(sx - v.x) / v.scale, (sy - v.y) / v.scale]; }
-studio.toScreen = (x, y) => {
-  const r = $("canvas").getBoundingClientRect();
-  const [sx, sy] = toScreen(x, y);
-  return [r.left + sx, r.top + sy];
-};
 
 // Fit the view to the drawing: the ink and the curve with a margin for the markers'
 // labels (a small drawing on a large sheet fills the view), else the whole image.
@@ -196,85 +169,6 @@ function draw() {
   else $("where").textContent = `${Math.round(t.total)} px, ${s.strokes.length} stroke${s.strokes.length === 1 ? "" : "s"}`;
 }
 
-// Start markers: where each stroke begins. One that would hide a junction's marker (a line
-// starting at a junction) sits just beyond it along its stroke.
-function startPlaces() {
-  const s = studio.state;
-  const markers = s.graph.junctions.map((j) => ({ at: toScreen(...j.at), r: j.role === "triple" ? 24 : 11 }));
-  return s.strokes.map((stroke) => {
-    const start = toScreen(...stroke.points[0]);
-    const under = markers.find((m) => Math.hypot(m.at[0] - start[0], m.at[1] - start[1]) < m.r + 6);
-    if (!under) return start;
-    return stroke.points.map((p) => toScreen(...p))
-      .find(([px, py]) => Math.hypot(px - under.at[0], py - under.at[1]) > under.r + 9) || start;
-  });
-}
-
-function startMarkers(g, starts) {
-  starts.forEach(([x, y], k) => {
-    g.fillStyle = COLORS.start; g.beginPath(); g.arc(x, y, k === 0 ? 7 : 5, 0, 2 * Math.PI); g.fill();
-    g.fillStyle = "#fff"; g.font = "bold 9px sans-serif"; g.textAlign = "center"; g.textBaseline = "middle";
-    g.fillText(String(k + 1), x, y + 0.5);
-  });
-}
-
-function arrows(g, t) {
-  const step = 90 / studio.view.scale;  // one arrow every ~90 screen px
-  let next = step / 2;
-  g.fillStyle = "rgba(20,20,20,0.75)";
-  for (let i = 1; i < t.pts.length; i++) {
-    if (t.pts[i].first || t.cum[i] < next) continue;
-    next = t.cum[i] + step;
-    const a = toScreen(...t.pts[i - 1]), b = toScreen(...t.pts[i]);
-    const ang = Math.atan2(b[1] - a[1], b[0] - a[0]);
-    g.save(); g.translate(b[0], b[1]); g.rotate(ang);
-    g.beginPath(); g.moveTo(6, 0); g.lineTo(-4, -4.5); g.lineTo(-4, 4.5); g.closePath(); g.fill();
-    g.restore();
-  }
-}
-
-// Stretches the line draws twice (a stem down and back up, a path route inspection repeats):
-// a wide amber band under the curve, "×2" at its middle.
-function retraces(g) {
-  const s = studio.state;
-  g.save();
-  g.lineCap = "round"; g.lineJoin = "round";
-  g.lineWidth = Math.max(8, s.stroke_width * studio.view.scale * 1.6);
-  g.strokeStyle = COLORS.retrace;
-  for (const r of s.graph.retraces || []) {
-    g.beginPath();
-    r.points.forEach((p, i) => { const [x, y] = toScreen(...p); if (i) g.lineTo(x, y); else g.moveTo(x, y); });
-    g.stroke();
-  }
-  g.fillStyle = "#6d4c00"; g.font = "bold 11px sans-serif"; g.textAlign = "center"; g.textBaseline = "middle";
-  for (const r of s.graph.retraces || []) { const [x, y] = toScreen(...r.at); g.fillText("×2", x + 12, y - 12); }
-  g.restore();
-}
-
-// Pen gaps the vectorizer bridged: the two ends joined, dashed, under the curve; gaps the
-// user kept open (an "unbridge" edit): a grey circle struck through.
-function bridges(g) {
-  g.save();
-  const ring = ([a, b]) => {
-    const [ax, ay] = toScreen(...a), [bx, by] = toScreen(...b);
-    return [(ax + bx) / 2, (ay + by) / 2, Math.max(9, Math.hypot(bx - ax, by - ay) / 2 + 5)];
-  };
-  for (const gap of studio.state.graph.bridges || []) {
-    const [x, y, r] = ring(gap);
-    g.strokeStyle = COLORS.gap; g.lineWidth = studio.tool === "gap" ? 3 : 2; g.setLineDash([4, 3]);
-    g.beginPath(); g.arc(x, y, r, 0, 2 * Math.PI); g.stroke();
-    g.setLineDash([]);
-    label(g, "gap", x, y, r + 3);
-  }
-  for (const gap of studio.state.graph.unbridged || []) {
-    const [x, y, r] = ring(gap);
-    g.strokeStyle = COLORS.other; g.lineWidth = 2;
-    g.beginPath(); g.arc(x, y, r, 0, 2 * Math.PI);
-    g.moveTo(x - r * 0.7, y + r * 0.7); g.lineTo(x + r * 0.7, y - r * 0.7); g.stroke();
-    label(g, "gap open", x, y, r + 3);
-  }
-  g.restore();
-}
 
 function middle([a, b]) { return { at: [(a[0] + b[0]) / 2, (a[1] + b[1]) / 2], ends: [a, b] }; }
 
@@ -283,182 +177,6 @@ function toSegment(p, [a, b]) {
   const dx = b[0] - a[0], dy = b[1] - a[1], n = dx * dx + dy * dy;
   const t = n ? Math.max(0, Math.min(1, ((p[0] - a[0]) * dx + (p[1] - a[1]) * dy) / n)) : 0;
   return dist(p, [a[0] + t * dx, a[1] + t * dy]);
-}
-
-function percent(p) { return p === null || p === undefined ? "" : p < 0.001 ? " <0.1%" : ` ${Math.round(100 * p)}%`; }
-
-// The passes of a triple point in a circle of radius r at (x, y): each pass joins its two
-// branch directions through the centre in its own colour, on a white halo; stub: px it
-// runs on beyond the circle along the real branches, so that each branch shows its pass.
-function drawPasses(g, x, y, r, passes, stub = 0) {
-  const at = (deg, d) => [x + d * Math.cos((deg * Math.PI) / 180), y + d * Math.sin((deg * Math.PI) / 180)];
-  const path = ([a, b]) => {
-    g.beginPath(); g.moveTo(...at(a, r + stub)); g.lineTo(...at(a, r));
-    const [qx, qy] = at(b, r);
-    g.quadraticCurveTo(x, y, qx, qy); g.lineTo(...at(b, r + stub));
-  };
-  g.save();
-  g.lineCap = "round"; g.lineJoin = "round";
-  passes.forEach((pass, k) => {
-    g.strokeStyle = "rgba(255,255,255,0.95)"; g.lineWidth = Math.max(4, r / 3.5); path(pass); g.stroke();
-    g.strokeStyle = PASS_COLORS[k % PASS_COLORS.length]; g.lineWidth = Math.max(2, r / 7); path(pass); g.stroke();
-  });
-  g.restore();
-}
-
-// The place of the pairing drawn among the ones offered (likeliest first), 1-based.
-function passRank(j) { return j.options.findIndex((o) => samePasses(o.passes, j.passes)) + 1; }
-
-// A triple point: its three passes drawn through the marker and along each branch, so the
-// pairing is seen, not read; a square when you chose it.
-function tripleMarker(g, j) {
-  const [x, y] = toScreen(...j.at), r = 20;
-  g.lineWidth = 3; g.strokeStyle = COLORS.passes; g.fillStyle = "rgba(255,255,255,0.92)";
-  g.beginPath();
-  if (j.fixed) g.rect(x - r - 2, y - r - 2, 2 * r + 4, 2 * r + 4); else g.arc(x, y, r + 2, 0, 2 * Math.PI);
-  g.fill(); g.stroke();
-  drawPasses(g, x, y, r - 2, j.passes, 12);
-  const scorer = j.confidence === null ? " (straightest)" : percent(j.confidence);
-  label(g, `3 passes: pairing ${passRank(j)}/${j.options.length}${scorer}${j.fixed ? " · yours" : ""}`, x, y, r + 12);
-}
-
-// A marker's text, beside the marker at (x, y) of radius `gap`; drawn by `placeLabels`
-// once every marker is drawn.
-function label(g, text, x, y, gap) { studio.labels.push({ text, x, y, gap }); }
-
-// Each text on a white box so that it reads over the curve, right of its marker, else
-// left, below or above, wherever it stays on the canvas and covers no marker (nor `more`
-// boxes: [x, y, w, h]) and no text placed before (junctions a few px apart would print
-// over each other).
-function placeLabels(g, more = []) {
-  g.font = "11px sans-serif"; g.textAlign = "left"; g.textBaseline = "middle";
-  const boxes = studio.labels.map(({ x, y, gap }) => [x - gap, y - gap, 2 * gap, 2 * gap]).concat(more);
-  const h = 13, c = $("canvas");
-  const placed = [];
-  studio.placed = [];  // the texts drawn and their boxes (screen px)
-  for (const { text, x, y, gap } of studio.labels) {
-    // Two nodes a pixel or two apart (a split crossing) would print the same text twice.
-    if (placed.some((q) => q.text === text && Math.hypot(q.x - x, q.y - y) < 12)) continue;
-    placed.push({ text, x, y });
-    const w = g.measureText(text).width;
-    const spots = [[x + gap, y], [x - gap - w, y], [x - w / 2, y + gap + h / 2], [x - w / 2, y - gap - h / 2]];
-    const covers = (sx, sy, b) => sx < b[0] + b[2] && b[0] < sx + w && sy - h / 2 < b[1] + b[3] && b[1] < sy + h / 2;
-    const inside = (sx, sy) => sx >= 2 && sx + w <= c.clientWidth - 2 && sy - h / 2 >= 0 && sy + h / 2 <= c.clientHeight;
-    const [lx, ly] = spots.find(([sx, sy]) => inside(sx, sy) && !boxes.some((b) => covers(sx, sy, b))) ||
-      spots.find(([sx, sy]) => inside(sx, sy)) || spots[0];
-    boxes.push([lx, ly - h / 2, w, h]);
-    studio.placed.push({ text, box: [lx, ly - h / 2, w, h] });
-    g.fillStyle = "rgba(255,255,255,0.8)"; g.fillRect(lx - 2, ly - h / 2, w + 4, h);
-    g.strokeStyle = "rgba(255,255,255,0.9)"; g.lineWidth = 3; g.lineJoin = "round"; g.strokeText(text, lx, ly);
-    g.fillStyle = "#222"; g.fillText(text, lx, ly);
-  }
-}
-
-function samePasses(a, b) { return JSON.stringify(a) === JSON.stringify(b); }
-
-// Marker radii on screen, per junction role (a triple point's is drawn by tripleMarker).
-const MARKER_R = { triple: 22, crossing: 10, unresolved: 9 };
-
-// Where each junction's marker is drawn, in screen px: on its junction, except where
-// markers would cover each other (the two halves of a split crossing a pixel apart, a Y
-// beside a crossing): such a group is fanned out around its middle, each marker tied to
-// its junction by a thin line, so that each one reads and takes its own click.
-function markerPlaces() {
-  const ms = studio.state.graph.junctions.map((j) => {
-    const at = toScreen(...j.at);
-    return { j, at, x: at[0], y: at[1], r: MARKER_R[j.role] || 6 };
-  });
-  const group = ms.map((_, i) => i);
-  const root = (i) => (group[i] === i ? i : (group[i] = root(group[i])));
-  ms.forEach((a, i) => ms.forEach((b, k) => {
-    if (k > i && a.j.role !== "triple" && b.j.role !== "triple" &&
-        Math.hypot(a.x - b.x, a.y - b.y) < a.r + b.r + 2) group[root(i)] = root(k);
-  }));
-  const groups = new Map();
-  ms.forEach((m, i) => { const k = root(i); groups.set(k, (groups.get(k) || []).concat([m])); });
-  for (const members of groups.values()) {
-    const n = members.length;
-    if (n < 2) continue;
-    const cx = members.reduce((t, m) => t + m.at[0], 0) / n, cy = members.reduce((t, m) => t + m.at[1], 0) / n;
-    const spread = Math.max(...members.map((m) => m.r)) + 2;
-    const radius = spread / Math.sin(Math.PI / n);
-    // Around the middle in the order they lie (coinciding ones by id), turned so that the
-    // first keeps its own side.
-    const angle = (m) => Math.atan2(m.at[1] - cy, m.at[0] - cx);
-    members.sort((a, b) => angle(a) - angle(b) || a.j.id - b.j.id);
-    const first = Math.hypot(members[0].at[0] - cx, members[0].at[1] - cy) > 0.5 ? angle(members[0]) : Math.PI;
-    members.forEach((m, k) => {
-      const a = first + (2 * Math.PI * k) / n;
-      m.x = cx + radius * Math.cos(a); m.y = cy + radius * Math.sin(a); m.moved = true;
-    });
-  }
-  return ms;
-}
-
-// The marker under screen point (sx, sy) among these roles, or null.
-function markerHit(sx, sy, roles) {
-  let best = null, bestD = Infinity;
-  for (const m of studio.markers || []) {
-    const d = Math.hypot(m.x - sx, m.y - sy);
-    if (roles.includes(m.j.role) && d <= Math.max(18, m.r + 4) && d < bestD) { best = m.j; bestD = d; }
-  }
-  return best;
-}
-studio.markerAt = (id) => {
-  const m = (studio.markers || []).find((q) => q.j.id === id);
-  const r = $("canvas").getBoundingClientRect();
-  return m ? [r.left + m.x, r.top + m.y] : null;
-};
-
-function junctionMarkers(g) {
-  const graph = studio.state.graph;
-  if (studio.tool === "start") {
-    for (const at of graph.ends || []) {
-      const [x, y] = toScreen(...at);
-      g.strokeStyle = COLORS.start; g.lineWidth = 2; g.setLineDash([3, 2]);
-      g.beginPath(); g.arc(x, y, 9, 0, 2 * Math.PI); g.stroke(); g.setLineDash([]);
-    }
-  }
-  if (studio.tool === "merge") {
-    for (const b of graph.branches) {
-      const [x, y] = toScreen(...b.at);
-      g.fillStyle = "#00897b"; g.beginPath();
-      g.moveTo(x, y - 7); g.lineTo(x + 7, y); g.lineTo(x, y + 7); g.lineTo(x - 7, y); g.closePath(); g.fill();
-    }
-  }
-  studio.markers = markerPlaces();
-  for (const m of studio.markers) {
-    if (!m.moved) continue;
-    // A marker moved off its junction: a thin line from the junction (a dot) to it.
-    g.strokeStyle = "rgba(60,60,60,0.8)"; g.fillStyle = "rgba(60,60,60,0.9)"; g.lineWidth = 1.5;
-    g.beginPath(); g.moveTo(m.at[0], m.at[1]); g.lineTo(m.x, m.y); g.stroke();
-    g.beginPath(); g.arc(m.at[0], m.at[1], 2.5, 0, 2 * Math.PI); g.fill();
-  }
-  for (const { j, x, y } of studio.markers) {
-    if (j.role === "triple") { tripleMarker(g, j); continue; }
-    if (j.role !== "crossing") {
-      // An unresolved junction (the warning's "three or more strokes seem to meet") is
-      // named where it is: the order there is the walk's guess. A click says what to do.
-      const open = j.role === "unresolved";
-      g.strokeStyle = open ? COLORS.gap : COLORS.other; g.lineWidth = 2; g.fillStyle = "rgba(255,255,255,0.85)";
-      g.beginPath(); g.arc(x, y, open ? 7 : 5, 0, 2 * Math.PI); g.fill(); g.stroke();
-      if (open) {
-        g.fillStyle = COLORS.gap; g.font = "bold 10px sans-serif"; g.textAlign = "center"; g.textBaseline = "middle";
-        g.fillText("?", x, y + 0.5);
-        label(g, "unresolved", x, y, 10);
-      }
-      continue;
-    }
-    const color = COLORS[j.decision] || COLORS.other;
-    g.lineWidth = 3; g.strokeStyle = color; g.fillStyle = "rgba(255,255,255,0.85)";
-    g.beginPath();
-    if (j.fixed) g.rect(x - 9, y - 9, 18, 18); else g.arc(x, y, 9, 0, 2 * Math.PI);
-    g.fill(); g.stroke();
-    // Confidence as the filled share of an inner disc.
-    g.fillStyle = color; g.beginPath(); g.moveTo(x, y);
-    g.arc(x, y, 6, -Math.PI / 2, -Math.PI / 2 + 2 * Math.PI * (j.confidence || 0)); g.closePath(); g.fill();
-    label(g, `${j.decision} ${Math.round(100 * (j.confidence || 0))}%`, x, y, 12);
-  }
 }
 
 // What an unresolved junction offers: merge it with the degree-3 node its shortest branch
@@ -568,7 +286,12 @@ function show(state) {
         `${j.fixed ? " · fixed by you" : ""} · ${offered}, likeliest first:`);
       li.appendChild(passChoice(j));
     } else {
-      li.textContent = `${where} ${j.decision} · CNN p(cross) ${(j.p_crossing * 100).toFixed(0)}%` +
+      // The marker's figure is the confidence (how far the classifier's views agree), not the
+      // probability: "touching 100%" beside p(cross) 19% reads as a contradiction unless both are named.
+      li.title = "confidence: the share of the classifier's 8 turned and mirrored views of this junction " +
+        "that agree (the figure on the marker); p(crossing): their mean probability that two strokes cross here";
+      li.textContent = `${where} ${j.decision} · confidence ${Math.round(100 * (j.confidence || 0))}% · ` +
+        `CNN p(crossing) ${(j.p_crossing * 100).toFixed(0)}%` +
         (j.fixed ? " · fixed by you" : "");
     }
     list.appendChild(li);
@@ -851,6 +574,9 @@ function setup() {
   setupView();
   $("undo").onclick = undo; $("redo").onclick = redo;
   document.addEventListener("keydown", (e) => {
+    // Space plays and pauses the pen (as in the player), unless a control has the key.
+    if (e.key === " " && !e.ctrlKey && !["INPUT", "BUTTON", "SELECT", "TEXTAREA", "LABEL"].includes(e.target.tagName) &&
+        !$("tab-refine").hidden) { e.preventDefault(); play(); return; }
     if (!(e.ctrlKey || e.metaKey) || e.target.tagName === "INPUT") return;
     if (e.key === "z" && !e.shiftKey) { e.preventDefault(); undo(); }
     if (e.key === "y" || (e.key === "z" && e.shiftKey)) { e.preventDefault(); redo(); }
@@ -883,7 +609,13 @@ function setup() {
     catch (error) { report(error); }
   };
   $("load").onclick = async () => {
-    try { const r = await call("api/edits"); apply(r.edits); } catch (error) { report(error); }
+    try {
+      const r = await call("api/edits");
+      // No file yet: nothing to load (applying "no edits" would throw the user's away).
+      if (!r.exists) hint(`no edits saved yet: ${r.path} does not exist (Save edits writes it)`);
+      else if (JSON.stringify(r.edits) === JSON.stringify(currentEdits())) hint(`the edits are those of ${r.path} already`);
+      else { hint(""); apply(r.edits); }
+    } catch (error) { report(error); }
   };
   $("open").onchange = async () => {
     const file = $("open").files[0]; if (!file) return;
