@@ -72,9 +72,11 @@ def test_state_pairing_edit_changes_the_order(client):
 def test_save_and_load_edits(client, drawing):
     edits = {"format": "onestroke-edits", "version": 1, "threshold": 0.45, "blur": 1.0, "multi": False,
              "tolerance": 8, "edits": [{"kind": "reverse", "at": [200, 100]}]}
+    assert client.get("/api/edits").json()["exists"] is False  # the page then loads nothing
     saved = client.post("/api/edits", json={"edits": edits}).json()
     assert saved["saved"].endswith("saved.edits.json")
-    assert client.get("/api/edits").json()["edits"]["edits"] == edits["edits"]
+    loaded = client.get("/api/edits").json()
+    assert loaded["exists"] is True and loaded["edits"]["edits"] == edits["edits"]
     assert drawing.with_name("saved.edits.json").read_text().startswith("{")
 
 

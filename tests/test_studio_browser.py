@@ -306,6 +306,12 @@ def test_edits_file_save_load_and_open(page, studio, tmp_path):
     edits = page.evaluate(f"{STATE}.edits")
     assert edits["edits"], "the earlier tests left edits to save"
 
+    # Load before anything was saved: says so and keeps the edits (it used to apply "none").
+    steps = page.evaluate("window.studio.history.length")
+    page.click("#load")
+    page.wait_for_function("document.getElementById('hint').textContent.includes('no edits saved yet')")
+    page.wait_for_timeout(200)
+    assert page.evaluate(f"{STATE}.edits") == edits and page.evaluate("window.studio.history.length") == steps
     # Save writes the edits file named on the command line; the CLI replays it to the
     # page's SVG, byte for byte.
     page.click("#save")

@@ -303,13 +303,15 @@ def _kept_ink(ink: np.ndarray, longest: int) -> tuple[np.ndarray, float, bool]:
         ink &= ~np.isin(labels, frame)
         labels[~ink] = 0
     width = estimate_stroke_width(ink)
-    areas = np.bincount(labels.ravel(), minlength=count + 1)[1:]
+    # Areas counted over the ink pixels only (paper is label 0, which is not a piece).
+    areas = np.bincount(labels[ink], minlength=count + 1)[1:]
     speck = max(4.0, width * width)
     keep = areas >= speck
     if not keep.any():
         raise InputError("no ink found: only specks smaller than a stroke")
-    # A lookup by label (0: paper) is the same as np.isin and needs no sorting.
-    ink = np.concatenate([[False], keep])[labels]
+    # A lookup by label (0: paper) is the same as np.isin and needs no sorting; with every
+    # piece kept it is the ink itself.
+    ink = ink.copy() if keep.all() else np.concatenate([[False], keep])[labels]
     # Holes are the 4-connected pieces of paper that do not reach the image edge (what
     # `binary_fill_holes` fills), found with one labelling instead of its dilation loop. A
     # piece reaching the crop's edge reaches the paper around the crop, and so the image's.
@@ -317,9 +319,12 @@ def _kept_ink(ink: np.ndarray, longest: int) -> tuple[np.ndarray, float, bool]:
     hole = np.ones(count + 1, dtype=bool)
     hole[0] = False  # ink
     hole[np.concatenate([paper[0], paper[-1], paper[:, 0], paper[:, -1]])] = False
+    if not hole.any():
+        return ink, width, framed  # all paper reaches the edge: nothing to fill
     small = np.bincount(paper.ravel()) < max(2.0, 0.5 * width * width)
     small &= hole
-    ink |= small[paper]
+    if small.any():
+        ink |= small[paper]
     return ink, width, framed
 
 

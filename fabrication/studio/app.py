@@ -186,7 +186,8 @@ def create_app(session: StudioSession, *, token: str, hosts: set[str]) -> Guard:
         return JSONResponse({"saved": str(session.edits_path), "edits": edits.to_dict()})
 
     async def load_edits(request: Request):
-        return JSONResponse({"path": str(session.edits_path), "edits": session.saved_edits().to_dict()})
+        return JSONResponse({"path": str(session.edits_path), "exists": session.edits_path.is_file(),
+                             "edits": session.saved_edits().to_dict()})
 
     async def send(request: Request):
         from fabrication.studio.sender import LaserSender

@@ -609,7 +609,13 @@ function setup() {
     catch (error) { report(error); }
   };
   $("load").onclick = async () => {
-    try { const r = await call("api/edits"); apply(r.edits); } catch (error) { report(error); }
+    try {
+      const r = await call("api/edits");
+      // No file yet: nothing to load (applying "no edits" would throw the user's away).
+      if (!r.exists) hint(`no edits saved yet: ${r.path} does not exist (Save edits writes it)`);
+      else if (JSON.stringify(r.edits) === JSON.stringify(currentEdits())) hint(`the edits are those of ${r.path} already`);
+      else { hint(""); apply(r.edits); }
+    } catch (error) { report(error); }
   };
   $("open").onchange = async () => {
     const file = $("open").files[0]; if (!file) return;

@@ -43,7 +43,7 @@ export function arrows(g, t) {
 }
 
 // Stretches the line draws twice (a stem down and back up, a path route inspection repeats):
-// a wide amber band under the curve, "×2" at its middle.
+// a wide amber band under the curve, "×2" beside its middle.
 export function retraces(g) {
   const s = studio.state;
   g.save();
@@ -55,9 +55,9 @@ export function retraces(g) {
     r.points.forEach((p, i) => { const [x, y] = toScreen(...p); if (i) g.lineTo(x, y); else g.moveTo(x, y); });
     g.stroke();
   }
-  g.fillStyle = "#6d4c00"; g.font = "bold 11px sans-serif"; g.textAlign = "center"; g.textBaseline = "middle";
-  for (const r of s.graph.retraces || []) { const [x, y] = toScreen(...r.at); g.fillText("×2", x + 12, y - 12); }
   g.restore();
+  // "×2" beside the band's middle, placed like the markers' texts: clear of them and of each other.
+  for (const r of s.graph.retraces || []) { const [x, y] = toScreen(...r.at); label(g, "×2", x, y, 7); }
 }
 
 // Pen gaps the vectorizer bridged: the two ends joined, dashed, under the curve; gaps the
@@ -136,7 +136,12 @@ export function placeLabels(g, more = []) {
     if (placed.some((q) => q.text === text && Math.hypot(q.x - x, q.y - y) < 12)) continue;
     placed.push({ text, x, y });
     const w = g.measureText(text).width;
-    const spots = [[x + gap, y], [x - gap - w, y], [x - w / 2, y + gap + h / 2], [x - w / 2, y - gap - h / 2]];
+    // Right, left, below, above; then the corners; then the same farther out (a crowd of
+    // markers: the halves of a split crossing with a "×2" between them).
+    const around = (d) => [[x + d, y], [x - d - w, y], [x - w / 2, y + d + h / 2], [x - w / 2, y - d - h / 2],
+      [x + d * 0.7, y - d * 0.7 - h / 2], [x + d * 0.7, y + d * 0.7 + h / 2],
+      [x - d * 0.7 - w, y - d * 0.7 - h / 2], [x - d * 0.7 - w, y + d * 0.7 + h / 2]];
+    const spots = around(gap).concat(around(gap + 14), around(gap + 28));
     const covers = (sx, sy, b) => sx < b[0] + b[2] && b[0] < sx + w && sy - h / 2 < b[1] + b[3] && b[1] < sy + h / 2;
     const inside = (sx, sy) => sx >= 2 && sx + w <= c.clientWidth - 2 && sy - h / 2 >= 0 && sy + h / 2 <= c.clientHeight;
     const [lx, ly] = spots.find(([sx, sy]) => inside(sx, sy) && !boxes.some((b) => covers(sx, sy, b))) ||
