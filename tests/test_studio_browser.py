@@ -280,6 +280,13 @@ def test_zoom_pan_and_reverse_one_stroke(page):
     assert page.evaluate(f"{STATE}.edits.edits.length") == count and page.evaluate("window.studio.at") == \
         page.evaluate("window.studio.history.length") - 1
     page.screenshot(path=str(ARTIFACTS / "studio-8-zoomed.png"))
+    # A resized window keeps the zoom the user chose (it used to fit the drawing again).
+    scale = page.evaluate("window.studio.view.scale")
+    page.set_viewport_size({"width": 1180, "height": 720})
+    page.wait_for_timeout(100)
+    assert page.evaluate("window.studio.view.scale") == scale
+    page.set_viewport_size({"width": 1280, "height": 760})
+    page.wait_for_timeout(100)
     # Clicks still find what is under the pointer in the zoomed, panned view.
     click_at(page, junction["at"])
     settle(page, count + 1 if not junction["fixed"] else count)

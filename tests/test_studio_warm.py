@@ -72,3 +72,17 @@ def test_a_request_stops_background_work_between_stages(drawing):
     assert errors and len(checks) == 2  # stopped at the first stage boundary after the request
     assert answer["state"]["settings"]["threshold"] == 0.47
     assert not any(key[0] == 0.41 for key in session.cache.front)
+
+
+def test_stopping_the_studio_stops_and_waits_for_background_work(drawing):
+    """On Ctrl-C the command stops the background work and waits for it: a process that
+    exits while a thread is inside native code aborts ("terminate called without an active
+    exception", exit -6: it happened to `onestroke studio` about one run in four)."""
+    session = StudioSession(drawing, edits_path=Path(os.devnull), classifier="geometric", precompute=True)
+    session.state(Edits(threshold=0.45))  # starts the neighbours in the background
+    warmer = session._warmer
+    assert warmer is not None
+    assert session.stop_background(60) and not warmer.is_alive()
+    fronts = len(session.cache.front)
+    session.state(Edits(threshold=0.46))  # no background work is started any more
+    assert session.idle(0) and session._warmer is warmer and len(session.cache.front) <= fronts + 1

@@ -61,6 +61,7 @@ def studio(source: str, port: int, no_browser: bool, edits_path: str | None, pro
             session.sender.abort()
             session.sender.wait(10.0)
         server.stop()
+        session.stop_background()
 
 
 def _graphical() -> bool:

@@ -170,6 +170,15 @@ class StudioSession:
             warmer.join(timeout)
         return warmer is None or not warmer.is_alive()
 
+    def stop_background(self, timeout: float = 10.0) -> bool:
+        """Stop background work (it ends at its next stage boundary) and wait for it: the
+        process must not exit while a thread is inside the vectorizer's native code
+        (onnxruntime, qhull), which aborts it ("terminate called without an active
+        exception"). True if none is left."""
+        self.precompute = False
+        self._generation += 1
+        return self.idle(timeout)
+
     def ticket(self, page: str):
         """A state request of page `page`: a callable saying whether the page has asked for
         another state since. A slider dragged over several values while a re-run takes a

@@ -528,7 +528,15 @@ function setupView() {
     studio.view.x = sx - ix * studio.view.scale; studio.view.y = sy - iy * studio.view.scale;
     draw();
   }, { passive: false });
-  window.addEventListener("resize", () => { fit(); draw(); });
+  // A resized window fits the drawing again, unless the user zoomed or panned: then the
+  // point at the middle of the view stays there.
+  let size = [$("canvas").clientWidth, $("canvas").clientHeight];
+  window.addEventListener("resize", () => {
+    const now = [$("canvas").clientWidth, $("canvas").clientHeight];
+    if (!studio.moved) fit();
+    else { studio.view.x += (now[0] - size[0]) / 2; studio.view.y += (now[1] - size[1]) / 2; }
+    size = now; draw();
+  });
 }
 
 // ---------------------------------------------------------------- play
