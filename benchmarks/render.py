@@ -8,8 +8,8 @@ polygon rasterizer, does not depend on how finely the curve was cut into segment
 ground truth and an output that follows the same curve render to the same pixels.
 
 `render_profile` draws one stroke whose width changes along it (a brush, a broad nib,
-foreshortening in a photo): coverage is the largest clip(w(s)/2 - d + 1/2) over the centre
-line, computed band by band of nearly equal width.
+foreshortening in a photo): coverage is the largest clip(w(s)/2 - d + 1/2) over discs
+centred along the centre line.
 """
 
 from __future__ import annotations
@@ -57,7 +57,8 @@ def render(drawing: Drawing, *, stroke_width: float | None = None, size: tuple[i
     return image
 
 
-WIDTH_BAND = 0.1  # px of width per band in `render_profile` (coverage error <= 0.05)
+PROFILE_SPACING = 0.5  # px between the discs `render_profile` unites (edge scallops < 0.02 px deep)
+SPLAT_CHUNK = 4_000_000  # (disc, pixel) pairs evaluated at a time
 
 
 def profile_widths(profile: tuple[np.ndarray, np.ndarray], fractions: np.ndarray) -> np.ndarray:
@@ -69,32 +70,30 @@ def profile_widths(profile: tuple[np.ndarray, np.ndarray], fractions: np.ndarray
 
 def render_profile(drawing: Drawing, profile: tuple[np.ndarray, np.ndarray]) -> np.ndarray:
     """Render a one-stroke `drawing` (px) whose ink width follows `profile` (see
-    `profile_widths`) along its arc length: (H, W) float64 in [0, 1], 1 = paper."""
+    `profile_widths`) along its arc length: (H, W) float64 in [0, 1], 1 = paper.
+
+    The ink is the union of discs of the local radius r centred every PROFILE_SPACING px on the
+    centre line; a pixel's coverage is the largest clip(r - d + 1/2, 0, 1) over the discs (d:
+    its centre's distance to the disc's), the constant-width `render` with r varying."""
     width, height = int(round(drawing.width)), int(round(drawing.height))
-    stroke = drawing.strokes[0]
-    samples = stroke.sample_evenly(SAMPLE_SPACING)
+    samples = drawing.strokes[0].sample_evenly(PROFILE_SPACING)
     radii = profile_widths(profile, np.linspace(0.0, 1.0, len(samples))) / 2
-    coverage = np.zeros((height, width))
-    band = np.floor(radii / WIDTH_BAND).astype(int)
-    for b in np.unique(band):
-        pts = samples[band == b]
-        r = (b + 0.5) * WIDTH_BAND
-        reach = r + 1.5
-        cols, rows = np.floor(pts[:, 0]).astype(int), np.floor(pts[:, 1]).astype(int)
-        lo = np.maximum(np.floor(pts.min(axis=0) - reach - 1).astype(int), 0)
-        hi = np.minimum(np.ceil(pts.max(axis=0) + reach + 2).astype(int), (width, height))
-        if np.any(hi <= lo):
-            continue
-        seed = np.zeros((hi[1] - lo[1], hi[0] - lo[0]), dtype=bool)
-        inside = (cols >= lo[0]) & (cols < hi[0]) & (rows >= lo[1]) & (rows < hi[1])
-        seed[rows[inside] - lo[1], cols[inside] - lo[0]] = True
-        near = ndimage.distance_transform_edt(~seed) <= reach
-        rr, cc = np.nonzero(near)
-        d, _ = cKDTree(pts).query(np.c_[cc + lo[0] + 0.5, rr + lo[1] + 0.5], distance_upper_bound=reach + 1.0)
+    reach = int(np.ceil(radii.max() + 1.5))
+    oy, ox = (a.ravel() for a in np.mgrid[-reach:reach + 1, -reach:reach + 1])
+    coverage = np.zeros(height * width)
+    step = max(1, SPLAT_CHUNK // len(ox))
+    for lo in range(0, len(samples), step):
+        p, r = samples[lo:lo + step], radii[lo:lo + step, None]
+        cols = np.floor(p[:, :1]).astype(int) + ox
+        rows = np.floor(p[:, 1:]).astype(int) + oy
+        d = np.hypot(cols + 0.5 - p[:, :1], rows + 0.5 - p[:, 1:])
         cov = np.clip(r - d + 0.5, 0.0, 1.0)
-        view = coverage[lo[1]:hi[1], lo[0]:hi[0]]
-        view[rr, cc] = np.maximum(view[rr, cc], cov)
-    return 1.0 - coverage
+        ok = (cov > 0.0) & (cols >= 0) & (cols < width) & (rows >= 0) & (rows < height)
+        index = rows * width + cols
+        edge = ok & (cov < 1.0)
+        np.maximum.at(coverage, index[edge], cov[edge])
+        coverage[index[ok & (cov >= 1.0)]] = 1.0  # full cover: nothing exceeds it
+    return 1.0 - coverage.reshape(height, width)
 
 
 def render_truth(gt) -> np.ndarray:
