@@ -9,6 +9,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.interpolate import splev, splprep
 
+from vectorize.graph import arc_lengths
 from vectorize.ink_guard import MARGIN, STEP, InkGuard, curve_excess, keep_in_ink
 from vectorize.retraces import Twin, mirror_flags, mirror_keep, rolled, share_pieces, twin_piece, valid_twins
 from vectorize.stroke import Stroke
@@ -135,7 +136,7 @@ def sharp_corners(xy: np.ndarray, stroke_width: float, *, closed: bool) -> np.nd
     within half a width (a tight smooth bend spreads its turn out; a corner does not)."""
     if len(xy) < 5:
         return np.zeros(0, dtype=int)
-    arc = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(xy, axis=0), axis=1))])
+    arc = arc_lengths(xy)
     wide = _turn(xy, arc, 1.5 * stroke_width, closed)
     narrow = _turn(xy, arc, 0.5 * stroke_width, closed)
     candidate = (wide > np.radians(40.0)) & (narrow > 0.6 * wide)
@@ -286,7 +287,7 @@ def fit_stroke(traced: TracedPoints, *, closed: bool, sigma: float, stroke_width
         twins = valid_twins(xy, twins)
     # Around a corner the axis is off the centre line for about a stroke width: leave it out.
     # (The corner joints below read the tip along this arc too.)
-    arc = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(xy, axis=0), axis=1))])
+    arc = arc_lengths(xy)
     at = arc[np.flatnonzero(corner)]  # ascending, as the arc is
     if at.size:
         # the distance along the line to the nearest corner, either side (one pass, not one

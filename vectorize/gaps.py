@@ -195,7 +195,7 @@ def _faces(graph: MedialGraph, bid: int, index: int, toward: np.ndarray, stroke_
             return False  # a free end: bridged end to end, or not at all
         legs = np.array([slot_direction(graph, slot, reach) for slot in slots(graph, node)])
     else:
-        arc = np.concatenate([[0.0], np.cumsum(branch.edge_lengths)])
+        arc = branch.arc
         point = branch.points[index]
         legs = []
         for target in (arc[index] - reach, arc[index] + reach):

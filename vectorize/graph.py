@@ -80,6 +80,11 @@ def edge_lengths(points: np.ndarray) -> np.ndarray:
     return np.sqrt(d[:, 0] * d[:, 0] + d[:, 1] * d[:, 1])
 
 
+def arc_lengths(points: np.ndarray) -> np.ndarray:
+    """(M, 2) points -> (M,) arc length at each point along the polyline, 0 at the first."""
+    return np.concatenate([[0.0], np.cumsum(edge_lengths(points))])
+
+
 # `measure_short` measures branches of up to this many points together.
 SHORT = 8
 

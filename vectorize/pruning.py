@@ -91,7 +91,7 @@ def trim_free_ends(graph: MedialGraph, *, stroke_width: float) -> None:
         if branch.a == branch.b:
             continue
         out = branch.oriented_from(node)
-        arc = np.concatenate([[0.0], np.cumsum(out.edge_lengths)])
+        arc = out.arc
         # The radius one stroke width in: past the cap, before any widening further on
         # (a spike's two sides merge into wider ink towards its junction).
         band = out.radii[(arc >= 0.6 * stroke_width) & (arc <= 1.4 * stroke_width)]

@@ -57,7 +57,7 @@ def foot_is_retraced(graph: MedialGraph, node: int, foot: int, stroke_width: flo
     half = 0.5 * float(np.arccos(np.clip(np.dot(dirs[a], dirs[b]), -1.0, 1.0)))
     merged = stroke_width / (2.0 * max(np.sin(half), 1e-3))
     branch = graph.branches[slots(graph, node)[foot][0]].oriented_from(node)
-    arc = np.concatenate([[0.0], np.cumsum(branch.edge_lengths)])
+    arc = branch.arc
     if arc[-1] <= 2.0 * merged:
         return False
     inner = (arc > stroke_width) & (arc < arc[-1] - stroke_width)

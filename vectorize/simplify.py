@@ -110,7 +110,7 @@ def _min_radius(branch: Branch) -> float:
 def _merge(graph: MedialGraph, a: int, b: int, bid: int) -> int:
     """Replace nodes a, b and their joining branch by one node at the branch's middle."""
     join = graph.remove_branch(bid).oriented_from(a)
-    arc = np.concatenate([[0.0], np.cumsum(join.edge_lengths)])
+    arc = join.arc
     mid = int(np.searchsorted(arc, arc[-1] / 2.0))
     mid = min(max(mid, 0), len(arc) - 1)
     node = graph.add_node(join.points[mid], float(join.radii.max()))

@@ -8,6 +8,7 @@ from functools import cached_property
 import numpy as np
 
 from onestroke.errors import InputError
+from vectorize.graph import arc_lengths
 
 # Samples per Bézier segment of the arc-length table; the chord error this leaves in the
 # length is below 1e-5 of the segment length for the gentle segments spline fitting makes.
@@ -122,7 +123,7 @@ class Stroke:
         t = np.concatenate(
             [(k + local[:-1]) / self.segment_count for k in range(self.segment_count)] + [[1.0]]
         )
-        s = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(pts, axis=0), axis=1))])
+        s = arc_lengths(pts)
         return t, s
 
     @property

@@ -13,6 +13,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from onestroke.errors import InputError
+from vectorize.graph import arc_lengths
 
 # Positions of the lock's needle points, as fractions of the lock length back from the
 # end of the path. Consecutive entries differ, so no lock stitch has zero length.
@@ -39,7 +40,7 @@ class LockOptions:
 def walk_back(path: np.ndarray, distances: np.ndarray) -> np.ndarray:
     """Points at arc `distances` (m,) mm back from the last point of polyline `path` (N, 2)."""
     rev = path[::-1]
-    cum = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(rev, axis=0), axis=1))])
+    cum = arc_lengths(rev)
     d = np.clip(distances, 0.0, cum[-1])
     return np.column_stack([np.interp(d, cum, rev[:, 0]), np.interp(d, cum, rev[:, 1])])
 
@@ -65,7 +66,7 @@ def _clear_length(path: np.ndarray, length: float, form: np.ndarray) -> float:
     """The tack length in [length / 2, length] whose holes (at `form` x length along
     `path`) lie furthest from the path's own holes, preferring the longest that keeps
     TACK_CLEARANCE."""
-    cum = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(path, axis=0), axis=1))])[1:]
+    cum = arc_lengths(path)[1:]
     if not len(cum):
         return length
     marks = np.unique(form[form > 0])

@@ -22,6 +22,7 @@ from fabrication.embroidery.stats import EmbroideryStats
 from machines.hoops import Hoop
 from onestroke.errors import InputError
 from vectorize.drawing import Drawing
+from vectorize.graph import arc_lengths
 
 THREAD_WIDTH = 0.35  # mm: a 40 wt embroidery thread
 # Thread is drawn slightly see-through so that layers sewn over each other (triple stitch,
@@ -181,7 +182,7 @@ def render_drawing_preview(drawing: Drawing, path: str | os.PathLike,
     a_parts, b_parts, u_parts = [], [], []
     for index, stroke in enumerate(drawing.strokes):
         poly = stroke.flatten(tolerance)
-        s = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(poly, axis=0), axis=1))])
+        s = arc_lengths(poly)
         a_parts.append(poly[:-1])
         b_parts.append(poly[1:])
         u_parts.append(index + s[1:] / max(s[-1], 1e-12))

@@ -11,6 +11,7 @@ from functools import cached_property
 
 import numpy as np
 
+from vectorize.graph import arc_lengths
 from vectorize.stroke import Stroke
 
 
@@ -75,7 +76,7 @@ def dense_curve(stroke: Stroke, tolerance: float = 0.005) -> DenseCurve:
     if keep.sum() < 2:
         keep[-1] = True
     points, t = points[keep], t[keep]
-    s = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(points, axis=0), axis=1))])
+    s = arc_lengths(points)
     if s[-1] <= 0:
         s[-1] = 1e-9
     return DenseCurve(points, t, s)
