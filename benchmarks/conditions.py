@@ -33,9 +33,11 @@ from benchmarks.render import render, to_uint8
 CONDITIONS = ("clean", "noisy", "scan", "pencil", "specks", "varwidth", "half", "gaps", "jpeg", "breaks", "photo")
 
 
-def _jpeg(image: np.ndarray, quality: int) -> np.ndarray:
+def through_jpeg(image: np.ndarray, quality: int, subsampling: int = -1) -> np.ndarray:
+    """`image` (uint8, gray or RGB) through a JPEG file at `quality` (Pillow's chroma
+    subsampling unless given: 2 is 4:2:0, a phone's)."""
     buffer = io.BytesIO()
-    Image.fromarray(image).save(buffer, "JPEG", quality=quality)
+    Image.fromarray(image).save(buffer, "JPEG", quality=quality, subsampling=subsampling)
     return np.asarray(Image.open(buffer))
 
 
@@ -53,7 +55,7 @@ def condition_image(drawing, gray: np.ndarray, condition: str,
         paper = 0.83 + 0.15 * np.cos(2.5 * xx + 1.3 * yy)
         page = 0.18 + (paper - 0.18) * ndimage.gaussian_filter(gray, 0.8)
         page = page + rng.normal(0.0, 0.03, gray.shape)
-        return _jpeg(to_uint8(np.clip(page, 0, 1)), 70), 1.0
+        return through_jpeg(to_uint8(np.clip(page, 0, 1)), 70), 1.0
     if condition == "pencil":
         cover = (1.0 - gray) * (0.55 + 0.45 * rng.uniform(0.0, 1.0, gray.shape))
         return to_uint8(1.0 - 0.6 * cover), 1.0
@@ -75,7 +77,7 @@ def condition_image(drawing, gray: np.ndarray, condition: str,
         small = Image.fromarray(to_uint8(gray)).resize((w // 2, h // 2), Image.LANCZOS)
         return np.asarray(small), w / (w // 2)
     if condition == "jpeg":
-        return _jpeg(to_uint8(gray), int(rng.integers(25, 51))), 1.0
+        return through_jpeg(to_uint8(gray), int(rng.integers(25, 51))), 1.0
     if condition == "gaps":
         page = gray.copy()
         line = np.concatenate([s.sample_evenly(0.5) for s in drawing.strokes])

@@ -33,6 +33,7 @@ from scipy.sparse.csgraph import dijkstra
 from scipy.spatial import cKDTree
 
 from vectorize.drawing import Drawing
+from vectorize.graph import arc_lengths
 
 EXCURSION_SLACK = 1.0  # px added to half the width: the acceptance bound of the excursion
 CENTRE_SPACING = 0.25  # px between ground-truth centre-line samples (distance error < 0.01 px)
@@ -183,10 +184,6 @@ MIN_REACH = 3.0  # widths from the tip a near retrace reaches at least (a sharp 
 MAX_PARTING = 0.5  # px the two passes of one band may part per px along it (2 sin 15 degrees)
 
 
-def _arc(poly: np.ndarray) -> np.ndarray:
-    return np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(poly, axis=0), axis=1))]
-
-
 def _at(poly: np.ndarray, s: np.ndarray, q: np.ndarray) -> np.ndarray:
     return np.c_[np.interp(q, s, poly[:, 0]), np.interp(q, s, poly[:, 1])]
 
@@ -204,7 +201,7 @@ def near_retraces(polyline: np.ndarray, width: float) -> list[tuple[float, float
     non-overlapping.
     """
     poly = np.asarray(polyline, dtype=float)
-    s = _arc(poly)
+    s = arc_lengths(poly)
     w = float(width)
     step = w / 4.0
     q = np.arange(w, s[-1] - w, step)
@@ -243,7 +240,7 @@ def snap_near_retraces(polyline: np.ndarray, width: float) -> np.ndarray:
     the way out, then steps (less than a width) across to where the real way back leaves the
     merged band. Retraces already exact are left as they are."""
     poly = np.asarray(polyline, dtype=float)
-    s = _arc(poly)
+    s = arc_lengths(poly)
     pieces, cursor = [poly[:1]], 0.0
     for t, u, sep in near_retraces(poly, width):
         if sep <= EXACT_PX:
@@ -273,13 +270,13 @@ def fair_meta(polyline: np.ndarray, *, ambiguous: bool = False, scale: float = 1
     """
     poly = np.asarray(polyline, dtype=float)
     graph = ink_graph(poly)
-    retraced = float(_arc(poly)[-1] - graph.lengths.sum())
+    retraced = float(arc_lengths(poly)[-1] - graph.lengths.sum())
     why = "ambiguous" if ambiguous else ("retrace" if retraced > RETRACE_SLACK else "")
     if near_width is not None and why != "ambiguous":
         snapped = snap_near_retraces(poly, near_width)
         if snapped is not poly:
             near_graph = ink_graph(snapped)
-            near = float(_arc(snapped)[-1] - near_graph.lengths.sum())
+            near = float(arc_lengths(snapped)[-1] - near_graph.lengths.sum())
             if near > retraced + RETRACE_SLACK:
                 graph, retraced, why = near_graph, near, "near-retrace"
     meta: dict = {"retraced_length": retraced, "fair": False, "fair_why": ""}

@@ -22,20 +22,20 @@ the phone stores (`conditions.py` calls it for the condition "photo"):
 
 from __future__ import annotations
 
-import io
 from dataclasses import replace
 
 import numpy as np
 import shapely
-from PIL import Image
 from scipy import ndimage
 
+from benchmarks.conditions import through_jpeg  # it imports this module only where used
 from benchmarks.ground_truth import CANVAS, MARGIN, GroundTruth
+from benchmarks.metrics import FLATTEN_TOLERANCE
 from vectorize.drawing import Drawing
+from vectorize.graph import arc_lengths
 from vectorize.stroke import Stroke
 
 TILT = 0.04  # largest corner move, share of the canvas side
-FLATTEN = 0.05  # px
 
 
 def random_homography(rng: np.random.Generator) -> np.ndarray:
@@ -78,20 +78,18 @@ def _fit_inside(h: np.ndarray, pts: np.ndarray, width: float) -> np.ndarray:
 
 def photographed(gt: GroundTruth, rng: np.random.Generator) -> GroundTruth:
     """`gt` as the photo's frame sees it (module doc); kind "photo", meta condition "photo"."""
-    poly = gt.stroke.flatten(FLATTEN)
+    poly = gt.stroke.flatten(FLATTEN_TOLERANCE)
     h = _fit_inside(random_homography(rng), poly, gt.width)
     mapped = apply_homography(h, poly)
     if gt.closed:
         mapped[-1] = mapped[0]
     stroke = Stroke.from_polyline(mapped)
-    seg = np.linalg.norm(np.diff(mapped, axis=0), axis=1)
-    s = np.r_[0.0, np.cumsum(seg)]
+    s = arc_lengths(mapped)
     profile = (s / s[-1], gt.width * local_scale(h, poly))
     if "width_profile" in gt.meta:  # a brush's width, foreshortened too
         from benchmarks.render import profile_widths
 
-        base = profile_widths(gt.meta["width_profile"], np.r_[0.0, np.cumsum(np.linalg.norm(
-            np.diff(poly, axis=0), axis=1))] / gt.stroke.length)
+        base = profile_widths(gt.meta["width_profile"], arc_lengths(poly) / gt.stroke.length)
         profile = (profile[0], base * profile[1] / gt.width)
 
     def move(g):
@@ -139,6 +137,4 @@ def photo_image(gray: np.ndarray, rng: np.random.Generator) -> np.ndarray:
     if rng.uniform() < 0.3:  # blue-black ink: the ink's own colour where it covers the paper
         rgb = rgb * (1.0 - 0.5 * (1.0 - gray[..., None]) * np.array([0.5, 0.35, 0.0]))
     rgb8 = np.clip(np.round(rgb * 255.0), 0, 255).astype(np.uint8)
-    buffer = io.BytesIO()
-    Image.fromarray(rgb8).save(buffer, "JPEG", quality=int(rng.integers(70, 91)), subsampling=2)
-    return np.asarray(Image.open(buffer).convert("RGB"))
+    return through_jpeg(rgb8, int(rng.integers(70, 91)), subsampling=2)
