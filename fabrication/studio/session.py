@@ -72,7 +72,6 @@ class StudioSession:
         if not self.drawing_path.is_file():
             raise InputError(f"input file {str(drawing)!r} does not exist")
         self.edits_path = Path(edits_path) if edits_path else self.drawing_path.with_suffix(".edits.json")
-        self.profile = str(profile) if profile else None
         # The laser panel's choices: id -> (label, profile path or loaded LaserProfile). The
         # built-in ones and the command line's are read from their path at each use (as the
         # CLI does); those loaded from the page are kept parsed, never as a path.
@@ -81,9 +80,9 @@ class StudioSession:
 
         for path in bundled_laser_profiles():
             self.profiles[f"built-in:{path.stem}"] = (f"built-in: {load_laser_profile(path).name}", path)
-        if self.profile:
-            self.profiles["command-line"] = (f"command line: {Path(self.profile).name}", Path(self.profile))
-        self.default_profile = "command-line" if self.profile else next(iter(self.profiles))
+        if profile:
+            self.profiles["command-line"] = (f"command line: {Path(profile).name}", Path(profile))
+        self.default_profile = "command-line" if profile else next(iter(self.profiles))
         self.options = VectorizeOptions(classifier=classifier)
         self.cache = StageCache()
         self.lock = threading.Lock()  # one vectorization at a time: the cache is not shared-safe
@@ -283,7 +282,8 @@ class StudioSession:
 
         if not isinstance(text, str) or not isinstance(file_name, str):
             raise InputError("a profile upload needs the file's name and text")
-        size = len(text.encode("utf-8", "replace"))
+        data = text.encode("utf-8", "replace")
+        size = len(data)
         if size > MAX_PROFILE_BYTES:
             raise InputError(f"profile file of {size} bytes is too large (at most {MAX_PROFILE_BYTES // 1024} kB)")
         name = " ".join(Path(file_name.replace("\\", "/")).name.split())[:80] or "profile.toml"
@@ -291,7 +291,7 @@ class StudioSession:
             profile = laser_profile_from_text(text, source=f"laser profile {name!r}")
         except InputError as error:
             raise InputError(" ".join(str(error).split())) from None  # one line for the panel
-        key = "loaded:" + hashlib.sha256(text.encode("utf-8", "replace")).hexdigest()[:12]
+        key = "loaded:" + hashlib.sha256(data).hexdigest()[:12]
         if key not in self.profiles and sum(k.startswith("loaded:") for k in self.profiles) >= MAX_LOADED_PROFILES:
             raise InputError(f"at most {MAX_LOADED_PROFILES} profiles can be loaded in one session")
         self.profiles[key] = (f"{name}: {profile.name}", profile)

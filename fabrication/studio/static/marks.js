@@ -106,7 +106,7 @@ export function drawPasses(g, x, y, r, passes, stub = 0) {
 
 // A triple point: its three passes drawn through the marker and along each branch, so the
 // pairing is seen, not read; a square when you chose it.
-export function tripleMarker(g, j) {
+function tripleMarker(g, j) {
   const [x, y] = toScreen(...j.at), r = 20;
   g.lineWidth = 3; g.strokeStyle = COLORS.passes; g.fillStyle = "rgba(255,255,255,0.92)";
   g.beginPath();
@@ -119,7 +119,7 @@ export function tripleMarker(g, j) {
 
 // A marker's text, beside the marker at (x, y) of radius `gap`; drawn by `placeLabels`
 // once every marker is drawn.
-export function label(g, text, x, y, gap) { studio.labels.push({ text, x, y, gap }); }
+function label(g, text, x, y, gap) { studio.labels.push({ text, x, y, gap }); }
 
 // Each text on a white box so that it reads over the curve, right of its marker, else
 // left, below or above, wherever it stays on the canvas and covers no marker (nor `more`
@@ -161,7 +161,7 @@ const MARKER_R = { triple: 22, crossing: 10, unresolved: 9 };
 // markers would cover each other (the two halves of a split crossing a pixel apart, a Y
 // beside a crossing): such a group is fanned out around its middle, each marker tied to
 // its junction by a thin line, so that each one reads and takes its own click.
-export function markerPlaces() {
+function markerPlaces() {
   const ms = studio.state.graph.junctions.map((j) => {
     const at = toScreen(...j.at);
     return { j, at, x: at[0], y: at[1], r: MARKER_R[j.role] || 6 };
