@@ -204,30 +204,53 @@ def ink_depth(ink: np.ndarray, rows: np.ndarray | None = None, cols: np.ndarray 
     paper: (H, W) float64, equal to `ndimage.distance_transform_edt(ink)`; rows, cols: the
     ink pixels (as `np.nonzero(ink)` gives them), when the caller has them.
 
-    The nearest paper pixel of an ink pixel has an ink pixel beside it (a paper pixel with
-    paper on all four sides has a neighbour nearer that ink pixel), so a k-d tree of those
-    edge pixels, asked only at the ink, gives the transform; a line drawing's box is mostly
-    paper, which the transform's full pass over the box spends most of its time on.
+    An ink pixel with paper beside it is 1 px from the paper, one with paper only on a
+    diagonal sqrt(2) px (nothing is nearer than a neighbour). For the others, the nearest
+    paper pixel has an ink pixel beside it (a paper pixel with paper on all four sides has a
+    neighbour nearer that ink pixel), so a k-d tree of those edge pixels, asked only at the
+    deeper ink, gives the transform; a line drawing's box is mostly paper, which the
+    transform's full pass over the box spends most of its time on, and a thin line's ink is
+    mostly within a diagonal of the paper.
     """
     if rows is None or cols is None:
         rows, cols = _pixels(ink)
-    edge = np.zeros_like(ink)
-    edge[1:] |= ink[:-1]
-    edge[:-1] |= ink[1:]
-    edge[:, 1:] |= ink[:, :-1]
-    edge[:, :-1] |= ink[:, 1:]
-    edge &= ~ink
-    paper = np.column_stack(_pixels(edge))
-    if not len(paper) or not len(rows):
+    paper = ~ink
+    edge = grow(ink, 1) & paper
+    if not len(rows) or not edge.any():
         return ndimage.distance_transform_edt(ink)
-    inside = np.column_stack([rows, cols])
-    _, nearest = cKDTree(paper).query(inside)
-    # The same arithmetic as the transform: squared offsets (whole numbers) summed, rooted.
-    offset = (paper[nearest] - inside).astype(np.float64)
-    np.multiply(offset, offset, offset)
     distance = np.zeros(ink.shape)
-    distance[rows, cols] = np.sqrt(offset[:, 0] + offset[:, 1])
+    # The same arithmetic as the transform: squared offsets (whole numbers) summed, rooted.
+    beside = grow(paper, 1)[rows, cols]
+    diagonal = grow(paper, 1, square=True)[rows, cols] & ~beside
+    distance[rows[beside], cols[beside]] = np.sqrt(1.0)
+    distance[rows[diagonal], cols[diagonal]] = np.sqrt(2.0)
+    deep = ~(beside | diagonal)
+    if deep.any():
+        inside = np.column_stack([rows[deep], cols[deep]])
+        edges = np.column_stack(_pixels(edge))
+        _, nearest = cKDTree(edges).query(inside)
+        offset = (edges[nearest] - inside).astype(np.float64)
+        np.multiply(offset, offset, offset)
+        distance[inside[:, 0], inside[:, 1]] = np.sqrt(offset[:, 0] + offset[:, 1])
     return distance
+
+
+def grow(mask: np.ndarray, steps: int, *, square: bool = False) -> np.ndarray:
+    """`mask` (H, W) bool dilated `steps` times by its 4 neighbours (square: its 8
+    neighbours), nothing beyond the edges: equal to `ndimage.binary_dilation(mask,
+    iterations=steps)` (with `structure=np.ones((3, 3))` when square), at a tenth of its
+    cost on a line drawing's box (shifted ORs of whole rows instead of a pass per pixel)."""
+    for _ in range(steps):
+        out = mask.copy()
+        out[1:] |= mask[:-1]
+        out[:-1] |= mask[1:]
+        if square:
+            mask = out
+            out = mask.copy()
+        out[:, 1:] |= mask[:, :-1]
+        out[:, :-1] |= mask[:, 1:]
+        mask = out
+    return mask
 
 
 def _pixels(mask: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -343,8 +366,8 @@ def ink_image(gray: np.ndarray, scale: float, *, threshold: float | None) -> Ink
     # Only the box around the ink changes: the dilation cannot reach beyond 2 px of the ink.
     box = ink_box(ink, 2)
     kept = ink[box]
-    near = ndimage.binary_dilation(kept, iterations=2)
-    part = np.where(near, gray[box], 1.0).astype(np.float32)
+    near = grow(kept, 2)
+    part = np.where(near, gray[box], np.float32(1.0)).astype(np.float32, copy=False)
     part[(part < level) & ~kept] = 1.0
     part[kept & (part >= level)] = 0.0
     work = np.ones(gray.shape, dtype=np.float32)
