@@ -17,6 +17,7 @@ from vectorize.binarize import (
     estimate_stroke_width,
     extract_ink,
     frame_labels,
+    grow,
     ink_depth,
     ink_image,
     ink_threshold,
@@ -184,6 +185,17 @@ def test_ink_depth_on_small_masks_at_the_edges():
         assert np.array_equal(ink_depth(mask), ndimage.distance_transform_edt(mask))
         if mask.any():
             assert estimate_stroke_width(mask) == _scipy_width(mask)
+
+
+def test_grow_is_scipys_binary_dilation():
+    rng = np.random.default_rng(5)
+    masks = [np.zeros((3, 4), bool), np.ones((1, 6), bool), np.eye(7, dtype=bool)[::-1]]
+    masks += [rng.random((rng.integers(1, 30), rng.integers(1, 30))) < rng.random() * 0.3 for _ in range(100)]
+    for mask in masks:
+        for steps in (1, 2, 3):
+            assert np.array_equal(grow(mask, steps), ndimage.binary_dilation(mask, iterations=steps))
+            assert np.array_equal(grow(mask, steps, square=True),
+                                  ndimage.binary_dilation(mask, structure=np.ones((3, 3)), iterations=steps))
 
 
 def test_a_phone_photo_becomes_gray_row_block_by_row_block():
