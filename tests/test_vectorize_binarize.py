@@ -14,6 +14,8 @@ from scipy import ndimage
 from tests.conftest import figure_eight, render_polylines
 from tests.test_vectorize_inputs import shaded_scan
 from vectorize.binarize import (
+    blurred,
+    downscaled_gray,
     estimate_stroke_width,
     extract_ink,
     frame_labels,
@@ -185,6 +187,20 @@ def test_ink_depth_on_small_masks_at_the_edges():
         assert np.array_equal(ink_depth(mask), ndimage.distance_transform_edt(mask))
         if mask.any():
             assert estimate_stroke_width(mask) == _scipy_width(mask)
+
+
+@pytest.mark.parametrize("name, page", _pages(), ids=[name for name, _ in _pages()])
+def test_the_blur_of_the_box_is_skimages_blur_of_the_whole_image(name, page):
+    from skimage.filters import gaussian
+
+    gray, _ = downscaled_gray(page, max_size=1000)
+    spotted = gray.copy()
+    spotted[0, -1] = spotted[-1, 0] = 0.5  # a dark pixel in two corners: the box is the image
+    for image in (gray, spotted):
+        for blur in (0.3, 1.0, 2.5):
+            expected = gaussian(image, sigma=blur, preserve_range=True).astype(np.float32)
+            assert np.array_equal(blurred(image, blur), expected), (name, blur)
+    assert blurred(gray, 0.0) is gray
 
 
 def test_grow_is_scipys_binary_dilation():

@@ -81,7 +81,15 @@ def _to_gray(image: np.ndarray) -> np.ndarray:
 
 
 def working_gray(image: np.ndarray, *, max_size: int, blur: float) -> tuple[np.ndarray, float]:
-    """Gray image downscaled (anti-aliased) so its longest side is <= max_size; and the scale."""
+    """Gray image downscaled (anti-aliased) so its longest side is <= max_size, then blurred
+    (`blurred`); and the scale."""
+    gray, scale = downscaled_gray(image, max_size=max_size)
+    return blurred(gray, blur), scale
+
+
+def downscaled_gray(image: np.ndarray, *, max_size: int) -> tuple[np.ndarray, float]:
+    """Gray image downscaled (anti-aliased) so its longest side is <= max_size: (H, W)
+    float32 in [0, 1], and the scale (what a blur does not change)."""
     gray = to_gray(image)
     h, w = gray.shape
     if min(h, w) < MIN_SIDE:
@@ -94,11 +102,36 @@ def working_gray(image: np.ndarray, *, max_size: int, blur: float) -> tuple[np.n
 
         scale = max_size / max(h, w)
         gray = rescale(gray, scale, anti_aliasing=True, preserve_range=True).astype(np.float32)
-    if blur > 0:
-        from skimage.filters import gaussian
-
-        gray = gaussian(gray, sigma=blur, preserve_range=True).astype(np.float32)
     return gray, scale
+
+
+GAUSS_TRUNCATE = 4.0  # skimage.filters.gaussian's: the kernel reaches int(4 sigma + 0.5) px
+
+
+def blurred(gray: np.ndarray, blur: float) -> np.ndarray:
+    """`gray` (H, W) float32 blurred by a Gaussian of sigma `blur` px
+    (`skimage.filters.gaussian`, edges extended), a new array; `gray` itself when blur is 0.
+
+    Only the box around the pixels that are not pure white, grown by the kernel's reach, is
+    filtered: beyond it every window is white, which the filter leaves exactly white (its
+    weights sum to 1 within far less than a float32 step: checked on a white patch), and
+    inside it the box's white edge extended is what the whole image has there. A clean
+    drawing's paper is mostly such white; the filter over it was most of a blur's time."""
+    if blur <= 0:
+        return gray
+    from skimage.filters import gaussian
+
+    def blur_of(part: np.ndarray) -> np.ndarray:
+        return gaussian(part, sigma=blur, preserve_range=True, truncate=GAUSS_TRUNCATE).astype(np.float32)
+
+    reach = int(GAUSS_TRUNCATE * blur + 0.5) + 1
+    patch = np.ones((2 * reach + 1, 2 * reach + 1), dtype=np.float32)
+    if not np.all(blur_of(patch) == 1.0):
+        return blur_of(gray)
+    box = ink_box(gray != 1.0, reach)
+    out = np.ones_like(gray)
+    out[box] = blur_of(gray[box])
+    return out
 
 
 def flatten_paper(gray: np.ndarray) -> np.ndarray:
@@ -351,11 +384,14 @@ def _kept_ink(ink: np.ndarray, longest: int) -> tuple[np.ndarray, float, bool]:
     return ink, width, framed
 
 
-def paper_gray(image: np.ndarray, *, max_size: int, blur: float) -> tuple[np.ndarray, float]:
+def paper_gray(image: np.ndarray, *, max_size: int, blur: float,
+               downscaled: tuple[np.ndarray, float] | None = None) -> tuple[np.ndarray, float]:
     """The working gray image with the paper's shading divided out (H, W) float32, and the
-    scale: what the threshold does not change (`binarize` without the ink)."""
-    gray, scale = working_gray(image, max_size=max_size, blur=blur)
-    return flatten_paper(gray), scale
+    scale: what the threshold does not change (`binarize` without the ink). downscaled:
+    `downscaled_gray` of this image and max_size, when the caller has it (a blur does not
+    change it)."""
+    gray, scale = downscaled if downscaled is not None else downscaled_gray(image, max_size=max_size)
+    return flatten_paper(blurred(gray, blur)), scale
 
 
 def ink_image(gray: np.ndarray, scale: float, *, threshold: float | None) -> InkImage:
