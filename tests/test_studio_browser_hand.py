@@ -15,7 +15,7 @@ import pytest
 from conftest import ARTIFACTS
 from fabrication.studio.server import StudioServer
 from fabrication.studio.session import StudioSession
-from studio_fixtures import bench_drawing, cli_bytes, click_at, download, open_page, settle
+from studio_fixtures import bench_drawing, cli_bytes, click_at, download, curve_under_labels, open_page, settle
 
 pytestmark = pytest.mark.slow
 
@@ -53,6 +53,12 @@ def test_a_triple_point_cycles_through_the_pairings_that_keep_one_stroke(served,
     assert triple["confidence"] is not None and len(triple["options"]) >= 3
     assert triple["options"][0]["passes"] == [list(p) for p in triple["passes"]]  # the likeliest is drawn
     assert "three passes" in page.inner_text("#junctions")
+    # Each text beside its marker, off the curve; the triple point's, with branches all
+    # around, where it hides least: across a line, not along it (it used to lie along the
+    # line entering the triple point, hiding 100 px of it).
+    under = curve_under_labels(page)
+    passes = next(text for text in under if text.startswith("3 passes"))
+    assert under.pop(passes) < 20 and under == {"crossing 100%": 0}, (passes, under)
     page.screenshot(path=str(ARTIFACTS / "studio-hand-1-triple.png"))
 
     # A click takes the next pairing in order of likelihood; the route, and with it the
@@ -134,6 +140,10 @@ def test_a_cursive_word_shows_its_retraces_and_starts_at_a_stems_tip(served, tmp
     # The two pen gaps were bridged: marked where they are.
     assert len(graph["bridges"]) == 2 and "pen gaps bridged: 2" in page.inner_text("#junctions")
     assert sorted(round(a[0], -2) for a, _ in graph["bridges"]) == [400, 700]
+    texts = [p["text"] for p in page.evaluate("window.studio.placed")]
+    assert texts.count("×2") == len(graph["retraces"]) and texts.count("gap") == 2
+    under = curve_under_labels(page)  # "×2" beside its band, "gap" beside its circle, off the curve
+    assert under == {"×2": 0, "gap": 0, "crossing 100%": 0}, under
     page.screenshot(path=str(ARTIFACTS / "studio-hand-3-retraces-gaps.png"))
 
     # The line should start at the word's lead-in (the leftmost free end), which the route

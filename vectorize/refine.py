@@ -415,14 +415,22 @@ class Refinement:
 
     def unheeded(self, solution) -> list[str]:
         """One warning per "once" edit whose branch the line still draws twice (every other
-        way to join the ends that retrace joins is marked "once" too, or there is none)."""
+        way to join the ends that retrace joins is marked "once" too, or there is none), and
+        per "twice" edit whose branch it still draws once (route inspection goes back over a
+        branch only on a path joining two odd nodes, and no cheapest one runs there, or the
+        start chosen at that branch's tip forbids it): a click that changes nothing says why."""
         count = _pass_counts(solution)
         result = []
-        for edit in self.edits.of("once"):
+        for edit in self.edits.of("once", "twice"):
             bid = _nearest_branch(solution.graph, self.to_working(edit.at), self.tol + self.w)
-            if bid is not None and count.get(bid, 0) > 1:
-                result.append(f"the stretch at {edit.at[0]:.0f}, {edit.at[1]:.0f} is still drawn twice: "
-                              "one line over the drawing found no way around it")
+            if bid is None:
+                continue
+            where = f"the stretch at {edit.at[0]:.0f}, {edit.at[1]:.0f}"
+            if edit.kind == "once" and count.get(bid, 0) > 1:
+                result.append(f"{where} is still drawn twice: one line over the drawing found no way around it")
+            if edit.kind == "twice" and count.get(bid, 0) < 2:
+                result.append(f"{where} is still drawn once: the line goes back over a stretch only where "
+                              "that is its shortest way on to the rest of the drawing, and it is not here")
         return result
 
     def unmatched(self) -> list[str]:

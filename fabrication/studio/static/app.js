@@ -35,7 +35,7 @@ async function apply(edits, push = true) {
   } catch (error) {
     // A refused edits state (e.g. an opened file that is not an edits file) is no step.
     if (push && studio.history[studio.at] === edits) { studio.history.pop(); studio.at -= 1; updateButtons(); }
-    if (ticket === studio.requests) report(error);
+    if (ticket === studio.requests) tell(error.message, true);
   } finally {
     busy(false);
     if (rerun) rerunning(-1);
@@ -438,6 +438,16 @@ const MISSED = {
     : "no pen gap was bridged in this drawing (single-line mode bridges them; multi-stroke none)",
 };
 
+// What comes of the header's actions (undo, redo, save, load, open: at hand on every tab),
+// said in the panel in view: on Refine an error in its warnings and a note as the hint; on
+// the Embroidery or Laser tab both in that panel's list, where the user is looking.
+function tell(message, error = false) {
+  const list = studio.tab === "refine" ? "warnings" : `${studio.tab}-warnings`;
+  if (error) report(new Error(message), list);
+  else if (studio.tab === "refine") hint(message);
+  else { const li = document.createElement("li"); li.textContent = message; $(list).replaceChildren(li); }
+}
+
 function hint(text, buttons = []) {
   $("hint").textContent = text || "";
   for (const b of buttons) $("hint").append(" ", b);
@@ -627,23 +637,26 @@ function setup() {
   $("scrub").oninput = () => { studio.playing = false; $("play").textContent = "▶ Play"; studio.pen = $("scrub").value / 1000; draw(); };
   setupPanels(() => studio.shown);
   $("save").onclick = async () => {
-    try { const r = await call("api/edits", { edits: currentEdits() }); $("summary").textContent += ` · saved ${r.saved}`; }
-    catch (error) { report(error); }
+    try {
+      const r = await call("api/edits", { edits: currentEdits() });
+      if (studio.tab === "refine") $("summary").textContent += ` · saved ${r.saved}`;
+      else tell(`saved ${r.saved}`);
+    } catch (error) { tell(error.message, true); }
   };
   $("load").onclick = async () => {
     try {
       const r = await call("api/edits");
       // No file yet: nothing to load (applying "no edits" would throw the user's away).
-      if (!r.exists) hint(`no edits saved yet: ${r.path} does not exist (Save edits writes it)`);
-      else if (JSON.stringify(r.edits) === JSON.stringify(currentEdits())) hint(`the edits are those of ${r.path} already`);
+      if (!r.exists) tell(`no edits saved yet: ${r.path} does not exist (Save edits writes it)`);
+      else if (JSON.stringify(r.edits) === JSON.stringify(currentEdits())) tell(`the edits are those of ${r.path} already`);
       else { hint(""); apply(r.edits); }
-    } catch (error) { report(error); }
+    } catch (error) { tell(error.message, true); }
   };
   $("open").onchange = async () => {
     const file = $("open").files[0]; if (!file) return;
     let data;
     try { data = JSON.parse(await file.text()); }
-    catch (error) { report(new Error(`${file.name} is not an edits file (not JSON)`)); }
+    catch (error) { tell(`${file.name} is not an edits file (not JSON)`, true); }
     if (data !== undefined) apply(data);
     $("open").value = "";
   };
