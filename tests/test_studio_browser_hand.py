@@ -15,7 +15,8 @@ import pytest
 from conftest import ARTIFACTS
 from fabrication.studio.server import StudioServer
 from fabrication.studio.session import StudioSession
-from studio_fixtures import bench_drawing, cli_bytes, click_at, download, curve_under_labels, open_page, settle
+from studio_fixtures import (bench_drawing, cli_bytes, click_at, curve_under_labels, download, drag_slider,
+                             open_page, settle)
 
 pytestmark = pytest.mark.slow
 
@@ -90,6 +91,13 @@ def test_a_triple_point_cycles_through_the_pairings_that_keep_one_stroke(served,
     assert page.evaluate(f"{STATE}.edits.edits.map(e => e.kind)") == ["split"]
     assert page.evaluate(f"{STATE}.report.intersections") == 5 and page.evaluate(f"{STATE}.report.strokes") == 1
     assert not page.evaluate(f"{STATE}.report.warnings")
+    # The two crossings, 3 px apart, fan out beside the point; the line starts there, and
+    # its start marker (radius 7) sits clear of both markers as drawn (it used to cover one).
+    assert page.evaluate("window.studio.markers.filter(m => m.moved).length") == 2
+    clearance = page.evaluate("Math.min(...window.studio.starts.flatMap(([x, y]) => "
+                              "window.studio.markers.map(m => Math.hypot(m.x - x, m.y - y) - m.r)))")
+    assert clearance >= 7, clearance
+    page.screenshot(path=str(ARTIFACTS / "studio-hand-2c-triple-split.png"))
     page.click("#undo")
     settle(page, 1, f"!!{TRIPLE}")
     page.check("input[name=tool][value=pairing]")
@@ -220,6 +228,35 @@ def test_a_bridged_gap_opened_closed_undone_and_both_pieces_kept(served, tmp_pat
     assert page.evaluate(f"{STATE}.report.strokes") >= 2 and page.evaluate(f"{STATE}.report.dropped") == 0
     assert not [w for w in page.evaluate(f"{STATE}.report.warnings") if "unbridge" in w]
     page.check("input[name=tool][value=pairing]")
+
+
+def test_a_threshold_that_leaves_a_stub_of_the_line_says_so(served):
+    """Blur 3 px, then the threshold dragged down to 0.07: little ink is that dark, and the
+    line shrinks to a stub at the triple point. The page says so with the lengths (it used
+    to show the stub and nothing else); the automatic threshold brings the line back and
+    takes the note back."""
+    page, _ = served["triple"]
+    steps, settings = page.evaluate("window.studio.history.length"), page.evaluate(f"{STATE}.settings")
+    assert settings["threshold"] is None and settings["blur"] == 0
+    drag_slider(page, "#blur", 0.75)
+    settle(page, extra=f"{STATE}.settings.blur === 3")
+    assert page.is_hidden("#hint")  # blurred, the line is still whole
+    drag_slider(page, "#threshold", 0.02)
+    settle(page, extra=f"{STATE}.settings.threshold === 0.07")
+    short = page.evaluate("window.studio.line.total")
+    text = page.inner_text("#hint")
+    assert page.is_visible("#hint") and short < 100, (short, text)
+    assert text.startswith(f"at threshold 0.07 and blur 3 px the line is {round(short)} px long (") and (
+        "most of the ink is lighter than the threshold" in text), text
+    page.screenshot(path=str(ARTIFACTS / "studio-hand-7-threshold-stub.png"))
+    page.click("#auto-threshold")
+    settle(page, extra=f"{STATE}.settings.threshold === null")
+    assert page.evaluate("window.studio.line.total") > 2000 and page.is_hidden("#hint")
+    assert page.evaluate("window.studio.history.length") == steps + 3  # blur, threshold, automatic
+    for _ in range(3):
+        page.click("#undo")
+        settle(page)
+    assert page.evaluate(f"{STATE}.settings") == settings
 
 
 def exports_match_the_cli(page, drawing, edits, tmp_path, command: str, kind: str, *flags) -> None:

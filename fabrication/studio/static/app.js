@@ -177,7 +177,7 @@ function draw() {
   arrows(g, t);
   junctionMarkers(g);
   bridges(g);
-  const starts = startPlaces();
+  const starts = studio.starts = startPlaces();  // screen px, for the tests too
   placeLabels(g, starts.map(([x, y]) => [x - 8, y - 8, 16, 16]));
   startMarkers(g, starts);
   if (studio.pen < 1 || studio.playing) penMarker(g, t, penAt);
@@ -242,6 +242,26 @@ function describeUnresolved(j) {
     "is read as going on through it, so the line's order here is a guess";
 }
 
+// A threshold or blur that leaves little of the ink (the line shrinks to a stub, the
+// drawing vanishes from the view) says so, beside the longest line this page has shown
+// (a slider moved step by step shrinks the line a little at each answer); a later answer
+// from other settings takes it back.
+function sayShrunk(old) {
+  const s = studio.state, now = studio.line.total;
+  const setting = (st, r) => `${st.threshold === null ? `the automatic threshold ${Number(r.threshold).toFixed(2)}`
+    : `threshold ${Number(st.threshold).toFixed(2)}`} and blur ${st.blur} px`;
+  const moved = old && SETTINGS.some((k) => old.edits[k] !== s.edits[k]);
+  const most = studio.longest;
+  if (moved && most && now < SHRUNK * most.total) {
+    hint(`at ${setting(s.settings, s.report)} the line is ${Math.round(now)} px long (${Math.round(most.total)} px at ` +
+      `${most.setting}): most of the ink is lighter than the threshold (blur lightens thin lines); raise the ` +
+      "threshold, lower the blur or tick \"automatic threshold\"");
+    studio.shrunk = true;
+  } else if (studio.shrunk && moved) { hint(""); studio.shrunk = false; }
+  if (!most || now > most.total) studio.longest = { total: now, setting: setting(s.settings, s.report) };
+}
+const SHRUNK = 0.25;  // a line under a quarter of the longest shown is a stub
+
 // The pen's place through an edit: a paused (or playing) pen stays on the spot of the
 // drawing where it was, i.e. at the new curve's point nearest to it; where the new curve
 // passes that spot more than once (a crossing, a stretch drawn twice), on the pass whose
@@ -287,11 +307,12 @@ function penMarker(g, t, penAt) {
 // ---------------------------------------------------------------- showing a state
 function show(state) {
   const first = !studio.state;
-  const before = studio.line;
+  const before = studio.line, old = studio.state;
   studio.state = state;
   studio.line = timeline();
   if (first) fit();
   else keepPen(before, studio.line);
+  sayShrunk(old);
   $("name").textContent = state.name;
   const r = state.report;
   $("summary").textContent = `${r.strokes} stroke${r.strokes === 1 ? "" : "s"}, ${r.intersections} crossing` +

@@ -6,16 +6,19 @@ import { $ } from "./api.js";
 import { COLORS, PASS_COLORS, passRank, percent, studio, toScreen } from "./view.js";
 
 // Start markers: where each stroke begins. One that would hide a junction's marker (a line
-// starting at a junction) sits just beyond it along its stroke.
+// starting at a junction) sits just beyond the markers along its stroke: beyond the marker
+// as drawn (fanned out beside its junction, `markerPlaces`) and the junction's dot.
 export function startPlaces() {
   const s = studio.state;
-  const markers = s.graph.junctions.map((j) => ({ at: toScreen(...j.at), r: j.role === "triple" ? 24 : 11 }));
+  const markers = (studio.markers || []).flatMap((m) => {
+    const r = m.j.role === "triple" ? 24 : 11;
+    return m.moved ? [{ at: [m.x, m.y], r }, { at: m.at, r: 4 }] : [{ at: m.at, r }];
+  });
+  const clear = ([px, py], extra) => markers.every((m) => Math.hypot(m.at[0] - px, m.at[1] - py) >= m.r + extra);
   return s.strokes.map((stroke) => {
     const start = toScreen(...stroke.points[0]);
-    const under = markers.find((m) => Math.hypot(m.at[0] - start[0], m.at[1] - start[1]) < m.r + 6);
-    if (!under) return start;
-    return stroke.points.map((p) => toScreen(...p))
-      .find(([px, py]) => Math.hypot(px - under.at[0], py - under.at[1]) > under.r + 9) || start;
+    if (clear(start, 6)) return start;
+    return stroke.points.map((p) => toScreen(...p)).find((p) => clear(p, 9)) || start;
   });
 }
 
