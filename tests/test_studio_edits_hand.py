@@ -117,3 +117,11 @@ def test_a_twice_the_line_cannot_keep_is_said(drawings):
                             edits=Edits(items=(Edit(kind="twice", at=tuple(middle.at)),)))
     assert heeded.drawing.length > base.drawing.length + middle.length
     assert not [w for w in heeded.report.warnings if "still drawn" in w]
+    # Multi-stroke mode draws no route over the whole drawing: there the same twice (and a
+    # once on a stretch drawn twice) acts on nothing by the mode, and says that, not that
+    # it "matched nothing" (the stretch is right there).
+    items = (Edit(kind="twice", at=tuple(middle.at)), Edit(kind="once", at=tuple(lead_in["at"])))
+    multi = vectorize_file(path, VectorizeOptions(), cache=cache, edits=Edits(multi=True, items=items))
+    assert [w for w in multi.report.warnings if w.startswith("edit ")] == [
+        f"edit 1 (twice at {middle.at[0]:.0f}, {middle.at[1]:.0f}) acts in single-line mode only and was skipped",
+        f"edit 2 (once at {x:.0f}, {y:.0f}) acts in single-line mode only and was skipped"]

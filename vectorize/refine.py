@@ -434,10 +434,15 @@ class Refinement:
         return result
 
     def unmatched(self) -> list[str]:
-        """One warning per edit that found nothing to act on."""
-        return [f"edit {i + 1} ({e.kind} at {e.at[0]:.0f}, {e.at[1]:.0f}) matched nothing within "
-                f"{self.edits.tolerance:g} px and was skipped"
-                for i, e in enumerate(self.edits.items) if i not in self.hits]
+        """One warning per edit that found nothing to act on; "twice" and "once" in
+        multi-stroke mode, which draws no route over the whole drawing, act on nothing by
+        their mode, wherever they are (not "matched nothing": the stretch may be right there)."""
+        def said(i, e):
+            head = f"edit {i + 1} ({e.kind} at {e.at[0]:.0f}, {e.at[1]:.0f})"
+            if self.options.multi and e.kind in ("twice", "once"):
+                return f"{head} acts in single-line mode only and was skipped"
+            return f"{head} matched nothing within {self.edits.tolerance:g} px and was skipped"
+        return [said(i, e) for i, e in enumerate(self.edits.items) if i not in self.hits]
 
     # -- the page's view -------------------------------------------------------------
     def graph_view(self, solution, bridges=(), refused=()) -> GraphView:
