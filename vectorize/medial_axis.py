@@ -58,7 +58,7 @@ def medial_axis(rings: list[np.ndarray], gray: np.ndarray, level: float, *, tile
         keep = ~((ring_of[p] == ring_of[q]) & (gap <= 1))
         ends = part.ridges[keep]
         inside = np.zeros(len(part.key), dtype=bool)
-        asked = np.unique(ends)
+        asked = np.flatnonzero(np.bincount(ends.ravel(), minlength=len(part.key)))
         if len(asked):
             inside[asked] = _inside(gray, level, part.center[asked])
         keep[keep] = inside[ends[:, 0]] & inside[ends[:, 1]]
@@ -68,8 +68,9 @@ def medial_axis(rings: list[np.ndarray], gray: np.ndarray, level: float, *, tile
             return None
         keep[keep] = part.fits[ends[:, 0]] & part.fits[ends[:, 1]]
         ends = part.ridges[keep]
-        used = np.unique(ends)
-        return (part.key[ends], part.ridge_points[keep], part.key[used], part.center[used], part.radius[used])
+        used = np.bincount(ends.ravel(), minlength=len(part.key)) > 0
+        number = np.cumsum(used) - 1
+        return (number[ends], part.ridge_points[keep], part.key[used], part.center[used], part.radius[used])
 
     parts = None
     if tiles is None:
@@ -89,14 +90,22 @@ def medial_axis(rings: list[np.ndarray], gray: np.ndarray, level: float, *, tile
                 parts = None
     if parts is None:
         parts = [inside_ridges()]
-    ridge_keys, ridge_points, keys, centers, radii = (np.concatenate(column) for column in zip(*parts))
-    if len(ridge_keys) == 0:
+    # Vertices in the order of their names, one per name (a vertex in two tiles is found
+    # twice, with the same bits), and ridges in the order of their vertices.
+    offsets = np.cumsum([0] + [len(part[2]) for part in parts[:-1]])
+    ridges = np.concatenate([part[0] + offset for part, offset in zip(parts, offsets)])
+    ridge_points, keys, centers, radii = (np.concatenate(column) for column in list(zip(*parts))[1:])
+    if len(ridges) == 0:
         raise VectorizeError("no centre line found inside the ink")
-    keys, first = np.unique(keys, return_index=True)
-    xy, radius = centers[first], radii[first]
-    # A ridge found in two tiles is one: the same vertex pair, oriented low to high.
-    ends = np.sort(np.searchsorted(keys, ridge_keys), axis=1)
-    _, once = np.unique(ends[:, 0] * len(keys) + ends[:, 1], return_index=True)
+    order = np.argsort(keys)
+    new = np.concatenate([[True], keys[order[1:]] != keys[order[:-1]]])
+    vertex_of = np.empty(len(keys), dtype=np.int64)
+    vertex_of[order] = np.cumsum(new) - 1
+    xy, radius = centers[order[new]], radii[order[new]]
+    ends = np.sort(vertex_of[ridges], axis=1)
+    pair = ends[:, 0] * len(xy) + ends[:, 1]
+    order = np.argsort(pair)
+    once = order[np.concatenate([[True], pair[order[1:]] != pair[order[:-1]]])]
     edges, ridge_points = ends[once], ridge_points[once]
     # Object angle: half the angle at the ridge midpoint between its two generating samples.
     mid = xy[edges].mean(axis=1)

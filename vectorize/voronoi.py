@@ -30,7 +30,7 @@ SAME_CENTER = 1e-10
 # that cocircular samples on it, and a group's near-equal circles, are inside the slab too.
 FIT_SLACK = 1e-8
 # Points are moved by up to this many px for qhull (see `voronoi_part`), by a fixed draw.
-JITTER = 1e-6
+JITTER = 1e-8
 JITTER_SEED = 0
 # Rounding error of the circumcentre formula and the distances, as a fraction of the extent.
 ROUNDING = 1e-12
