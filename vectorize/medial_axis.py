@@ -14,7 +14,7 @@ from vectorize.voronoi import empty_circle_bound, tile_slabs, voronoi_part
 
 # From this many outline samples on, the Voronoi diagram is computed in tiles, one thread per
 # core (qhull lets go of the GIL); below, starting the threads costs more than it saves.
-TILED_SAMPLES = 8000
+TILED_SAMPLES = 4000
 MAX_TILES = 8
 
 
@@ -32,9 +32,8 @@ def medial_axis(rings: list[np.ndarray], gray: np.ndarray, level: float, *, tile
 
     A ridge is kept when both its vertices lie inside the ink and its two generating samples
     are not neighbours on one ring (those ridges cut the outline, not the ink's middle).
-    Vertices come in the order of their names (`vectorize.voronoi.VoronoiPart.key`) and
-    ridges in the order of their vertices, so the graph does not depend on how the diagram
-    was computed. tiles: how many tiles to compute the diagram in, one thread each (1: whole;
+    Vertices come in the order of their coordinates and ridges in the order of their
+    vertices, so the graph does not depend on how the diagram was computed. tiles: how many tiles to compute the diagram in, one thread each (1: whole;
     None: one per core from `TILED_SAMPLES` samples on); it falls back to the whole diagram
     where the ink's widest part would make the tiles overlap too much.
     """
@@ -90,8 +89,8 @@ def medial_axis(rings: list[np.ndarray], gray: np.ndarray, level: float, *, tile
                 parts = None
     if parts is None:
         parts = [inside_ridges()]
-    # Vertices in the order of their names, one per name (a vertex in two tiles is found
-    # twice, with the same bits), and ridges in the order of their vertices.
+    # One vertex per name (a vertex found in two tiles has the same bits in both), in the
+    # order of its coordinates (x, then y); ridges in the order of their vertices.
     offsets = np.cumsum([0] + [len(part[2]) for part in parts[:-1]])
     ridges = np.concatenate([part[0] + offset for part, offset in zip(parts, offsets)])
     ridge_points, keys, centers, radii = (np.concatenate(column) for column in list(zip(*parts))[1:])
@@ -99,9 +98,13 @@ def medial_axis(rings: list[np.ndarray], gray: np.ndarray, level: float, *, tile
         raise VectorizeError("no centre line found inside the ink")
     order = np.argsort(keys)
     new = np.concatenate([[True], keys[order[1:]] != keys[order[:-1]]])
+    once = order[new]
+    place = np.lexsort((keys[once], centers[once, 1], centers[once, 0]))
+    rank = np.empty(len(once), dtype=np.int64)
+    rank[place] = np.arange(len(once))
     vertex_of = np.empty(len(keys), dtype=np.int64)
-    vertex_of[order] = np.cumsum(new) - 1
-    xy, radius = centers[order[new]], radii[order[new]]
+    vertex_of[order] = rank[np.cumsum(new) - 1]
+    xy, radius = centers[once[place]], radii[once[place]]
     ends = np.sort(vertex_of[ridges], axis=1)
     pair = ends[:, 0] * len(xy) + ends[:, 1]
     order = np.argsort(pair)
