@@ -38,11 +38,12 @@ KEEP_IMAGES = 8
 class StageCache:
     """Results of the early stages for one image (the studio keeps one per drawing).
 
-    paper: (blur, max_size) -> (gray, scale) of `vectorize.binarize.paper_gray` (the
-    threshold does not change it); axis: (threshold, blur, max_size) -> (ink, rings,
-    medial graph before pruning) (the mode does not change them); front: `front_key` ->
-    the pruned (and in single-line mode bridged) graph with its ink (the "unbridge" edits
-    change it too).
+    gray: (max_size,) -> (gray, scale) of `vectorize.binarize.downscaled_gray` (neither
+    blur nor threshold change it); paper: (blur, max_size) -> (gray, scale) of
+    `vectorize.binarize.paper_gray` (the threshold does not change it); axis: (threshold,
+    blur, max_size) -> (ink, rings, medial graph before pruning) (the mode does not change
+    them); front: `front_key` -> the pruned (and in single-line mode bridged) graph with its
+    ink (the "unbridge" edits change it too).
 
     cancel: None or a callable the pipeline asks between stages; when it says True the run
     stops with `onestroke.errors.Cancelled`. Every entry is stored only once its stage has
@@ -51,6 +52,7 @@ class StageCache:
 
     def __init__(self) -> None:
         self.loaded = None  # ((path, max_size), (image, frame)) of the last file read
+        self.gray: dict = {}
         self.paper: dict = {}
         self.axis: dict = {}
         self.front: dict = {}
@@ -69,7 +71,7 @@ class StageCache:
         positions), computed once; compute(cache) may use `stage` for the parts that fewer
         options change."""
         if self._image is not image:
-            for store in (self.paper, self.axis, self.front, self.simplified, self.solved):
+            for store in (self.gray, self.paper, self.axis, self.front, self.simplified, self.solved):
                 store.clear()
             self._image = image
         key = front_key(options, edits)
@@ -78,7 +80,7 @@ class StageCache:
         return self.front[key]
 
     def stage(self, name: str, key: tuple, compute):
-        """The cached result of stage `name` ("paper" or "axis") for `key`, computed once."""
+        """The cached result of stage `name` ("gray", "paper" or "axis") for `key`, computed once."""
         store = getattr(self, name)
         if key not in store:
             _bounded_put(store, key, compute(), KEEP_IMAGES)

@@ -127,14 +127,12 @@ function label(g, text, x, y, gap) { studio.labels.push({ text, x, y, gap }); }
 // over each other).
 export function placeLabels(g, more = []) {
   g.font = "11px sans-serif"; g.textAlign = "left"; g.textBaseline = "middle";
-  const boxes = studio.labels.map(({ x, y, gap }) => [x - gap, y - gap, 2 * gap, 2 * gap]).concat(more);
+  const markers = studio.labels.map(({ x, y, gap }) => [x - gap, y - gap, 2 * gap, 2 * gap]).concat(more);
   const h = 13, c = $("canvas");
-  const placed = [];
-  studio.placed = [];  // the texts drawn and their boxes (screen px)
+  studio.placed = [];  // the texts drawn: their markers' places and their boxes (screen px)
   for (const { text, x, y, gap } of studio.labels) {
     // Two nodes a pixel or two apart (a split crossing) would print the same text twice.
-    if (placed.some((q) => q.text === text && Math.hypot(q.x - x, q.y - y) < 12)) continue;
-    placed.push({ text, x, y });
+    if (studio.placed.some((q) => q.text === text && Math.hypot(q.x - x, q.y - y) < 12)) continue;
     const w = g.measureText(text).width;
     // Right, left, below, above; then the corners; then the same farther out (a crowd of
     // markers: the halves of a split crossing with a "×2" between them).
@@ -144,10 +142,10 @@ export function placeLabels(g, more = []) {
     const spots = around(gap).concat(around(gap + 14), around(gap + 28));
     const covers = (sx, sy, b) => sx < b[0] + b[2] && b[0] < sx + w && sy - h / 2 < b[1] + b[3] && b[1] < sy + h / 2;
     const inside = (sx, sy) => sx >= 2 && sx + w <= c.clientWidth - 2 && sy - h / 2 >= 0 && sy + h / 2 <= c.clientHeight;
-    const [lx, ly] = spots.find(([sx, sy]) => inside(sx, sy) && !boxes.some((b) => covers(sx, sy, b))) ||
+    const free = (sx, sy) => !markers.some((b) => covers(sx, sy, b)) && !studio.placed.some((q) => covers(sx, sy, q.box));
+    const [lx, ly] = spots.find(([sx, sy]) => inside(sx, sy) && free(sx, sy)) ||
       spots.find(([sx, sy]) => inside(sx, sy)) || spots[0];
-    boxes.push([lx, ly - h / 2, w, h]);
-    studio.placed.push({ text, box: [lx, ly - h / 2, w, h] });
+    studio.placed.push({ text, x, y, box: [lx, ly - h / 2, w, h] });
     g.fillStyle = "rgba(255,255,255,0.8)"; g.fillRect(lx - 2, ly - h / 2, w + 4, h);
     g.strokeStyle = "rgba(255,255,255,0.9)"; g.lineWidth = 3; g.lineJoin = "round"; g.strokeText(text, lx, ly);
     g.fillStyle = "#222"; g.fillText(text, lx, ly);
