@@ -35,7 +35,7 @@ async function apply(edits, push = true) {
   } catch (error) {
     // A refused edits state (e.g. an opened file that is not an edits file) is no step.
     if (push && studio.history[studio.at] === edits) { studio.history.pop(); studio.at -= 1; updateButtons(); }
-    if (ticket === studio.requests) report(error);
+    if (ticket === studio.requests) tell(error.message, true);
   } finally {
     busy(false);
     if (rerun) rerunning(-1);
@@ -177,7 +177,7 @@ function draw() {
   arrows(g, t);
   junctionMarkers(g);
   bridges(g);
-  const starts = startPlaces();
+  const starts = studio.starts = startPlaces();  // screen px, for the tests too
   placeLabels(g, starts.map(([x, y]) => [x - 8, y - 8, 16, 16]));
   startMarkers(g, starts);
   if (studio.pen < 1 || studio.playing) penMarker(g, t, penAt);
@@ -242,6 +242,26 @@ function describeUnresolved(j) {
     "is read as going on through it, so the line's order here is a guess";
 }
 
+// A threshold or blur that leaves little of the ink (the line shrinks to a stub, the
+// drawing vanishes from the view) says so, beside the longest line this page has shown
+// (a slider moved step by step shrinks the line a little at each answer); a later answer
+// from other settings takes it back.
+function sayShrunk(old) {
+  const s = studio.state, now = studio.line.total;
+  const setting = (st, r) => `${st.threshold === null ? `the automatic threshold ${Number(r.threshold).toFixed(2)}`
+    : `threshold ${Number(st.threshold).toFixed(2)}`} and blur ${st.blur} px`;
+  const moved = old && SETTINGS.some((k) => old.edits[k] !== s.edits[k]);
+  const most = studio.longest;
+  if (moved && most && now < SHRUNK * most.total) {
+    hint(`at ${setting(s.settings, s.report)} the line is ${Math.round(now)} px long (${Math.round(most.total)} px at ` +
+      `${most.setting}): most of the ink is lighter than the threshold (blur lightens thin lines); raise the ` +
+      "threshold, lower the blur or tick \"automatic threshold\"");
+    studio.shrunk = true;
+  } else if (studio.shrunk && moved) { hint(""); studio.shrunk = false; }
+  if (!most || now > most.total) studio.longest = { total: now, setting: setting(s.settings, s.report) };
+}
+const SHRUNK = 0.25;  // a line under a quarter of the longest shown is a stub
+
 // The pen's place through an edit: a paused (or playing) pen stays on the spot of the
 // drawing where it was, i.e. at the new curve's point nearest to it; where the new curve
 // passes that spot more than once (a crossing, a stretch drawn twice), on the pass whose
@@ -287,11 +307,12 @@ function penMarker(g, t, penAt) {
 // ---------------------------------------------------------------- showing a state
 function show(state) {
   const first = !studio.state;
-  const before = studio.line;
+  const before = studio.line, old = studio.state;
   studio.state = state;
   studio.line = timeline();
   if (first) fit();
   else keepPen(before, studio.line);
+  sayShrunk(old);
   $("name").textContent = state.name;
   const r = state.report;
   $("summary").textContent = `${r.strokes} stroke${r.strokes === 1 ? "" : "s"}, ${r.intersections} crossing` +
@@ -437,6 +458,16 @@ const MISSED = {
     ? "no pen gap here: click on a dashed circle to open it, a struck-through one to close it"
     : "no pen gap was bridged in this drawing (single-line mode bridges them; multi-stroke none)",
 };
+
+// What comes of the header's actions (undo, redo, save, load, open: at hand on every tab),
+// said in the panel in view: on Refine an error in its warnings and a note as the hint; on
+// the Embroidery or Laser tab both in that panel's list, where the user is looking.
+function tell(message, error = false) {
+  const list = studio.tab === "refine" ? "warnings" : `${studio.tab}-warnings`;
+  if (error) report(new Error(message), list);
+  else if (studio.tab === "refine") hint(message);
+  else { const li = document.createElement("li"); li.textContent = message; $(list).replaceChildren(li); }
+}
 
 function hint(text, buttons = []) {
   $("hint").textContent = text || "";
@@ -627,23 +658,26 @@ function setup() {
   $("scrub").oninput = () => { studio.playing = false; $("play").textContent = "▶ Play"; studio.pen = $("scrub").value / 1000; draw(); };
   setupPanels(() => studio.shown);
   $("save").onclick = async () => {
-    try { const r = await call("api/edits", { edits: currentEdits() }); $("summary").textContent += ` · saved ${r.saved}`; }
-    catch (error) { report(error); }
+    try {
+      const r = await call("api/edits", { edits: currentEdits() });
+      if (studio.tab === "refine") $("summary").textContent += ` · saved ${r.saved}`;
+      else tell(`saved ${r.saved}`);
+    } catch (error) { tell(error.message, true); }
   };
   $("load").onclick = async () => {
     try {
       const r = await call("api/edits");
       // No file yet: nothing to load (applying "no edits" would throw the user's away).
-      if (!r.exists) hint(`no edits saved yet: ${r.path} does not exist (Save edits writes it)`);
-      else if (JSON.stringify(r.edits) === JSON.stringify(currentEdits())) hint(`the edits are those of ${r.path} already`);
+      if (!r.exists) tell(`no edits saved yet: ${r.path} does not exist (Save edits writes it)`);
+      else if (JSON.stringify(r.edits) === JSON.stringify(currentEdits())) tell(`the edits are those of ${r.path} already`);
       else { hint(""); apply(r.edits); }
-    } catch (error) { report(error); }
+    } catch (error) { tell(error.message, true); }
   };
   $("open").onchange = async () => {
     const file = $("open").files[0]; if (!file) return;
     let data;
     try { data = JSON.parse(await file.text()); }
-    catch (error) { report(new Error(`${file.name} is not an edits file (not JSON)`)); }
+    catch (error) { tell(`${file.name} is not an edits file (not JSON)`, true); }
     if (data !== undefined) apply(data);
     $("open").value = "";
   };
