@@ -13,6 +13,7 @@ import numpy as np
 import pytest
 
 from benchmarks.drawings import generate_drawing
+from benchmarks.metrics import evaluate
 from benchmarks.render import render
 from vectorize import VectorizeOptions, vectorize_image
 
@@ -21,6 +22,18 @@ def _stages(gt):
     result = vectorize_image(render(gt.drawing), VectorizeOptions(multi=False, classifier="cnn", seed=0,
                                                                   keep_stages=True))
     return result.stages
+
+
+def test_shallow_crossing_off_the_merged_node_is_crossed():
+    """triple-0-20021 (benchmark triple set, seed 0): a shallow crossing low in the drawing
+    merges into one node off the crossing; read as a touch there, the loop was run the wrong
+    way round (order 0.60). Cropped on the crossing, it is crossed and the order is right."""
+    gt = generate_drawing("triple", 0, 20_021)
+    image = render(gt.drawing)
+    result = vectorize_image(image, VectorizeOptions(multi=False, classifier="cnn", seed=0))
+    scores = evaluate(gt, result.drawing, image)
+    assert scores.stroke_count == 1
+    assert scores.correct, scores.order
 
 
 @pytest.mark.parametrize("kind, seed, index", [
