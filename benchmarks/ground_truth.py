@@ -5,6 +5,7 @@ intersections are not counted."""
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from itertools import chain, islice, zip_longest
 
 import numpy as np
 
@@ -65,3 +66,14 @@ class GroundTruth:
 
 class Rejected(Exception):
     """A sample that breaks a rule; the generator draws another."""
+
+
+_NONE_LEFT = object()
+
+
+def interleaved(queues, count: int | None = None) -> list:
+    """One item of each queue in turn (a queue that runs out is passed over), the first
+    `count` (default all): a set mixing its sources so that any first part has each kind."""
+    mixed = (item for item in chain.from_iterable(zip_longest(*queues, fillvalue=_NONE_LEFT))
+             if item is not _NONE_LEFT)
+    return list(islice(mixed, count))

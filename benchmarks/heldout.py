@@ -31,7 +31,7 @@ import shapely
 import shapely.affinity
 
 from benchmarks.drawings import generate_set
-from benchmarks.ground_truth import CANVAS, MARGIN, GroundTruth
+from benchmarks.ground_truth import CANVAS, MARGIN, GroundTruth, interleaved
 from benchmarks.handwriting import WORDS, handwriting_drawing
 from benchmarks.hershey import hershey_set, load_glyphs
 from benchmarks.relief import relief_glyphs, relief_set
@@ -102,15 +102,8 @@ def heldout_set(count: int | None = None, seed: int = 0) -> list[GroundTruth]:
     sources["handwriting"] = [handwriting_drawing(seed, i) for i in words[:SHARES["handwriting"]]]
     for name in ("plain", "touch", "triple"):
         sources[name] = generate_set(name, SHARES[name], 1000 + seed)
-    mixed: list[GroundTruth] = []
-    queues = [list(v) for v in sources.values()]
-    while any(queues):
-        for q in queues:
-            if q:
-                mixed.append(q.pop(0))
-    mixed = mixed[:count] if count is not None else mixed
     out = []
-    for k, gt in enumerate(mixed):
+    for k, gt in enumerate(interleaved(sources.values(), count)):
         condition = CONDITIONS[k % len(CONDITIONS)]
         out.append(replace(gt, name=f"{gt.name}-{condition}", meta={**gt.meta, "condition": condition}))
     return out

@@ -22,8 +22,7 @@ import numpy as np
 import shapely
 import shapely.affinity
 
-from benchmarks.ground_truth import GroundTruth
-from vectorize.drawing import Drawing
+from benchmarks.ground_truth import GroundTruth, interleaved
 
 SEED_OFFSET = 5  # photo sources: a seed the other sets do not use
 # drawings per kind at the default count (40)
@@ -42,12 +41,7 @@ def photo_sources(count: int, seed: int) -> list[GroundTruth]:
     n = count // 5 + 1
     queues = [[handwriting_drawing(s, i) for i in range(n)], hershey_set(n, s), relief_set(n, s),
               generate_set("plain", n, 1000 * s), kana_set(n, s)]
-    out: list[GroundTruth] = []
-    while len(out) < count and any(queues):
-        for q in queues:
-            if q and len(out) < count:
-                out.append(q.pop(0))
-    return out
+    return interleaved(queues, count)
 
 
 def kinds_set(count: int | None = None, seed: int = 0) -> list[GroundTruth]:
@@ -67,22 +61,15 @@ def kinds_set(count: int | None = None, seed: int = 0) -> list[GroundTruth]:
         "brush-capital": capital_set(share["brush-capital"], seed),
         "photo": [photographed(gt, rng) for gt in photo_sources(share["photo"], seed)],
     }
-    mixed: list[GroundTruth] = []
-    queues = [list(v) for v in sources.values()]
-    while any(queues) and len(mixed) < count:
-        for q in queues:
-            if q and len(mixed) < count:
-                mixed.append(q.pop(0))
-    return mixed
+    return interleaved(sources.values(), count)
 
 
 def scaled(gt: GroundTruth, factor: float) -> GroundTruth:
     """`gt` drawn `factor` times larger on a canvas `factor` times larger (a 3000-4000 px
     page of the same drawing): geometry, widths, width profile and minimum length scaled."""
-    matrix = np.array([[factor, 0.0, 0.0], [0.0, factor, 0.0]])
     d = gt.drawing
-    drawing = Drawing(tuple(s.transformed(matrix) for s in d.strokes), d.width * factor, d.height * factor,
-                      unit=d.unit, stroke_width=d.stroke_width * factor)
+    drawing = d.transformed(np.array([[factor, 0.0, 0.0], [0.0, factor, 0.0]]), width=d.width * factor,
+                            height=d.height * factor, unit=d.unit, stroke_width=d.stroke_width * factor)
     meta = {**gt.meta, "scale": factor}
     if "width_profile" in meta:
         knots, widths = meta["width_profile"]

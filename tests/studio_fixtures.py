@@ -140,3 +140,28 @@ def cli_bytes(command: str, drawing: Path, edits: dict, tmp_path: Path, suffix: 
                                     "-o", str(out), *flags])
     assert run.exit_code == 0, run.output
     return out.read_bytes()
+
+
+def curve_under_labels(page) -> dict[str, float]:
+    """text -> screen px of the drawn curve under that marker's text on the drawing (its white
+    box: the text's box and the 2 px the box adds each side), each segment of the curve
+    walked in 0.5 px steps."""
+    return page.evaluate("""() => {
+        const s = window.studio, t = s.line, r = document.getElementById('canvas').getBoundingClientRect();
+        const at = (p) => { const [x, y] = s.toScreen(p[0], p[1]); return [x - r.left, y - r.top]; };
+        const under = {};
+        for (const { text, box: [x, y, w, h] } of s.placed) {
+            let length = 0;
+            for (let i = 1; i < t.pts.length; i++) {
+                if (t.pts[i].first) continue;
+                const a = at(t.pts[i - 1]), b = at(t.pts[i]), d = Math.hypot(b[0] - a[0], b[1] - a[1]);
+                const n = Math.max(1, Math.ceil(2 * d));
+                for (let k = 1; k <= n; k++) {
+                    const px = a[0] + (b[0] - a[0]) * k / n, py = a[1] + (b[1] - a[1]) * k / n;
+                    if (px >= x - 2 && px <= x + w + 2 && py >= y && py <= y + h) length += d / n;
+                }
+            }
+            under[text] = Math.max(under[text] || 0, length);
+        }
+        return under;
+    }""")

@@ -14,6 +14,7 @@ if str(ROOT) not in sys.path:
     sys.path.insert(0, str(ROOT))
 
 from benchmarks.brush import THIN, brush_profile, kana_set, nib_profile  # noqa: E402
+from benchmarks.ground_truth import interleaved  # noqa: E402
 from benchmarks.ink_metrics import ink_scores  # noqa: E402
 from benchmarks.metrics import polyline_intersections  # noqa: E402
 from benchmarks.photo import apply_homography, photo_image, photographed  # noqa: E402
@@ -89,3 +90,11 @@ def test_a_photo_moves_the_ground_truth_and_darkens_the_page_unevenly():
     lum = image.mean(axis=2)
     corners = [lum[:20, :20].mean(), lum[:20, -20:].mean(), lum[-20:, :20].mean(), lum[-20:, -20:].mean()]
     assert max(corners) - min(corners) > 20  # light falloff and shadow: not one paper level
+
+
+def test_sets_mix_their_sources_one_of_each_in_turn():
+    queues = [["a1", "a2", "a3"], [], ["b1"], ["c1", "c2"]]
+    assert interleaved(queues) == ["a1", "b1", "c1", "a2", "c2", "a3"]
+    assert interleaved(queues, 4) == ["a1", "b1", "c1", "a2"]
+    assert interleaved(queues, 10) == interleaved(queues) and interleaved(queues, 0) == []
+    assert interleaved([[None, 0], [""]]) == [None, "", 0]  # falsy items are items too

@@ -16,8 +16,8 @@ from click.testing import CliRunner
 
 from conftest import ARTIFACTS
 from fabrication.cli import main
-from studio_fixtures import (IDLE, click_at, coloured_pixels, download, drag_slider, page, settle,  # noqa: F401
-                             studio)
+from studio_fixtures import (IDLE, click_at, coloured_pixels, download, drag_slider, curve_under_labels,  # noqa: F401
+                             page, settle, studio)
 
 pytestmark = pytest.mark.slow
 
@@ -38,6 +38,9 @@ def test_click_a_junction_through_its_pairings_undo_redo_and_play(page):
     page.screenshot(path=str(ARTIFACTS / "studio-1-loaded.png"))
     assert coloured_pixels(page) > 3000  # the curve, coloured start to end, is on the canvas
     assert "1 stroke, 3 crossings" in page.inner_text("#summary")
+    under = curve_under_labels(page)  # the three crossings' texts, beside the curve, not on it
+    assert under == {"crossing 100%": 0}, under
+    assert len(page.evaluate("window.studio.placed")) == 3
     count = page.evaluate(f"{STATE}.edits.edits.length")
 
     # Each click on a junction moves it to the next pairing (crossing -> touching -> third

@@ -15,7 +15,8 @@ import pytest
 from conftest import ARTIFACTS
 from fabrication.studio.server import StudioServer
 from fabrication.studio.session import StudioSession
-from studio_fixtures import bench_drawing, cli_bytes, click_at, download, open_page, settle
+from studio_fixtures import (bench_drawing, cli_bytes, click_at, curve_under_labels, download, drag_slider,
+                             open_page, settle)
 
 pytestmark = pytest.mark.slow
 
@@ -53,6 +54,12 @@ def test_a_triple_point_cycles_through_the_pairings_that_keep_one_stroke(served,
     assert triple["confidence"] is not None and len(triple["options"]) >= 3
     assert triple["options"][0]["passes"] == [list(p) for p in triple["passes"]]  # the likeliest is drawn
     assert "three passes" in page.inner_text("#junctions")
+    # Each text beside its marker, off the curve; the triple point's, with branches all
+    # around, where it hides least: across a line, not along it (it used to lie along the
+    # line entering the triple point, hiding 100 px of it).
+    under = curve_under_labels(page)
+    passes = next(text for text in under if text.startswith("3 passes"))
+    assert under.pop(passes) < 20 and under == {"crossing 100%": 0}, (passes, under)
     page.screenshot(path=str(ARTIFACTS / "studio-hand-1-triple.png"))
 
     # A click takes the next pairing in order of likelihood; the route, and with it the
@@ -84,6 +91,13 @@ def test_a_triple_point_cycles_through_the_pairings_that_keep_one_stroke(served,
     assert page.evaluate(f"{STATE}.edits.edits.map(e => e.kind)") == ["split"]
     assert page.evaluate(f"{STATE}.report.intersections") == 5 and page.evaluate(f"{STATE}.report.strokes") == 1
     assert not page.evaluate(f"{STATE}.report.warnings")
+    # The two crossings, 3 px apart, fan out beside the point; the line starts there, and
+    # its start marker (radius 7) sits clear of both markers as drawn (it used to cover one).
+    assert page.evaluate("window.studio.markers.filter(m => m.moved).length") == 2
+    clearance = page.evaluate("Math.min(...window.studio.starts.flatMap(([x, y]) => "
+                              "window.studio.markers.map(m => Math.hypot(m.x - x, m.y - y) - m.r)))")
+    assert clearance >= 7, clearance
+    page.screenshot(path=str(ARTIFACTS / "studio-hand-2c-triple-split.png"))
     page.click("#undo")
     settle(page, 1, f"!!{TRIPLE}")
     page.check("input[name=tool][value=pairing]")
@@ -134,6 +148,10 @@ def test_a_cursive_word_shows_its_retraces_and_starts_at_a_stems_tip(served, tmp
     # The two pen gaps were bridged: marked where they are.
     assert len(graph["bridges"]) == 2 and "pen gaps bridged: 2" in page.inner_text("#junctions")
     assert sorted(round(a[0], -2) for a, _ in graph["bridges"]) == [400, 700]
+    texts = [p["text"] for p in page.evaluate("window.studio.placed")]
+    assert texts.count("×2") == len(graph["retraces"]) and texts.count("gap") == 2
+    under = curve_under_labels(page)  # "×2" beside its band, "gap" beside its circle, off the curve
+    assert under == {"×2": 0, "gap": 0, "crossing 100%": 0}, under
     page.screenshot(path=str(ARTIFACTS / "studio-hand-3-retraces-gaps.png"))
 
     # The line should start at the word's lead-in (the leftmost free end), which the route
@@ -210,6 +228,35 @@ def test_a_bridged_gap_opened_closed_undone_and_both_pieces_kept(served, tmp_pat
     assert page.evaluate(f"{STATE}.report.strokes") >= 2 and page.evaluate(f"{STATE}.report.dropped") == 0
     assert not [w for w in page.evaluate(f"{STATE}.report.warnings") if "unbridge" in w]
     page.check("input[name=tool][value=pairing]")
+
+
+def test_a_threshold_that_leaves_a_stub_of_the_line_says_so(served):
+    """Blur 3 px, then the threshold dragged down to 0.07: little ink is that dark, and the
+    line shrinks to a stub at the triple point. The page says so with the lengths (it used
+    to show the stub and nothing else); the automatic threshold brings the line back and
+    takes the note back."""
+    page, _ = served["triple"]
+    steps, settings = page.evaluate("window.studio.history.length"), page.evaluate(f"{STATE}.settings")
+    assert settings["threshold"] is None and settings["blur"] == 0
+    drag_slider(page, "#blur", 0.75)
+    settle(page, extra=f"{STATE}.settings.blur === 3")
+    assert page.is_hidden("#hint")  # blurred, the line is still whole
+    drag_slider(page, "#threshold", 0.02)
+    settle(page, extra=f"{STATE}.settings.threshold === 0.07")
+    short = page.evaluate("window.studio.line.total")
+    text = page.inner_text("#hint")
+    assert page.is_visible("#hint") and short < 100, (short, text)
+    assert text.startswith(f"at threshold 0.07 and blur 3 px the line is {round(short)} px long (") and (
+        "most of the ink is lighter than the threshold" in text), text
+    page.screenshot(path=str(ARTIFACTS / "studio-hand-7-threshold-stub.png"))
+    page.click("#auto-threshold")
+    settle(page, extra=f"{STATE}.settings.threshold === null")
+    assert page.evaluate("window.studio.line.total") > 2000 and page.is_hidden("#hint")
+    assert page.evaluate("window.studio.history.length") == steps + 3  # blur, threshold, automatic
+    for _ in range(3):
+        page.click("#undo")
+        settle(page)
+    assert page.evaluate(f"{STATE}.settings") == settings
 
 
 def exports_match_the_cli(page, drawing, edits, tmp_path, command: str, kind: str, *flags) -> None:

@@ -4,6 +4,8 @@ same drawing, edits file and flags (real `onestroke vectorize|embroider|laser` r
 
 from __future__ import annotations
 
+import json
+
 import pytest
 
 from conftest import ARTIFACTS
@@ -166,3 +168,41 @@ def test_load_a_machine_profile(page, studio, edited, tmp_path):
     page.fill(f"{form} input[name=size]", "60mm")
     page.press(f"{form} input[name=size]", "Tab")
     settle(page)
+
+
+def test_header_actions_answer_in_the_panel_in_view(page, studio, tmp_path):
+    """Open, load and save sit in the header, at hand on every tab: on the Embroidery tab
+    what they say is in that panel (it used to go to the hidden Refine panel, and the
+    user saw nothing)."""
+    page.click("nav .tab[data-tab=embroidery]")
+    settle(page, extra="document.getElementById('embroidery-stats').textContent.includes('stitches')")
+    edits = page.evaluate("window.studio.state.edits")
+    (tmp_path / "notes.json").write_text("these are not edits")
+    page.set_input_files("#open", str(tmp_path / "notes.json"))
+    page.wait_for_function("document.getElementById('embroidery-warnings').textContent.includes('notes.json')")
+    assert page.inner_text("#embroidery-warnings") == "error: notes.json is not an edits file (not JSON)"
+    (tmp_path / "other.json").write_text('{"format": "something else"}')
+    page.set_input_files("#open", str(tmp_path / "other.json"))
+    page.wait_for_function("document.getElementById('embroidery-warnings').textContent.includes('not an onestroke')")
+    settle(page)
+    assert page.is_visible("#embroidery-warnings") and page.evaluate("window.studio.state.edits") == edits
+    saved = studio[1].with_suffix(".edits.json")
+    if not saved.exists():
+        page.click("#load")
+        page.wait_for_function("document.getElementById('embroidery-warnings').textContent.includes('no edits saved')")
+    page.click("#save")
+    page.wait_for_function("document.getElementById('embroidery-warnings').textContent.startsWith('saved ')")
+    assert saved.exists() and page.is_visible("#embroidery-warnings")
+    page.click("#load")
+    page.wait_for_function("document.getElementById('embroidery-warnings').textContent.includes('already')")
+    # An edit made on the drawing meanwhile: new stitches, and the note makes way for the
+    # panel's own warnings.
+    junction = page.evaluate("window.studio.state.graph.junctions.find(j => j.role === 'crossing')")
+    click_at(page, junction["at"])
+    settle(page, extra="window.studio.state.edits.edits.some(e => e.kind === 'pairing' && e.pairing !== "
+                       f"{json.dumps(junction['decision'])}) && "
+                       "!document.getElementById('embroidery-warnings').textContent.includes('already')")
+    page.click("#undo")
+    settle(page)
+    assert page.evaluate("window.studio.state.edits") == edits
+    page.click("nav .tab[data-tab=refine]")

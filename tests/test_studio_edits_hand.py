@@ -91,3 +91,37 @@ def _triple_edits(base):
 
 def _little_edits(base):
     yield [Edit(kind="merge", at=base.graph.branches[0].at), Edit(kind="twice", at=base.drawing.strokes[0].start)]
+
+
+def test_a_twice_the_line_cannot_keep_is_said(drawings):
+    """"Draw a stretch twice here" where the line's cheapest route has no reason to come back
+    (a lead-in whose tip is the chosen start) changes nothing: the warnings say so, and a
+    twice the line keeps says nothing."""
+    path, cache = drawings["little"], StageCache()
+    base = vectorize_file(path, VectorizeOptions(), edits=Edits(), cache=cache)
+    lead_in = min(base.graph.retraces, key=lambda r: r["at"][0])  # the word's lead-in, drawn out and back
+    tip = min(base.graph.ends, key=lambda e: e[0])
+    started = Edits(items=(Edit(kind="start", at=tuple(tip)),))
+    start = vectorize_file(path, VectorizeOptions(), edits=started, cache=cache)
+    assert not any(r["at"] == lead_in["at"] for r in start.graph.retraces)  # started at its tip: drawn once
+    kept = Edits(items=started.items + (Edit(kind="twice", at=tuple(lead_in["at"])),))
+    result = vectorize_file(path, VectorizeOptions(), edits=kept, cache=cache)
+    assert drawing_to_svg(result.drawing) == drawing_to_svg(start.drawing)
+    x, y = lead_in["at"]
+    assert [w for w in result.report.warnings if "still drawn once" in w] == [
+        f"the stretch at {x:.0f}, {y:.0f} is still drawn once: the line goes back over a stretch only where "
+        "that is its shortest way on to the rest of the drawing, and it is not here"]
+    # Between two junctions mid-word a twice is kept: the line is longer and nothing is said.
+    middle = base.graph.branches[0]
+    heeded = vectorize_file(path, VectorizeOptions(), cache=cache,
+                            edits=Edits(items=(Edit(kind="twice", at=tuple(middle.at)),)))
+    assert heeded.drawing.length > base.drawing.length + middle.length
+    assert not [w for w in heeded.report.warnings if "still drawn" in w]
+    # Multi-stroke mode draws no route over the whole drawing: there the same twice (and a
+    # once on a stretch drawn twice) acts on nothing by the mode, and says that, not that
+    # it "matched nothing" (the stretch is right there).
+    items = (Edit(kind="twice", at=tuple(middle.at)), Edit(kind="once", at=tuple(lead_in["at"])))
+    multi = vectorize_file(path, VectorizeOptions(), cache=cache, edits=Edits(multi=True, items=items))
+    assert [w for w in multi.report.warnings if w.startswith("edit ")] == [
+        f"edit 1 (twice at {middle.at[0]:.0f}, {middle.at[1]:.0f}) acts in single-line mode only and was skipped",
+        f"edit 2 (once at {x:.0f}, {y:.0f}) acts in single-line mode only and was skipped"]

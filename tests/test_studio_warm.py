@@ -18,6 +18,26 @@ def test_neighbours_are_one_slider_step_away_in_the_direction_of_the_move(drawin
     assert [(e.threshold, e.blur) for e in found] == [(0.44, 0.5), (0.46, 0.5), (0.45, 0.75), (0.45, 0.25)]
     # The automatic threshold has no slider position to step from; blur stays in 0..4.
     assert [(e.threshold, e.blur) for e in session.neighbours(Edits())] == [(None, 0.25)]
+    # With the automatic threshold the slider sits at the threshold in use, on its 0.01 grid:
+    # the first drag goes one step either way, unticking "automatic" sends the position.
+    found = session.neighbours(Edits(), automatic=0.2255)
+    assert [(e.threshold, e.blur) for e in found] == [(0.24, None), (0.22, None), (None, 0.25), (0.23, None)]
+
+
+def test_the_first_slider_step_from_the_automatic_threshold_is_warmed(drawing):
+    session = StudioSession(drawing, edits_path=Path(os.devnull), classifier="geometric", precompute=True)
+    automatic = session.state(Edits())["report"]["threshold"]
+    assert session.idle(120)
+    fronts = len(session.cache.front)
+    for value in (round(automatic, 2) + 0.01, round(automatic, 2) - 0.01, round(automatic, 2)):
+        session.precompute = False  # (what this answer would warm is not the question)
+        warmed = session.state(Edits(threshold=round(value, 2)))
+        assert len(session.cache.front) == fronts, value  # answered from the cache
+        fresh = StudioSession(drawing, edits_path=Path(os.devnull), classifier="geometric").state(
+            Edits(threshold=round(value, 2)))
+        for state in (warmed, fresh):
+            state["report"].pop("seconds")
+        assert warmed == fresh
 
 
 def test_warmed_neighbours_answer_from_the_cache_with_a_fresh_sessions_state(drawing):

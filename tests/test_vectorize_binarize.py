@@ -14,9 +14,12 @@ from scipy import ndimage
 from tests.conftest import figure_eight, render_polylines
 from tests.test_vectorize_inputs import shaded_scan
 from vectorize.binarize import (
+    blurred,
+    downscaled_gray,
     estimate_stroke_width,
     extract_ink,
     frame_labels,
+    grow,
     ink_depth,
     ink_image,
     ink_threshold,
@@ -184,6 +187,31 @@ def test_ink_depth_on_small_masks_at_the_edges():
         assert np.array_equal(ink_depth(mask), ndimage.distance_transform_edt(mask))
         if mask.any():
             assert estimate_stroke_width(mask) == _scipy_width(mask)
+
+
+@pytest.mark.parametrize("name, page", _pages(), ids=[name for name, _ in _pages()])
+def test_the_blur_of_the_box_is_skimages_blur_of_the_whole_image(name, page):
+    from skimage.filters import gaussian
+
+    gray, _ = downscaled_gray(page, max_size=1000)
+    spotted = gray.copy()
+    spotted[0, -1] = spotted[-1, 0] = 0.5  # a dark pixel in two corners: the box is the image
+    for image in (gray, spotted):
+        for blur in (0.3, 1.0, 2.5):
+            expected = gaussian(image, sigma=blur, preserve_range=True).astype(np.float32)
+            assert np.array_equal(blurred(image, blur), expected), (name, blur)
+    assert blurred(gray, 0.0) is gray
+
+
+def test_grow_is_scipys_binary_dilation():
+    rng = np.random.default_rng(5)
+    masks = [np.zeros((3, 4), bool), np.ones((1, 6), bool), np.eye(7, dtype=bool)[::-1]]
+    masks += [rng.random((rng.integers(1, 30), rng.integers(1, 30))) < rng.random() * 0.3 for _ in range(100)]
+    for mask in masks:
+        for steps in (1, 2, 3):
+            assert np.array_equal(grow(mask, steps), ndimage.binary_dilation(mask, iterations=steps))
+            assert np.array_equal(grow(mask, steps, square=True),
+                                  ndimage.binary_dilation(mask, structure=np.ones((3, 3)), iterations=steps))
 
 
 def test_a_phone_photo_becomes_gray_row_block_by_row_block():

@@ -38,11 +38,12 @@ KEEP_IMAGES = 8
 class StageCache:
     """Results of the early stages for one image (the studio keeps one per drawing).
 
-    paper: (blur, max_size) -> (gray, scale) of `vectorize.binarize.paper_gray` (the
-    threshold does not change it); axis: (threshold, blur, max_size) -> (ink, rings,
-    medial graph before pruning) (the mode does not change them); front: `front_key` ->
-    the pruned (and in single-line mode bridged) graph with its ink (the "unbridge" edits
-    change it too).
+    gray: (max_size,) -> (gray, scale) of `vectorize.binarize.downscaled_gray` (neither
+    blur nor threshold change it); paper: (blur, max_size) -> (gray, scale) of
+    `vectorize.binarize.paper_gray` (the threshold does not change it); axis: (threshold,
+    blur, max_size) -> (ink, rings, medial graph before pruning) (the mode does not change
+    them); front: `front_key` -> the pruned (and in single-line mode bridged) graph with its
+    ink (the "unbridge" edits change it too).
 
     cancel: None or a callable the pipeline asks between stages; when it says True the run
     stops with `onestroke.errors.Cancelled`. Every entry is stored only once its stage has
@@ -51,6 +52,7 @@ class StageCache:
 
     def __init__(self) -> None:
         self.loaded = None  # ((path, max_size), (image, frame)) of the last file read
+        self.gray: dict = {}
         self.paper: dict = {}
         self.axis: dict = {}
         self.front: dict = {}
@@ -69,7 +71,7 @@ class StageCache:
         positions), computed once; compute(cache) may use `stage` for the parts that fewer
         options change."""
         if self._image is not image:
-            for store in (self.paper, self.axis, self.front, self.simplified, self.solved):
+            for store in (self.gray, self.paper, self.axis, self.front, self.simplified, self.solved):
                 store.clear()
             self._image = image
         key = front_key(options, edits)
@@ -78,7 +80,7 @@ class StageCache:
         return self.front[key]
 
     def stage(self, name: str, key: tuple, compute):
-        """The cached result of stage `name` ("paper" or "axis") for `key`, computed once."""
+        """The cached result of stage `name` ("gray", "paper" or "axis") for `key`, computed once."""
         store = getattr(self, name)
         if key not in store:
             _bounded_put(store, key, compute(), KEEP_IMAGES)
@@ -415,21 +417,34 @@ class Refinement:
 
     def unheeded(self, solution) -> list[str]:
         """One warning per "once" edit whose branch the line still draws twice (every other
-        way to join the ends that retrace joins is marked "once" too, or there is none)."""
+        way to join the ends that retrace joins is marked "once" too, or there is none), and
+        per "twice" edit whose branch it still draws once (route inspection goes back over a
+        branch only on a path joining two odd nodes, and no cheapest one runs there, or the
+        start chosen at that branch's tip forbids it): a click that changes nothing says why."""
         count = _pass_counts(solution)
         result = []
-        for edit in self.edits.of("once"):
+        for edit in self.edits.of("once", "twice"):
             bid = _nearest_branch(solution.graph, self.to_working(edit.at), self.tol + self.w)
-            if bid is not None and count.get(bid, 0) > 1:
-                result.append(f"the stretch at {edit.at[0]:.0f}, {edit.at[1]:.0f} is still drawn twice: "
-                              "one line over the drawing found no way around it")
+            if bid is None:
+                continue
+            where = f"the stretch at {edit.at[0]:.0f}, {edit.at[1]:.0f}"
+            if edit.kind == "once" and count.get(bid, 0) > 1:
+                result.append(f"{where} is still drawn twice: one line over the drawing found no way around it")
+            if edit.kind == "twice" and count.get(bid, 0) < 2:
+                result.append(f"{where} is still drawn once: the line goes back over a stretch only where "
+                              "that is its shortest way on to the rest of the drawing, and it is not here")
         return result
 
     def unmatched(self) -> list[str]:
-        """One warning per edit that found nothing to act on."""
-        return [f"edit {i + 1} ({e.kind} at {e.at[0]:.0f}, {e.at[1]:.0f}) matched nothing within "
-                f"{self.edits.tolerance:g} px and was skipped"
-                for i, e in enumerate(self.edits.items) if i not in self.hits]
+        """One warning per edit that found nothing to act on; "twice" and "once" in
+        multi-stroke mode, which draws no route over the whole drawing, act on nothing by
+        their mode, wherever they are (not "matched nothing": the stretch may be right there)."""
+        def said(i, e):
+            head = f"edit {i + 1} ({e.kind} at {e.at[0]:.0f}, {e.at[1]:.0f})"
+            if self.options.multi and e.kind in ("twice", "once"):
+                return f"{head} acts in single-line mode only and was skipped"
+            return f"{head} matched nothing within {self.edits.tolerance:g} px and was skipped"
+        return [said(i, e) for i, e in enumerate(self.edits.items) if i not in self.hits]
 
     # -- the page's view -------------------------------------------------------------
     def graph_view(self, solution, bridges=(), refused=()) -> GraphView:

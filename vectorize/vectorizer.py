@@ -9,7 +9,7 @@ from typing import TYPE_CHECKING, NamedTuple
 import numpy as np
 
 from onestroke.errors import InputError
-from vectorize.binarize import ink_image, paper_gray
+from vectorize.binarize import downscaled_gray, ink_image, paper_gray
 from vectorize.drawing import Drawing
 from vectorize.edits import Edits
 from vectorize.fitting import TracedPoints, fit_stroke
@@ -329,7 +329,11 @@ def _axis(image: np.ndarray, options: VectorizeOptions, clock: _Clock, cache: St
     # Every piece of ink is kept here; in single-line mode the pieces of a line broken by
     # pen gaps are bridged later, and only then is the largest kept.
     def paper():
-        return paper_gray(image, max_size=options.max_size, blur=options.blur)
+        if cache is None:
+            return paper_gray(image, max_size=options.max_size, blur=options.blur)
+        # The downscaled gray is the same at every blur: a blur change starts from it.
+        scaled = cache.stage("gray", (options.max_size,), lambda: downscaled_gray(image, max_size=options.max_size))
+        return paper_gray(image, max_size=options.max_size, blur=options.blur, downscaled=scaled)
 
     gray, scale = paper() if cache is None else cache.stage("paper", (options.blur, options.max_size), paper)
     ink = ink_image(gray, scale, threshold=options.threshold)

@@ -135,10 +135,19 @@ class StudioSession:
             finally:
                 self.cache.cancel = None
 
-    def neighbours(self, edits: Edits, previous: Edits | None = None) -> list[Edits]:
-        """The settings one slider step away from `edits` (threshold only when the user set
-        one; blur within the slider's range), the direction of the last move first."""
+    def neighbours(self, edits: Edits, previous: Edits | None = None,
+                   automatic: float | None = None) -> list[Edits]:
+        """The settings one slider step away from `edits` (blur within the slider's range),
+        the direction of the last move first. automatic: the threshold the vectorizer chose
+        when `edits` leave it automatic; the page puts the slider there (rounded to its
+        step), so the first drag sends one step either side of it, and unticking
+        "automatic" sends that position itself: those are warmed too."""
         found = []
+        if edits.threshold is None and automatic is not None:
+            position = round(automatic, 2)
+            found += [replace(edits, threshold=value) for value in
+                      (round(position + THRESHOLD_STEP, 2), round(position - THRESHOLD_STEP, 2))
+                      if 0.0 < value < 1.0]
         moved = {}
         if previous is not None:
             for name in ("threshold", "blur"):
@@ -155,16 +164,19 @@ class StudioSession:
             value = round(blur + sign * BLUR_STEP, 2)
             if 0.0 <= value <= MAX_BLUR:
                 found.append(replace(edits, blur=value))
+        if edits.threshold is None and automatic is not None and 0.0 < round(automatic, 2) < 1.0:
+            found.append(replace(edits, threshold=round(automatic, 2)))
         return found
 
-    def warm_neighbours(self, edits: Edits, previous: Edits | None = None) -> threading.Thread:
+    def warm_neighbours(self, edits: Edits, previous: Edits | None = None,
+                        automatic: float | None = None) -> threading.Thread:
         """Compute the neighbouring slider values of `edits` in a background thread, so that
         the next step of a slider is answered from the cache. The answer is the same as
         without it (the cache holds what a fresh run computes); any request stops it."""
         generation = self._generation
 
         def work() -> None:
-            for neighbour in self.neighbours(edits, previous):
+            for neighbour in self.neighbours(edits, previous, automatic):
                 if generation != self._generation:
                     return
                 try:
@@ -224,7 +236,7 @@ class StudioSession:
             "edits": edits.to_dict(),
         }
         if self.precompute:
-            self.warm_neighbours(edits, self._shown)
+            self.warm_neighbours(edits, self._shown, report.threshold)
         self._shown = edits
         return answer
 

@@ -118,8 +118,15 @@ export function createPlayer(root, input, options = {}) {
   let fitScale = 1;  // the scale "fit" chose: following the head only makes sense zoomed in
   let dpr = window.devicePixelRatio || 1;
 
+  // The data's y as drawn (down the canvas): G-code's y points up, so it is flipped.
+  const down = (y) => (d.yUp ? -y : y);
   const sx = (i) => view.ox + d.x[i] * view.scale;
-  const sy = (i) => view.oy + (d.yUp ? -d.y[i] : d.y[i]) * view.scale;
+  const sy = (i) => view.oy + down(d.y[i]) * view.scale;
+  // The frame (hoop, bed) as drawn: [left, top, right, bottom] in the data's units, y down.
+  function frameRect() {
+    const [x0, y0, x1, y1] = d.frame;
+    return [x0, Math.min(down(y0), down(y1)), x1, Math.max(down(y0), down(y1))];
+  }
 
   // index of the last row finished at time `t` (-1 if none): binary search on d.t
   function rowAt(t) {
@@ -212,7 +219,7 @@ export function createPlayer(root, input, options = {}) {
     for (const pass of [true, false]) {
       for (let i = 0; i < d.n; i++) {
         if (pass && d.kind[i] !== DRAW && d.kind[i] !== DOWN) continue;
-        const x = d.x[i], y = d.yUp ? -d.y[i] : d.y[i];
+        const x = d.x[i], y = down(d.y[i]);
         if (x < xmin) xmin = x; if (x > xmax) xmax = x; if (y < ymin) ymin = y; if (y > ymax) ymax = y;
         any = true;
       }
@@ -221,8 +228,7 @@ export function createPlayer(root, input, options = {}) {
     // The frame (a hoop, a bed) too when it is about the design's size: which hoop the
     // design sits in is part of the picture; a 400 mm bed around an 80 mm design is not.
     if (d.frame && any) {
-      const [x0, y0, x1, y1] = d.frame;
-      const fy0 = d.yUp ? -y1 : y0, fy1 = d.yUp ? -y0 : y1;
+      const [x0, fy0, x1, fy1] = frameRect();
       if (Math.max(x1 - x0, fy1 - fy0) <= 3 * Math.max(xmax - xmin, ymax - ymin)) {
         xmin = Math.min(xmin, x0); xmax = Math.max(xmax, x1); ymin = Math.min(ymin, fy0); ymax = Math.max(ymax, fy1);
       }
@@ -264,8 +270,7 @@ export function createPlayer(root, input, options = {}) {
 
     ctx.clearRect(0, 0, w, h);
     if (d.frame) {
-      const [x0, y0, x1, y1] = d.frame, s = view.scale;
-      const ya = d.yUp ? -y1 : y0, yb = d.yUp ? -y0 : y1;
+      const [x0, ya, x1, yb] = frameRect(), s = view.scale;
       ctx.save(); ctx.strokeStyle = "#b0b0b0"; ctx.lineWidth = dpr; ctx.setLineDash([6 * dpr, 4 * dpr]);
       ctx.strokeRect(view.ox + x0 * s, view.oy + ya * s, (x1 - x0) * s, (yb - ya) * s); ctx.restore();
     }
@@ -307,7 +312,7 @@ export function createPlayer(root, input, options = {}) {
     dom.kind.textContent = (KIND_TEXT[d.source] || KIND_TEXT.drawing)[d.kind[shownRow]] || "";
     dom.swatch.style.background = d.palette[d.color[shownRow]];
     const wx = (hx - view.ox) / view.scale, wy = (hy - view.oy) / view.scale;
-    dom.where.textContent = `x ${wx.toFixed(1)} y ${(d.yUp ? -wy : wy).toFixed(1)} ${d.unit}`;
+    dom.where.textContent = `x ${wx.toFixed(1)} y ${down(wy).toFixed(1)} ${d.unit}`;
     if (!scrubbing) dom.scrub.value = String(Math.round(d.total > 0 ? time / d.total * SCRUB_STEPS : 0));
     dom.play.textContent = playing ? "❚❚ Pause" : "▶ Play";
     root.dataset.index = String(i);
@@ -354,8 +359,7 @@ export function createPlayer(root, input, options = {}) {
     // canvas (inside: 0..1), or null without one.
     frameBox() {
       if (!d || !d.frame) return null;
-      const [x0, y0, x1, y1] = d.frame, w = dom.canvas.width, h = dom.canvas.height;
-      const ya = d.yUp ? -y1 : y0, yb = d.yUp ? -y0 : y1;
+      const [x0, ya, x1, yb] = frameRect(), w = dom.canvas.width, h = dom.canvas.height;
       return [(view.ox + x0 * view.scale) / w, (view.oy + ya * view.scale) / h,
               (view.ox + x1 * view.scale) / w, (view.oy + yb * view.scale) / h];
     },

@@ -35,7 +35,7 @@ async function apply(edits, push = true) {
   } catch (error) {
     // A refused edits state (e.g. an opened file that is not an edits file) is no step.
     if (push && studio.history[studio.at] === edits) { studio.history.pop(); studio.at -= 1; updateButtons(); }
-    if (ticket === studio.requests) report(error);
+    if (ticket === studio.requests) tell(error.message, true);
   } finally {
     busy(false);
     if (rerun) rerunning(-1);
@@ -49,12 +49,27 @@ function rerunning(step) {
   $("tab-refine").classList.toggle("rerunning", studio.rerunning > 0);
 }
 
-function withEdit(edit, replaceNear) {
-  const edits = JSON.parse(JSON.stringify(currentEdits()));
-  if (replaceNear) {
-    // One pairing per junction: a new choice replaces the old one instead of piling up.
-    edits.edits = edits.edits.filter((e) => !(e.kind === edit.kind && dist(e.at, edit.at) <= edits.tolerance));
-  }
+// Does edit e, of one of these kinds, lie within the edits' tolerance of `at` (by
+// `distance(e.at, at)`, image px: the radius within which the library matches an edit to
+// its junction or branch)?
+function isNear(e, edits, kinds, at, distance = dist) {
+  return kinds.includes(e.kind) && distance(e.at, at) <= edits.tolerance;
+}
+
+// A copy of `edits` without its edits of these kinds near `at`.
+function without(edits, kinds, at = null, distance = dist) {
+  const copy = JSON.parse(JSON.stringify(edits));
+  copy.edits = copy.edits.filter((e) => !isNear(e, copy, kinds, at, distance));
+  return copy;
+}
+
+// The current edits with these settings changed (threshold, blur, multi).
+function withSettings(change) { return Object.assign(without(currentEdits(), []), change); }
+
+// The current edits plus `edit`, which replaces the edits of the kinds `replaces` near its
+// place (one pairing per junction: a new choice replaces the old one instead of piling up).
+function withEdit(edit, replaces = []) {
+  const edits = without(currentEdits(), replaces, edit.at);
   edits.edits.push(edit);
   return edits;
 }
@@ -162,7 +177,7 @@ function draw() {
   arrows(g, t);
   junctionMarkers(g);
   bridges(g);
-  const starts = startPlaces();
+  const starts = studio.starts = startPlaces();  // screen px, for the tests too
   placeLabels(g, starts.map(([x, y]) => [x - 8, y - 8, 16, 16]));
   startMarkers(g, starts);
   if (studio.pen < 1 || studio.playing) penMarker(g, t, penAt);
@@ -179,12 +194,28 @@ function toSegment(p, [a, b]) {
   return dist(p, [a[0] + t * dx, a[1] + t * dy]);
 }
 
+// The branch a merge at unresolved junction j collapses: its shortest, to the degree-3 node
+// it leads to (the two are one crossing again), or undefined.
+function shortestBranch(j) {
+  return studio.state.graph.branches.filter((b) => (b.nodes || []).includes(j.id))
+    .sort((a, b) => a.length - b.length)[0];
+}
+
+// Merge unresolved junction j by its shortest branch (its button and the merge tool's click
+// on it); null when no branch leads from it.
+function mergeBranch(j) {
+  const branch = shortestBranch(j);
+  if (!branch) return null;
+  hint("");
+  return apply(withEdit({ kind: "merge", at: branch.at }));
+}
+
 // What an unresolved junction offers: merge it with the degree-3 node its shortest branch
 // leads to (one crossing again), and drop a split made there. Buttons, for the hint shown
 // on a click and the junction list.
 function unresolvedFixes(j) {
   const s = studio.state, buttons = [];
-  const branch = s.graph.branches.filter((b) => (b.nodes || []).includes(j.id)).sort((a, b) => a.length - b.length)[0];
+  const branch = shortestBranch(j);
   if (branch) {
     const other = s.graph.junctions.find((o) => o.id === branch.nodes.find((n) => n !== j.id));
     const button = document.createElement("button");
@@ -192,21 +223,15 @@ function unresolvedFixes(j) {
     button.textContent = other ? `merge with (${other.at[0].toFixed(0)}, ${other.at[1].toFixed(0)}): one crossing`
       : "merge by its shortest branch";
     button.title = `collapse the ${branch.length.toFixed(0)} px branch between them into a degree-4 crossing`;
-    button.onclick = () => { hint(""); apply(withEdit({ kind: "merge", at: branch.at }, false)); };
+    button.onclick = () => mergeBranch(j);
     buttons.push(button);
   }
-  const tol = currentEdits().tolerance;
-  const splits = currentEdits().edits.filter((e) => e.kind === "split" && dist(e.at, j.at) <= tol);
-  if (splits.length) {
+  const edits = currentEdits();
+  if (edits.edits.some((e) => isNear(e, edits, ["split"], j.at))) {
     const button = document.createElement("button");
     button.className = "unsplit";
     button.textContent = "undo the split here";
-    button.onclick = () => {
-      hint("");
-      const edits = JSON.parse(JSON.stringify(currentEdits()));
-      edits.edits = edits.edits.filter((e) => !(e.kind === "split" && dist(e.at, j.at) <= edits.tolerance));
-      apply(edits);
-    };
+    button.onclick = () => { hint(""); apply(without(currentEdits(), ["split"], j.at)); };
     buttons.push(button);
   }
   return buttons;
@@ -216,6 +241,26 @@ function describeUnresolved(j) {
   return `(${j.at[0].toFixed(0)}, ${j.at[1].toFixed(0)}) unresolved: ${j.degree} branches meet and none ` +
     "is read as going on through it, so the line's order here is a guess";
 }
+
+// A threshold or blur that leaves little of the ink (the line shrinks to a stub, the
+// drawing vanishes from the view) says so, beside the longest line this page has shown
+// (a slider moved step by step shrinks the line a little at each answer); a later answer
+// from other settings takes it back.
+function sayShrunk(old) {
+  const s = studio.state, now = studio.line.total;
+  const setting = (st, r) => `${st.threshold === null ? `the automatic threshold ${Number(r.threshold).toFixed(2)}`
+    : `threshold ${Number(st.threshold).toFixed(2)}`} and blur ${st.blur} px`;
+  const moved = old && SETTINGS.some((k) => old.edits[k] !== s.edits[k]);
+  const most = studio.longest;
+  if (moved && most && now < SHRUNK * most.total) {
+    hint(`at ${setting(s.settings, s.report)} the line is ${Math.round(now)} px long (${Math.round(most.total)} px at ` +
+      `${most.setting}): most of the ink is lighter than the threshold (blur lightens thin lines); raise the ` +
+      "threshold, lower the blur or tick \"automatic threshold\"");
+    studio.shrunk = true;
+  } else if (studio.shrunk && moved) { hint(""); studio.shrunk = false; }
+  if (!most || now > most.total) studio.longest = { total: now, setting: setting(s.settings, s.report) };
+}
+const SHRUNK = 0.25;  // a line under a quarter of the longest shown is a stub
 
 // The pen's place through an edit: a paused (or playing) pen stays on the spot of the
 // drawing where it was, i.e. at the new curve's point nearest to it; where the new curve
@@ -262,11 +307,12 @@ function penMarker(g, t, penAt) {
 // ---------------------------------------------------------------- showing a state
 function show(state) {
   const first = !studio.state;
-  const before = studio.line;
+  const before = studio.line, old = studio.state;
   studio.state = state;
   studio.line = timeline();
   if (first) fit();
   else keepPen(before, studio.line);
+  sayShrunk(old);
   $("name").textContent = state.name;
   const r = state.report;
   $("summary").textContent = `${r.strokes} stroke${r.strokes === 1 ? "" : "s"}, ${r.intersections} crossing` +
@@ -386,7 +432,7 @@ function passChoice(j) {
 }
 
 function choosePasses(j, option) {
-  return apply(withEdit({ kind: "passes", at: j.at, passes: option.passes }, true));
+  return apply(withEdit({ kind: "passes", at: j.at, passes: option.passes }, ["passes"]));
 }
 
 // ---------------------------------------------------------------- clicks on the drawing
@@ -413,6 +459,16 @@ const MISSED = {
     : "no pen gap was bridged in this drawing (single-line mode bridges them; multi-stroke none)",
 };
 
+// What comes of the header's actions (undo, redo, save, load, open: at hand on every tab),
+// said in the panel in view: on Refine an error in its warnings and a note as the hint; on
+// the Embroidery or Laser tab both in that panel's list, where the user is looking.
+function tell(message, error = false) {
+  const list = studio.tab === "refine" ? "warnings" : `${studio.tab}-warnings`;
+  if (error) report(new Error(message), list);
+  else if (studio.tab === "refine") hint(message);
+  else { const li = document.createElement("li"); li.textContent = message; $(list).replaceChildren(li); }
+}
+
 function hint(text, buttons = []) {
   $("hint").textContent = text || "";
   for (const b of buttons) $("hint").append(" ", b);
@@ -435,19 +491,19 @@ function clickTool(s, p, sx, sy) {
   const tool = studio.tool;
   if (tool === "pairing" || tool === "split" || tool === "merge") {
     const open = markerHit(sx, sy, ["unresolved"]);
-    const fixes = open ? unresolvedFixes(open) : [];
-    if (open && tool === "merge" && fixes.length && fixes[0].className === "merge-here") return fixes[0].onclick() || true;
-    if (open && !markerHit(sx, sy, ["crossing", "triple"])) { hint(describeUnresolved(open) + ".", fixes); return "hint"; }
+    const merged = open && tool === "merge" ? mergeBranch(open) : null;
+    if (merged) return merged;
+    if (open && !markerHit(sx, sy, ["crossing", "triple"])) {
+      hint(describeUnresolved(open) + ".", unresolvedFixes(open));
+      return "hint";
+    }
   }
   if (tool === "pairing" || tool === "split") {
     const j = markerHit(sx, sy, ["crossing", "triple"]);
     if (!j) return;
     if (tool === "split") {
       // A pairing chosen at this junction has nothing left to act on once it is split.
-      const edits = withEdit({ kind: "split", at: j.at }, false);
-      edits.edits = edits.edits.filter((e) => !((e.kind === "pairing" || e.kind === "passes") &&
-                                              dist(e.at, j.at) <= edits.tolerance));
-      return apply(edits);
+      return apply(withEdit({ kind: "split", at: j.at }, ["pairing", "passes"]));
     }
     if (j.role === "triple") {
       // The next of the pairings that keep one stroke, in the order of their likelihood.
@@ -456,11 +512,11 @@ function clickTool(s, p, sx, sy) {
       return choosePasses(j, j.options[(k + 1) % j.options.length]);
     }
     const next = PAIRINGS[(PAIRINGS.indexOf(j.decision) + 1) % 3];
-    return apply(withEdit({ kind: "pairing", at: j.at, pairing: next }, true));
+    return apply(withEdit({ kind: "pairing", at: j.at, pairing: next }, ["pairing"]));
   }
   if (tool === "merge") {
     const b = nearest(s.graph.branches, p, 16);
-    return b ? apply(withEdit({ kind: "merge", at: b.at }, false)) : null;
+    return b ? apply(withEdit({ kind: "merge", at: b.at })) : null;
   }
   if (tool === "start") {
     // A stroke's end, or a free end the line passes (the tip of a stem drawn down and back
@@ -470,7 +526,7 @@ function clickTool(s, p, sx, sy) {
       ends.push({ at: stroke.points[0] }, { at: stroke.points[stroke.points.length - 1] });
     }
     const e = nearest(ends, p, 24);
-    return e ? apply(withEdit({ kind: "start", at: e.at.slice(0, 2) }, false)) : null;
+    return e ? apply(withEdit({ kind: "start", at: e.at.slice(0, 2) })) : null;
   }
   if (tool === "retrace") {
     // On a stretch drawn twice: draw it once; elsewhere on the line: go back over it here
@@ -479,28 +535,19 @@ function clickTool(s, p, sx, sy) {
     const onBand = nearest(twice, p, 14);
     const q = onBand || nearest(studio.line.pts.map((q) => ({ at: q })), p, 16);
     if (!q) return;
-    const edit = { kind: onBand ? "once" : "twice", at: q.at.slice(0, 2) };
-    const edits = JSON.parse(JSON.stringify(currentEdits()));
-    edits.edits = edits.edits.filter((e) => !((e.kind === "twice" || e.kind === "once") &&
-                                              dist(e.at, edit.at) <= edits.tolerance));
-    edits.edits.push(edit);
-    return apply(edits);
+    return apply(withEdit({ kind: onBand ? "once" : "twice", at: q.at.slice(0, 2) }, ["twice", "once"]));
   }
   if (tool === "gap") {
     // A gap kept open: close it again (drop the edits that opened it); a bridged gap: open it.
     const open = nearest((s.graph.unbridged || []).map(middle), p, 24);
-    if (open) {
-      const edits = JSON.parse(JSON.stringify(currentEdits()));
-      edits.edits = edits.edits.filter((e) => !(e.kind === "unbridge" && toSegment(e.at, open.ends) <= edits.tolerance));
-      return apply(edits);
-    }
+    if (open) return apply(without(currentEdits(), ["unbridge"], open.ends, toSegment));
     const gap = nearest((s.graph.bridges || []).map(middle), p, 24);
-    return gap ? apply(withEdit({ kind: "unbridge", at: gap.at }, false)) : null;
+    return gap ? apply(withEdit({ kind: "unbridge", at: gap.at })) : null;
   }
   if (tool === "reverse") {
     const points = studio.line.pts.map((q) => ({ at: q }));
     const q = nearest(points, p, 16);
-    return q ? apply(withEdit({ kind: "reverse", at: q.at.slice(0, 2) }, false)) : null;
+    return q ? apply(withEdit({ kind: "reverse", at: q.at.slice(0, 2) })) : null;
   }
 }
 
@@ -563,9 +610,7 @@ function play() {
 // ---------------------------------------------------------------- wiring
 function settingsEdit(change) {
   clearTimeout(previewTimer);
-  const edits = JSON.parse(JSON.stringify(currentEdits()));
-  Object.assign(edits, change);
-  apply(edits);
+  apply(withSettings(change));
 }
 
 // While a slider is dragged, the value it rests on is vectorized already (not yet a step
@@ -575,7 +620,7 @@ let previewTimer = null;
 function preview(change) {
   studio.requests += 1;
   clearTimeout(previewTimer);
-  previewTimer = setTimeout(() => apply(Object.assign(JSON.parse(JSON.stringify(currentEdits())), change), false), 350);
+  previewTimer = setTimeout(() => apply(withSettings(change), false), 350);
 }
 
 function setup() {
@@ -595,7 +640,7 @@ function setup() {
   $("reverse-all").onclick = () => {
     const s = studio.state; if (!s || !s.strokes.length) return;
     const pts = s.strokes[0].points;
-    apply(withEdit({ kind: "reverse", at: pts[Math.floor(pts.length / 2)].slice(0, 2) }, false));
+    apply(withEdit({ kind: "reverse", at: pts[Math.floor(pts.length / 2)].slice(0, 2) }));
   };
   for (const id of ["threshold", "blur"]) $(id).addEventListener("pointerdown", () => { studio.holding = id; });
   window.addEventListener("pointerup", () => { studio.holding = null; });
@@ -613,23 +658,26 @@ function setup() {
   $("scrub").oninput = () => { studio.playing = false; $("play").textContent = "▶ Play"; studio.pen = $("scrub").value / 1000; draw(); };
   setupPanels(() => studio.shown);
   $("save").onclick = async () => {
-    try { const r = await call("api/edits", { edits: currentEdits() }); $("summary").textContent += ` · saved ${r.saved}`; }
-    catch (error) { report(error); }
+    try {
+      const r = await call("api/edits", { edits: currentEdits() });
+      if (studio.tab === "refine") $("summary").textContent += ` · saved ${r.saved}`;
+      else tell(`saved ${r.saved}`);
+    } catch (error) { tell(error.message, true); }
   };
   $("load").onclick = async () => {
     try {
       const r = await call("api/edits");
       // No file yet: nothing to load (applying "no edits" would throw the user's away).
-      if (!r.exists) hint(`no edits saved yet: ${r.path} does not exist (Save edits writes it)`);
-      else if (JSON.stringify(r.edits) === JSON.stringify(currentEdits())) hint(`the edits are those of ${r.path} already`);
+      if (!r.exists) tell(`no edits saved yet: ${r.path} does not exist (Save edits writes it)`);
+      else if (JSON.stringify(r.edits) === JSON.stringify(currentEdits())) tell(`the edits are those of ${r.path} already`);
       else { hint(""); apply(r.edits); }
-    } catch (error) { report(error); }
+    } catch (error) { tell(error.message, true); }
   };
   $("open").onchange = async () => {
     const file = $("open").files[0]; if (!file) return;
     let data;
     try { data = JSON.parse(await file.text()); }
-    catch (error) { report(new Error(`${file.name} is not an edits file (not JSON)`)); }
+    catch (error) { tell(`${file.name} is not an edits file (not JSON)`, true); }
     if (data !== undefined) apply(data);
     $("open").value = "";
   };

@@ -6,16 +6,19 @@ import { $ } from "./api.js";
 import { COLORS, PASS_COLORS, passRank, percent, studio, toScreen } from "./view.js";
 
 // Start markers: where each stroke begins. One that would hide a junction's marker (a line
-// starting at a junction) sits just beyond it along its stroke.
+// starting at a junction) sits just beyond the markers along its stroke: beyond the marker
+// as drawn (fanned out beside its junction, `markerPlaces`) and the junction's dot.
 export function startPlaces() {
   const s = studio.state;
-  const markers = s.graph.junctions.map((j) => ({ at: toScreen(...j.at), r: j.role === "triple" ? 24 : 11 }));
+  const markers = (studio.markers || []).flatMap((m) => {
+    const r = m.j.role === "triple" ? 24 : 11;
+    return m.moved ? [{ at: [m.x, m.y], r }, { at: m.at, r: 4 }] : [{ at: m.at, r }];
+  });
+  const clear = ([px, py], extra) => markers.every((m) => Math.hypot(m.at[0] - px, m.at[1] - py) >= m.r + extra);
   return s.strokes.map((stroke) => {
     const start = toScreen(...stroke.points[0]);
-    const under = markers.find((m) => Math.hypot(m.at[0] - start[0], m.at[1] - start[1]) < m.r + 6);
-    if (!under) return start;
-    return stroke.points.map((p) => toScreen(...p))
-      .find(([px, py]) => Math.hypot(px - under.at[0], py - under.at[1]) > under.r + 9) || start;
+    if (clear(start, 6)) return start;
+    return stroke.points.map((p) => toScreen(...p)).find((p) => clear(p, 9)) || start;
   });
 }
 
@@ -121,20 +124,38 @@ function tripleMarker(g, j) {
 // once every marker is drawn.
 function label(g, text, x, y, gap) { studio.labels.push({ text, x, y, gap }); }
 
+// Screen cells (CURVE_CELL px square, keys "col,row") the drawn curve runs through: a text
+// whose box touches one would hide the line where it matters (a triple point's branches).
+const CURVE_CELL = 6;
+function curveCells(width, height) {
+  const cells = new Set(), t = studio.line;
+  const mark = (x, y) => { if (x >= 0 && y >= 0 && x <= width && y <= height) cells.add(`${Math.floor(x / CURVE_CELL)},${Math.floor(y / CURVE_CELL)}`); };
+  let a = null;
+  for (const p of t ? t.pts : []) {
+    const b = toScreen(p[0], p[1]);
+    if (a && !p.first && Math.max(a[0], b[0]) >= 0 && Math.min(a[0], b[0]) <= width &&
+        Math.max(a[1], b[1]) >= 0 && Math.min(a[1], b[1]) <= height) {
+      const n = Math.ceil(Math.hypot(b[0] - a[0], b[1] - a[1]) / (CURVE_CELL / 2));
+      for (let k = 1; k <= n; k++) mark(a[0] + ((b[0] - a[0]) * k) / n, a[1] + ((b[1] - a[1]) * k) / n);
+    } else mark(b[0], b[1]);
+    a = b;
+  }
+  return cells;
+}
+
 // Each text on a white box so that it reads over the curve, right of its marker, else
 // left, below or above, wherever it stays on the canvas and covers no marker (nor `more`
-// boxes: [x, y, w, h]) and no text placed before (junctions a few px apart would print
-// over each other).
+// boxes: [x, y, w, h]) and no text placed before (junctions a few px apart would print over
+// each other), and hides none of the curve, or the least of it where the curve is all around.
 export function placeLabels(g, more = []) {
   g.font = "11px sans-serif"; g.textAlign = "left"; g.textBaseline = "middle";
-  const boxes = studio.labels.map(({ x, y, gap }) => [x - gap, y - gap, 2 * gap, 2 * gap]).concat(more);
+  const markers = studio.labels.map(({ x, y, gap }) => [x - gap, y - gap, 2 * gap, 2 * gap]).concat(more);
   const h = 13, c = $("canvas");
-  const placed = [];
-  studio.placed = [];  // the texts drawn and their boxes (screen px)
+  const curve = studio.labels.length ? curveCells(c.clientWidth, c.clientHeight) : null;
+  studio.placed = [];  // the texts drawn: their markers' places and their boxes (screen px)
   for (const { text, x, y, gap } of studio.labels) {
     // Two nodes a pixel or two apart (a split crossing) would print the same text twice.
-    if (placed.some((q) => q.text === text && Math.hypot(q.x - x, q.y - y) < 12)) continue;
-    placed.push({ text, x, y });
+    if (studio.placed.some((q) => q.text === text && Math.hypot(q.x - x, q.y - y) < 12)) continue;
     const w = g.measureText(text).width;
     // Right, left, below, above; then the corners; then the same farther out (a crowd of
     // markers: the halves of a split crossing with a "×2" between them).
@@ -144,10 +165,29 @@ export function placeLabels(g, more = []) {
     const spots = around(gap).concat(around(gap + 14), around(gap + 28));
     const covers = (sx, sy, b) => sx < b[0] + b[2] && b[0] < sx + w && sy - h / 2 < b[1] + b[3] && b[1] < sy + h / 2;
     const inside = (sx, sy) => sx >= 2 && sx + w <= c.clientWidth - 2 && sy - h / 2 >= 0 && sy + h / 2 <= c.clientHeight;
-    const [lx, ly] = spots.find(([sx, sy]) => inside(sx, sy) && !boxes.some((b) => covers(sx, sy, b))) ||
-      spots.find(([sx, sy]) => inside(sx, sy)) || spots[0];
-    boxes.push([lx, ly - h / 2, w, h]);
-    studio.placed.push({ text, box: [lx, ly - h / 2, w, h] });
+    const free = (sx, sy) => !markers.some((b) => covers(sx, sy, b)) && !studio.placed.some((q) => covers(sx, sy, q.box));
+    // How much of the curve a box there would hide: the curve's cells under the white box
+    // (2 px wider than the text) and 2 px around it (the line is up to 6 px wide).
+    const hidden = (sx, sy) => {
+      let n = 0;
+      for (let i = Math.floor((sx - 4) / CURVE_CELL); i <= Math.floor((sx + w + 4) / CURVE_CELL); i++) {
+        for (let j = Math.floor((sy - h / 2 - 2) / CURVE_CELL); j <= Math.floor((sy + h / 2 + 2) / CURVE_CELL); j++) {
+          if (curve.has(`${i},${j}`)) n += 1;
+        }
+      }
+      return n;
+    };
+    // Among the places on the canvas clear of markers and texts, the first that hides none
+    // of the curve, else the one that hides least (crossing a line, not lying along it).
+    const clear = spots.filter(([sx, sy]) => inside(sx, sy) && free(sx, sy));
+    let best = null, least = Infinity;
+    for (const spot of clear) {
+      const n = hidden(...spot);
+      if (n < least) { best = spot; least = n; }
+      if (!n) break;
+    }
+    const [lx, ly] = best || spots.find(([sx, sy]) => inside(sx, sy)) || spots[0];
+    studio.placed.push({ text, x, y, box: [lx, ly - h / 2, w, h] });
     g.fillStyle = "rgba(255,255,255,0.8)"; g.fillRect(lx - 2, ly - h / 2, w + 4, h);
     g.strokeStyle = "rgba(255,255,255,0.9)"; g.lineWidth = 3; g.lineJoin = "round"; g.strokeText(text, lx, ly);
     g.fillStyle = "#222"; g.fillText(text, lx, ly);

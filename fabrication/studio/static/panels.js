@@ -3,6 +3,7 @@
 "use strict";
 import { $, busy, call, escapeHtml, report } from "./api.js";
 import { createPlayer } from "./player.js";
+import { studio } from "./view.js";
 
 let edits = () => null;  // the page's current edits state (set by setupPanels)
 
@@ -20,11 +21,10 @@ function panelOptions(kind) {
   if (kind === "laser") return formValues("laser-form");
   return {};
 }
-function activeTab() { return document.querySelector("nav .tab.active").dataset.tab; }
 
 let panelTicket = 0;
 export async function refreshPanel() {
-  const tab = activeTab();
+  const tab = studio.tab;
   if (tab === "refine" || !edits()) return;
   const ticket = ++panelTicket;
   busy(true);
@@ -74,7 +74,7 @@ function showPlayer(kind, data) {
   else players[kind].load(data);
   if (kind === "laser") laserShown += 1;
   players[kind].seek(data.total);  // the finished job first; Play starts it from the beginning
-  window.studio.players = players;
+  studio.players = players;
 }
 
 function showStitches(data) {
@@ -193,6 +193,7 @@ export function setupPanels(currentEdits) {
   edits = currentEdits;
   for (const tab of document.querySelectorAll("nav .tab")) {
     tab.onclick = () => {
+      studio.tab = tab.dataset.tab;
       document.querySelectorAll("nav .tab").forEach((t) => t.classList.toggle("active", t === tab));
       document.querySelectorAll(".panel").forEach((p) => { p.hidden = p.id !== `tab-${tab.dataset.tab}`; });
       refreshPanel();

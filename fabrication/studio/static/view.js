@@ -16,6 +16,7 @@ export const studio = {
   pen: 1,                 // play position, fraction of the total length
   playing: false,
   tool: "pairing",
+  tab: "refine",          // the panel in view ("refine", "embroidery", "laser")
   image: new Image(),
   requests: 0,            // answers to ignore when a newer request was sent
   shown: null,            // the edits of the state shown (what the panels and downloads use)

@@ -1,0 +1,151 @@
+#!/usr/bin/env python
+"""Do two versions of the vectorizer write the same SVG bytes? (speed work must not change
+the output).
+
+    python benchmarks/same_svg.py make /tmp/inputs                 # the inputs, once
+    python benchmarks/same_svg.py run /tmp/inputs /work/wt/base-x /tmp/base.json
+    python benchmarks/same_svg.py run /tmp/inputs . /tmp/new.json
+    python benchmarks/same_svg.py compare /tmp/base.json /tmp/new.json
+
+`make` renders the drawings of every set of `benchmarks/vectorize_bench.py` (seeds 0 and 1,
+"kinds" included; --sets/--seeds/--count to take fewer) as the benchmark hands them to the
+vectorizer, and saves each as a .npy file (exact bytes, any dtype); the examples/ drawings
+are read by path. `run` imports `vectorize` from the given source tree (a git worktree of
+the version to check) and writes the SHA-256 of each output's SVG (or the error message):
+every drawing single-line, seed-0 drawings also multi-stroke; each examples/ drawing at
+several threshold and blur values through one `StageCache` (as the studio does, so the
+cached path is checked too), and the same values fresh. `compare` lists what differs.
+"""
+
+from __future__ import annotations
+
+import argparse
+import hashlib
+import json
+import multiprocessing as mp
+import sys
+import time
+from pathlib import Path
+
+HERE = Path(__file__).resolve().parents[1]
+# (threshold, blur) of the examples' runs: Li's threshold and set ones, no blur and blur.
+SETTINGS = [(None, 0.0), (0.35, 0.0), (0.5, 0.0), (None, 0.75), (0.4, 0.75), (None, 1.5), (0.45, 2.0)]
+
+
+def make(folder: Path, sets: list[str], seeds: list[int], count: int | None) -> int:
+    sys.path.insert(0, str(HERE))
+    import numpy as np
+
+    from benchmarks.conditions import condition_image
+    from benchmarks.render import render_truth
+    from benchmarks.vectorize_bench import DEFAULT_COUNTS, KINDS_COUNT, build_set
+
+    folder.mkdir(parents=True, exist_ok=True)
+    made = 0
+    for name in sets:
+        for seed in seeds:
+            wanted = count or DEFAULT_COUNTS.get(name, KINDS_COUNT)
+            for index, gt in enumerate(build_set(name, wanted, seed)):
+                gray = render_truth(gt)
+                image, _ = condition_image(gt.drawing, gray, gt.meta.get("condition", "clean"),
+                                           np.random.default_rng(index))
+                np.save(folder / f"{name}-s{seed}-{index:03d}.npy", image)
+                made += 1
+    print(f"{made} inputs in {folder}")
+    return 0
+
+
+def _one(task: tuple) -> tuple[str, str]:
+    """(key, SHA-256 of the SVG or the error) of one vectorization."""
+    import numpy as np
+
+    from vectorize import VectorizeOptions, vectorize_file, vectorize_image
+    from vectorize.svg_write import drawing_to_svg
+
+    key, kind, path, settings = task
+    results = []
+    try:
+        if kind == "npy":
+            image = np.load(path)
+            for multi in settings:
+                drawing = vectorize_image(image, VectorizeOptions(multi=multi, classifier="cnn", seed=0)).drawing
+                results.append((f"{key}{' multi' if multi else ''}", drawing_to_svg(drawing)))
+        else:
+            from vectorize.edits import Edits
+            from vectorize.refine import StageCache
+
+            cache = StageCache()  # one per drawing, as the studio keeps
+            for threshold, blur in SETTINGS:
+                for multi in (False, True):
+                    edits = Edits(threshold=threshold, blur=blur, multi=multi)
+                    for how, shared in (("cached", cache), ("fresh", None)):
+                        drawing = vectorize_file(path, VectorizeOptions(classifier="cnn"), edits=edits,
+                                                 cache=shared).drawing
+                        results.append((f"{key} t={threshold} b={blur} multi={multi} {how}", drawing_to_svg(drawing)))
+    except Exception as exc:  # noqa: BLE001 - a failure is an output to compare too
+        return [(key, f"{type(exc).__name__}: {exc}")]
+    return [(k, hashlib.sha256(svg.encode()).hexdigest()) for k, svg in results]
+
+
+def run(folder: Path, tree: Path, out: Path, jobs: int) -> int:
+    sys.path.insert(0, str(tree.resolve()))
+    import vectorize
+
+    source = Path(vectorize.__file__).resolve().parents[1]
+    tasks = []
+    for path in sorted(folder.glob("*.npy")):
+        tasks.append((path.stem, "npy", str(path), (False, True) if "-s0-" in path.stem else (False,)))
+    for path in sorted((HERE / "examples").glob("*.png")):
+        tasks.append((path.name, "file", str(path), None))
+    start = time.perf_counter()
+    hashes = {}
+    with mp.get_context("fork").Pool(jobs) as pool:
+        for pairs in pool.imap_unordered(_one, tasks):
+            hashes.update(pairs)
+    out.write_text(json.dumps(dict(sorted(hashes.items())), indent=0))
+    print(f"vectorize from {source}: {len(hashes)} outputs of {len(tasks)} drawings in "
+          f"{time.perf_counter() - start:.0f} s -> {out}")
+    return 0
+
+
+def compare(a: Path, b: Path) -> int:
+    first, second = json.loads(a.read_text()), json.loads(b.read_text())
+    differ = sorted(k for k in first.keys() | second.keys() if first.get(k) != second.get(k))
+    errors = sum(1 for v in first.values() if len(v) != 64)
+    for key in differ:
+        print(f"DIFFERS {key}: {first.get(key)} != {second.get(key)}")
+    print(f"{len(first)} and {len(second)} outputs; {len(differ)} differ; {errors} are errors in both")
+    return 1 if differ else 0
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    sub = ap.add_subparsers(dest="command", required=True)
+    m = sub.add_parser("make")
+    m.add_argument("folder", type=Path)
+    m.add_argument("--sets", nargs="*", default=None, help="default: every set and kinds")
+    m.add_argument("--seeds", nargs="*", type=int, default=[0, 1])
+    m.add_argument("--count", type=int, default=None, help="drawings per set (default: the benchmark's)")
+    r = sub.add_parser("run")
+    r.add_argument("folder", type=Path)
+    r.add_argument("tree", type=Path, help="the source tree whose vectorize to run")
+    r.add_argument("out", type=Path)
+    r.add_argument("--jobs", type=int, default=2)
+    c = sub.add_parser("compare")
+    c.add_argument("a", type=Path)
+    c.add_argument("b", type=Path)
+    args = ap.parse_args(argv)
+    if args.command == "make":
+        if args.sets is None:
+            sys.path.insert(0, str(HERE))
+            from benchmarks.vectorize_bench import SETS
+
+            args.sets = [*SETS, "kinds"]
+        return make(args.folder, args.sets, args.seeds, args.count)
+    if args.command == "run":
+        return run(args.folder, args.tree, args.out, args.jobs)
+    return compare(args.a, args.b)
+
+
+if __name__ == "__main__":
+    sys.exit(main())
