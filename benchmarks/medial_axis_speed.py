@@ -7,8 +7,9 @@ the hershey ampersand; --tsp adds the first N TSP-art drawings of the `kinds` se
 outline samples each). Each drawing is binarized and outlined as the vectorizer does, then
 its medial axis is computed R (7) times per way, and the medians are printed:
 
-- wall and CPU seconds (all threads) of the whole diagram (`tiles=1`) and of the default
-  (one tile per core from `TILED_SAMPLES` outline samples on);
+- wall and CPU seconds (all threads) of the whole diagram (`tiles=1`) and in one tile per
+  core (what the default does from `TILED_SAMPLES` outline samples on while the load
+  average leaves a core to spare);
 - "idle": the default's CPU minus its tiles' CPU plus the longest tile's (each worker's
   `time.thread_time`): its wall time on a machine with a free core per tile. On a loaded
   machine the wall columns include waiting for a core (the load average is printed).
@@ -101,7 +102,8 @@ def main(argv: list[str] | None = None) -> int:
         rings, gray, level = _inputs(image, (binarize, outline_rings))
         samples = sum(len(r) for r in rings)
         row = {}
-        for way, kwargs in (("whole", {"tiles": 1} if tiled else {}), ("tiled", {})):
+        cores = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count()
+        for way, kwargs in (("whole", {"tiles": 1} if tiled else {}), ("tiled", {"tiles": cores})):
             if way == "tiled" and not tiled:
                 continue
             medial.medial_axis(rings, gray, level, **kwargs)  # warm up

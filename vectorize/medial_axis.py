@@ -33,9 +33,11 @@ def medial_axis(rings: list[np.ndarray], gray: np.ndarray, level: float, *, tile
     A ridge is kept when both its vertices lie inside the ink and its two generating samples
     are not neighbours on one ring (those ridges cut the outline, not the ink's middle).
     Vertices come in the order of their coordinates and ridges in the order of their
-    vertices, so the graph does not depend on how the diagram was computed. tiles: how many tiles to compute the diagram in, one thread each (1: whole;
-    None: one per core from `TILED_SAMPLES` samples on); it falls back to the whole diagram
-    where the ink's widest part would make the tiles overlap too much.
+    vertices, so the graph does not depend on how the diagram was computed.
+    tiles: how many tiles to compute the diagram in, one thread each (1: whole; None: one
+    per core from `TILED_SAMPLES` samples on, while the machine has a core to spare); it
+    falls back to the whole diagram where the ink's widest part would make the tiles
+    overlap too much.
     """
     if not rings:
         raise VectorizeError("the ink has no outline to work from")
@@ -74,7 +76,10 @@ def medial_axis(rings: list[np.ndarray], gray: np.ndarray, level: float, *, tile
     parts = None
     if tiles is None:
         cores = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1)
-        tiles = min(cores, MAX_TILES) if len(samples) >= TILED_SAMPLES else 1
+        # Threads only pay with idle cores: on a busy machine they wait for the same cores
+        # and add the tiles' overlap (the result is the same either way).
+        busy = os.getloadavg()[0] if hasattr(os, "getloadavg") else 0.0
+        tiles = min(cores, MAX_TILES) if len(samples) >= TILED_SAMPLES and busy < cores - 0.5 else 1
     if tiles > 1:
         spacing = max(float(np.max(np.linalg.norm(np.diff(ring, axis=0, append=ring[:1]), axis=1)))
                       for ring in rings)
