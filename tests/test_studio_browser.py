@@ -237,6 +237,12 @@ def test_split_halves_a_pixel_apart_are_drawn_apart_and_each_clicks(page):
     assert len(labels) == 2
     a, b = labels
     assert a[0] + a[2] <= b[0] or b[0] + b[2] <= a[0] or a[1] + a[3] <= b[1] or b[1] + b[3] <= a[1]  # no overlap
+    # Every two texts there ("unresolved" twice, the "×2" between them) stand apart: boxes
+    # side by side used to read as one word ("unresolved×2").
+    boxes = page.evaluate("window.studio.placed.map(p => p.box)")
+    for i, p in enumerate(boxes):
+        for q in boxes[i + 1:]:
+            assert max(q[0] - (p[0] + p[2]), p[0] - (q[0] + q[2]), q[1] - (p[1] + p[3]), p[1] - (q[1] + q[3])) >= 6, (p, q)
     x, y = page.evaluate(f"window.studio.toScreen(597, 366)")
     page.screenshot(path=str(ARTIFACTS / "studio-7b-split-unresolved.png"), clip={"x": x - 160, "y": y - 90,
                                                                                   "width": 320, "height": 180})

@@ -377,6 +377,16 @@ def _kept_ink(ink: np.ndarray, longest: int) -> tuple[np.ndarray, float, bool]:
     hole[np.concatenate([paper[0], paper[-1], paper[:, 0], paper[:, -1]])] = False
     if not hole.any():
         return ink, width, framed  # all paper reaches the edge: nothing to fill
+    if not hole[1] and hole[2:].all():
+        # Only the first piece reaches the edge (the paper around the ink): every pixel of
+        # a higher label is in a hole, and only those need counting and filling.
+        inner = paper > 1
+        labels = paper[inner]
+        small = np.bincount(labels, minlength=count + 1) < max(2.0, 0.5 * width * width)
+        small &= hole
+        if small.any():
+            ink[inner] |= small[labels]
+        return ink, width, framed
     small = np.bincount(paper.ravel()) < max(2.0, 0.5 * width * width)
     small &= hole
     if small.any():

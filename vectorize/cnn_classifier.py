@@ -101,7 +101,7 @@ class CnnClassifier:
         """One verdict per junction; gray (H, W) float32 in [0, 1], 1 = paper."""
         if not junctions:
             return []
-        centers = np.array([j.center for j in junctions], dtype=float)
+        centers = np.array([j.crop_center for j in junctions], dtype=float)
         crops = crop_junctions(gray, centers, stroke_width, self.spec)
         mean, share = self.predict_crops(crops)
         return [JunctionVerdict(p_crossing=float(m), confidence=float(s)) for m, s in zip(mean, share)]

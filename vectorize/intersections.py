@@ -27,12 +27,20 @@ class Junction:
     """One degree-4 node of the simplified medial-axis graph.
 
     center: (2,) x, y in px of the working image; directions: (4, 2) unit tangents of the
-    four branches pointing away from the node; width: local stroke width in px.
+    four branches pointing away from the node; width: local stroke width in px;
+    crossing: (2,) px where the two straight-through passes are estimated to cross
+    (`vectorize.crossing_point`), where image classifiers centre their crops; None: center.
     """
 
     center: np.ndarray
     directions: np.ndarray
     width: float
+    crossing: np.ndarray | None = None
+
+    @property
+    def crop_center(self) -> np.ndarray:
+        """Where an image classifier looks: the estimated crossing, else the node."""
+        return self.center if self.crossing is None else self.crossing
 
 
 @dataclass(frozen=True)

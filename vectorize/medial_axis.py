@@ -2,18 +2,20 @@
 
 from __future__ import annotations
 
+import os
+from concurrent.futures import ThreadPoolExecutor
+
 import numpy as np
 from scipy.ndimage import map_coordinates
-from scipy.sparse import coo_matrix
-from scipy.sparse.csgraph import connected_components
-from scipy.spatial import Delaunay
 
 from onestroke.errors import VectorizeError
 from vectorize.graph import Branch, MedialGraph
+from vectorize.voronoi import empty_circle_bound, tile_slabs, voronoi_part
 
-# Circumcentres closer than this fraction of the drawing's extent are one Voronoi vertex
-# (cocircular samples; the error of the circumcentre formula is ~1e-13 of the extent).
-SAME_CENTER = 1e-10
+# From this many outline samples on, the Voronoi diagram is computed in tiles, one thread per
+# core (qhull lets go of the GIL); below, starting the threads costs more than it saves.
+TILED_SAMPLES = 4000
+MAX_TILES = 8
 
 
 def _inside(gray: np.ndarray, level: float, xy: np.ndarray) -> np.ndarray:
@@ -25,96 +27,101 @@ def _inside(gray: np.ndarray, level: float, xy: np.ndarray) -> np.ndarray:
     return ok & (values < level)
 
 
-def medial_axis(rings: list[np.ndarray], gray: np.ndarray, level: float) -> MedialGraph:
+def medial_axis(rings: list[np.ndarray], gray: np.ndarray, level: float, *, tiles: int | None = None) -> MedialGraph:
     """Inside Voronoi ridges of the outline samples as a graph of branches.
 
     A ridge is kept when both its vertices lie inside the ink and its two generating samples
     are not neighbours on one ring (those ridges cut the outline, not the ink's middle).
+    Vertices come in the order of their coordinates and ridges in the order of their
+    vertices, so the graph does not depend on how the diagram was computed.
+    tiles: how many tiles to compute the diagram in, one thread each (1: whole; None: one
+    per core from `TILED_SAMPLES` samples on, while the machine has a core to spare); it
+    falls back to the whole diagram where the ink's widest part would make the tiles
+    overlap too much.
     """
     if not rings:
         raise VectorizeError("the ink has no outline to work from")
     samples = np.vstack(rings)
+    if len(samples) < 8:
+        raise VectorizeError("the ink is too small to find its centre line")
     ring_of = np.repeat(np.arange(len(rings)), [len(r) for r in rings])
     ring_size = np.array([len(r) for r in rings])[ring_of]
     index_in_ring = np.concatenate([np.arange(len(r)) for r in rings])
-    if len(samples) < 8:
-        raise VectorizeError("the ink is too small to find its centre line")
-    vertices, ridge_vertices, ridge_points = voronoi_ridges(samples)
-    p, q = ridge_points[:, 0], ridge_points[:, 1]
-    gap = np.abs(index_in_ring[p] - index_in_ring[q])
-    gap = np.minimum(gap, ring_size[p] - gap)
-    neighbours = (ring_of[p] == ring_of[q]) & (gap <= 1)
-    inside_vertex = _inside(gray, level, vertices)
-    keep = ~neighbours
-    keep[keep] &= inside_vertex[ridge_vertices[keep, 0]] & inside_vertex[ridge_vertices[keep, 1]]
-    edges = ridge_vertices[keep]
-    if len(edges) == 0:
+    span = float(np.max(np.ptp(samples, axis=0))) + 1.0
+
+    def inside_ridges(chosen=None, slab=(-np.inf, np.inf), core=(-np.inf, np.inf), axis=0):
+        """This tile's kept ridges (key pairs, sample pairs) and their vertices' (keys,
+        centres, radii); None when an inside vertex of its core does not fit its slab."""
+        part = voronoi_part(samples, chosen, span=span, axis=axis, slab=slab)
+        p, q = part.ridge_points[:, 0], part.ridge_points[:, 1]
+        gap = np.abs(index_in_ring[p] - index_in_ring[q])
+        gap = np.minimum(gap, ring_size[p] - gap)
+        keep = ~((ring_of[p] == ring_of[q]) & (gap <= 1))
+        ends = part.ridges[keep]
+        inside = np.zeros(len(part.key), dtype=bool)
+        asked = np.flatnonzero(np.bincount(ends.ravel(), minlength=len(part.key)))
+        if len(asked):
+            inside[asked] = _inside(gray, level, part.center[asked])
+        keep[keep] = inside[ends[:, 0]] & inside[ends[:, 1]]
+        ends = part.ridges[keep]
+        mine = (part.center[:, axis] >= core[0]) & (part.center[:, axis] < core[1])
+        if (inside & mine & ~part.fits).any():
+            return None
+        keep[keep] = part.fits[ends[:, 0]] & part.fits[ends[:, 1]]
+        ends = part.ridges[keep]
+        used = np.bincount(ends.ravel(), minlength=len(part.key)) > 0
+        number = np.cumsum(used) - 1
+        return (number[ends], part.ridge_points[keep], part.key[used], part.center[used], part.radius[used])
+
+    parts = None
+    if tiles is None:
+        cores = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1)
+        # Threads only pay with idle cores: on a busy machine they wait for the same cores
+        # and add the tiles' overlap (the result is the same either way).
+        busy = os.getloadavg()[0] if hasattr(os, "getloadavg") else 0.0
+        tiles = min(cores, MAX_TILES) if len(samples) >= TILED_SAMPLES and busy < cores - 0.5 else 1
+    if tiles > 1:
+        spacing = max(float(np.max(np.linalg.norm(np.diff(ring, axis=0, append=ring[:1]), axis=1)))
+                      for ring in rings)
+        bound = empty_circle_bound(samples, gray, level, spacing)
+        # A kept ridge's two circles lie within twice the bound of its midpoint: a tile
+        # widened by that finds every ridge whose midpoint is in its core.
+        slabs = tile_slabs(samples, 2.0 * bound, tiles) if np.isfinite(bound) else None
+        if slabs is not None:
+            with ThreadPoolExecutor(max_workers=len(slabs)) as pool:
+                parts = list(pool.map(lambda slab: inside_ridges(*slab), slabs))
+            if any(part is None for part in parts):
+                parts = None
+    if parts is None:
+        parts = [inside_ridges()]
+    # One vertex per name (a vertex found in two tiles has the same bits in both), in the
+    # order of its coordinates (x, then y); ridges in the order of their vertices.
+    offsets = np.cumsum([0] + [len(part[2]) for part in parts[:-1]])
+    ridges = np.concatenate([part[0] + offset for part, offset in zip(parts, offsets)])
+    ridge_points, keys, centers, radii = (np.concatenate(column) for column in list(zip(*parts))[1:])
+    if len(ridges) == 0:
         raise VectorizeError("no centre line found inside the ink")
+    order = np.argsort(keys)
+    new = np.concatenate([[True], keys[order[1:]] != keys[order[:-1]]])
+    once = order[new]
+    place = np.lexsort((keys[once], centers[once, 1], centers[once, 0]))
+    rank = np.empty(len(once), dtype=np.int64)
+    rank[place] = np.arange(len(once))
+    vertex_of = np.empty(len(keys), dtype=np.int64)
+    vertex_of[order] = rank[np.cumsum(new) - 1]
+    xy, radius = centers[once[place]], radii[once[place]]
+    ends = np.sort(vertex_of[ridges], axis=1)
+    pair = ends[:, 0] * len(xy) + ends[:, 1]
+    order = np.argsort(pair)
+    once = order[np.concatenate([[True], pair[order[1:]] != pair[order[:-1]]])]
+    edges, ridge_points = ends[once], ridge_points[once]
     # Object angle: half the angle at the ridge midpoint between its two generating samples.
-    mid = vertices[edges].mean(axis=1)
-    u = samples[p[keep]] - mid
-    v = samples[q[keep]] - mid
+    mid = xy[edges].mean(axis=1)
+    u = samples[ridge_points[:, 0]] - mid
+    v = samples[ridge_points[:, 1]] - mid
     cos = (u * v).sum(1) / np.maximum(np.linalg.norm(u, axis=1) * np.linalg.norm(v, axis=1), 1e-12)
     sins = np.sin(np.arccos(np.clip(cos, -1.0, 1.0)) / 2.0)
-
-    used, local = np.unique(edges, return_inverse=True)
-    local = local.reshape(-1, 2)
-    xy = vertices[used]
-    # A Voronoi vertex is equally far from its generating samples and no sample is nearer
-    # (the empty circle): its radius is the distance to either sample of any ridge it ends.
-    radius = np.empty(len(used))
-    radius[local] = np.linalg.norm(xy[local] - samples[p[keep]][:, None, :], axis=2)
-    return _collapse_chains(xy, radius, local, sins)
-
-
-def voronoi_ridges(samples: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """The finite Voronoi diagram of `samples` (N, 2): (vertices (V, 2), ridges (R, 2) as
-    vertex index pairs, and their generating samples (R, 2) as sample index pairs).
-
-    Built from qhull's Delaunay triangulation, whose dual it is: a vertex is a triangle's
-    circumcentre, a ridge joins the circumcentres of two triangles sharing an edge and is
-    generated by that edge's two samples. `scipy.spatial.Voronoi` runs the same qhull
-    triangulation and then builds its ridges as Python lists, which costs as much again.
-    Triangles of cocircular samples (straight, evenly sampled outlines give many) share one
-    circumcentre; they are one Voronoi vertex, as qhull's Voronoi merges them.
-    """
-    tri = Delaunay(samples)
-    simplices, neighbors = tri.simplices, tri.neighbors
-    corners = samples[simplices]
-    # Circumcentres relative to each triangle's first corner (the small numbers keep the
-    # precision of the pixel coordinates).
-    b = corners[:, 1] - corners[:, 0]
-    c = corners[:, 2] - corners[:, 0]
-    d = 2.0 * (b[:, 0] * c[:, 1] - b[:, 1] * c[:, 0])
-    bb, cc = (b * b).sum(1), (c * c).sum(1)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        offset = np.column_stack([c[:, 1] * bb - b[:, 1] * cc, b[:, 0] * cc - c[:, 0] * bb]) / d[:, None]
-    centers = corners[:, 0] + offset
-    # Each edge shared by two triangles once (hull edges, neighbour -1, are infinite ridges).
-    count = len(simplices)
-    first = np.repeat(np.arange(count), 3)
-    second = neighbors.ravel()
-    opposite = np.tile(np.arange(3), count)
-    shared = second > first
-    first, second, opposite = first[shared], second[shared], opposite[shared]
-    ridge_points = np.column_stack([simplices[first, (opposite + 1) % 3], simplices[first, (opposite + 2) % 3]])
-    ridges = np.column_stack([first, second])
-    # One vertex per group of triangles with the same circumcentre: the ridges between them
-    # have no length and go.
-    span = np.max(np.ptp(samples, axis=0)) + 1.0
-    with np.errstate(invalid="ignore"):  # flat triangles' centres are infinite
-        same = np.linalg.norm(centers[first] - centers[second], axis=1) <= SAME_CENTER * span
-    if same.any():
-        merged = coo_matrix((np.ones(int(same.sum())), (first[same], second[same])), shape=(count, count))
-        _, label = connected_components(merged, directed=False)
-        # Each group's vertex is its first triangle's circumcentre.
-        representative = np.full(label.max() + 1, count)
-        np.minimum.at(representative, label, np.arange(count))
-        ridges = representative[label][ridges]
-        # A chain of near-equal centres may join two triangles a ridge also joins directly.
-        apart = ridges[:, 0] != ridges[:, 1]
-        ridges, ridge_points = ridges[apart], ridge_points[apart]
-    return centers, ridges, ridge_points
+    return _collapse_chains(xy, radius, edges, sins)
 
 
 def _collapse_chains(xy: np.ndarray, radius: np.ndarray, edges: np.ndarray, sins: np.ndarray) -> MedialGraph:

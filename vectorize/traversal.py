@@ -58,10 +58,14 @@ class Walker:
             elif node in self.simple.t_ends:
                 # Leave along the branch outside the smoothest pair (the pair with the
                 # largest angle between them is walked through later, in one go).
-                d = self.dirs[node]
-                pairs = [(float(np.dot(d[i], d[j])), k) for i, j, k in ((0, 1, 2), (0, 2, 1), (1, 2, 0))]
-                result.append((node, min(pairs)[1]))
+                result.append((node, self._t_stem(node)))
         return result
+
+    def _t_stem(self, node: int) -> int:
+        """The slot of a T-junction's line that ends there: outside its smoothest pair."""
+        d = self.dirs[node]
+        pairs = [(float(np.dot(d[i], d[j])), k) for i, j, k in ((0, 1, 2), (0, 2, 1), (1, 2, 0))]
+        return min(pairs)[1]
 
     def _exit(self, node: int, entry: int, used: dict, pairing: dict) -> int | None:
         degree = self.graph.degree(node)
@@ -86,6 +90,9 @@ class Walker:
             (a, b), (c, d) = pairing[node]
             partner = {a: b, b: a, c: d, d: c}[entry]
             return partner if free(partner) else None
+        if node in self.simple.t_ends and entry == self._t_stem(node):
+            # A line ending on another ends its stroke there, whichever end the walk began at.
+            return None
         # Any other junction: go as straight as possible among free branches.
         options = [i for i in range(degree) if i != entry and free(i)]
         if not options:

@@ -18,6 +18,7 @@ from vectorize.graph import MedialGraph
 from vectorize.ink_guard import InkGuard, guard_margin
 from vectorize.classifiers import make_classifier, shipped_pass_scorer
 from vectorize.clusters import merge_triple_points, straightest_pairs
+from vectorize.crossing_point import crossing_point
 from vectorize.intersections import Junction, JunctionVerdict, ranked_pairings
 from vectorize.medial_axis import medial_axis
 from vectorize.outline import outline_rings
@@ -85,7 +86,8 @@ def _junctions(graph: MedialGraph, nodes, stroke_width: float) -> list[Junction]
             band = r[(dist > 1.5 * stroke_width) & (dist < 3.5 * stroke_width)]
             radii.extend(band.tolist())
         width = 2.0 * float(np.median(radii)) if radii else stroke_width
-        result.append(Junction(center=graph.positions[node].copy(), directions=dirs, width=width))
+        result.append(Junction(center=graph.positions[node].copy(), directions=dirs, width=width,
+                               crossing=crossing_point(graph, node, dirs, stroke_width)))
     return result
 
 

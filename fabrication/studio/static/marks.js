@@ -127,6 +127,7 @@ function label(g, text, x, y, gap) { studio.labels.push({ text, x, y, gap }); }
 // Screen cells (CURVE_CELL px square, keys "col,row") the drawn curve runs through: a text
 // whose box touches one would hide the line where it matters (a triple point's branches).
 const CURVE_CELL = 6;
+const LABEL_SPACE = 6;  // px between two texts' boxes
 function curveCells(width, height) {
   const cells = new Set(), t = studio.line;
   const mark = (x, y) => { if (x >= 0 && y >= 0 && x <= width && y <= height) cells.add(`${Math.floor(x / CURVE_CELL)},${Math.floor(y / CURVE_CELL)}`); };
@@ -163,9 +164,12 @@ export function placeLabels(g, more = []) {
       [x + d * 0.7, y - d * 0.7 - h / 2], [x + d * 0.7, y + d * 0.7 + h / 2],
       [x - d * 0.7 - w, y - d * 0.7 - h / 2], [x - d * 0.7 - w, y + d * 0.7 + h / 2]];
     const spots = around(gap).concat(around(gap + 14), around(gap + 28));
-    const covers = (sx, sy, b) => sx < b[0] + b[2] && b[0] < sx + w && sy - h / 2 < b[1] + b[3] && b[1] < sy + h / 2;
+    const covers = (sx, sy, b, pad = 0) => sx < b[0] + b[2] + pad && b[0] - pad < sx + w &&
+      sy - h / 2 < b[1] + b[3] + pad && b[1] - pad < sy + h / 2;
     const inside = (sx, sy) => sx >= 2 && sx + w <= c.clientWidth - 2 && sy - h / 2 >= 0 && sy + h / 2 <= c.clientHeight;
-    const free = (sx, sy) => !markers.some((b) => covers(sx, sy, b)) && !studio.placed.some((q) => covers(sx, sy, q.box));
+    // Texts keep LABEL_SPACE px apart: two boxes side by side would read as one ("unresolved×2").
+    const free = (sx, sy) => !markers.some((b) => covers(sx, sy, b)) &&
+      !studio.placed.some((q) => covers(sx, sy, q.box, LABEL_SPACE));
     // How much of the curve a box there would hide: the curve's cells under the white box
     // (2 px wider than the text) and 2 px around it (the line is up to 6 px wide).
     const hidden = (sx, sy) => {
