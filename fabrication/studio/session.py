@@ -143,20 +143,17 @@ class StudioSession:
         step), so the first drag sends one step either side of it, and unticking
         "automatic" sends that position itself: those are warmed too."""
         found = []
-        if edits.threshold is None and automatic is not None:
-            position = round(automatic, 2)
-            found += [replace(edits, threshold=value) for value in
-                      (round(position + THRESHOLD_STEP, 2), round(position - THRESHOLD_STEP, 2))
-                      if 0.0 < value < 1.0]
         moved = {}
         if previous is not None:
             for name in ("threshold", "blur"):
                 old, new = getattr(previous, name), getattr(edits, name)
                 if old is not None and new is not None and new != old:
                     moved[name] = 1 if new > old else -1
-        if edits.threshold is not None:
+        unticked = round(automatic, 2) if edits.threshold is None and automatic is not None else None
+        position = edits.threshold if edits.threshold is not None else unticked
+        if position is not None:
             for sign in (moved.get("threshold", 1), -moved.get("threshold", 1)):
-                value = round(edits.threshold + sign * THRESHOLD_STEP, 2)
+                value = round(position + sign * THRESHOLD_STEP, 2)
                 if 0.0 < value < 1.0:
                     found.append(replace(edits, threshold=value))
         blur = edits.blur if edits.blur is not None else self.options.blur
@@ -164,8 +161,8 @@ class StudioSession:
             value = round(blur + sign * BLUR_STEP, 2)
             if 0.0 <= value <= MAX_BLUR:
                 found.append(replace(edits, blur=value))
-        if edits.threshold is None and automatic is not None and 0.0 < round(automatic, 2) < 1.0:
-            found.append(replace(edits, threshold=round(automatic, 2)))
+        if unticked is not None and 0.0 < unticked < 1.0:
+            found.append(replace(edits, threshold=unticked))
         return found
 
     def warm_neighbours(self, edits: Edits, previous: Edits | None = None,
