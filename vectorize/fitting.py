@@ -15,6 +15,12 @@ from vectorize.retraces import Twin, mirror_flags, mirror_keep, rolled, share_pi
 from vectorize.stroke import Stroke
 
 
+# The first fit of a piece takes one traced point per THIN stroke widths of arc length,
+# and every point within DENSE widths of an uncertain stretch (see `fit_stroke`).
+THIN = 0.25
+DENSE = 2.0
+
+
 @dataclass(frozen=True, kw_only=True)
 class TracedPoints:
     """The points of a traversed stroke with what the filter needs to know about each, as
@@ -77,13 +83,42 @@ def bspline_to_bezier(tck, u_start: float, u_end: float) -> np.ndarray:
     return np.stack([pa, pa + h * da, pb - h * db, pb], axis=1)
 
 
-def fit_piece(points: np.ndarray, *, closed: bool, sigma: float, anchor: bool = True) -> np.ndarray:
+def thinned(points: np.ndarray, spacing: float, dense: np.ndarray | None = None) -> np.ndarray:
+    """(N, 2) ordered points -> the first point of every `spacing` px of arc length, the
+    last, and every point where `dense` ((N,) bool) says so."""
+    if len(points) < 3 or spacing <= 0.0:
+        return points
+    bins = np.floor(arc_lengths(points) / spacing)
+    keep = np.concatenate([[True], bins[1:] > bins[:-1]])
+    keep[-1] = True
+    if dense is not None:
+        keep |= dense
+    return points[keep]
+
+
+def along_distance(arc: np.ndarray, marked: np.ndarray) -> np.ndarray:
+    """(N,) px along the line from each point to the nearest marked one, either side
+    (inf when none is); arc: (N,) ascending arc lengths, marked: (N,) bool."""
+    at = arc[marked]
+    if not at.size:
+        return np.full(len(arc), np.inf)
+    # one pass, not one per marked point: TSP art has thousands of corners
+    k = np.searchsorted(at, arc)
+    after = np.abs(at[np.minimum(k, at.size - 1)] - arc)
+    before = np.abs(arc - at[np.maximum(k - 1, 0)])
+    return np.minimum(before, after)
+
+
+def fit_piece(points: np.ndarray, *, closed: bool, sigma: float, anchor: bool = True,
+              spacing: float = 0.0, dense: np.ndarray | None = None) -> np.ndarray:
     """Fit one piece: (N, 2) ordered points -> Bézier control points (K, 4, 2).
 
     sigma: expected noise of the points in px; the smoothing allows that much residual.
     anchor: make an open piece start and end exactly on its first and last points.
+    spacing: fit one point per `spacing` px of arc length (0: every point), and every
+    point where `dense` ((N,) bool) says so.
     """
-    points = _dedupe(points, 1e-3)
+    points = _dedupe(thinned(points, spacing, dense), 1e-3)
     if closed and len(points) > 3 and np.linalg.norm(points[0] - points[-1]) < 1e-6:
         points = points[:-1]
     if len(points) < 4 or (closed and len(points) < 6):
@@ -288,15 +323,11 @@ def fit_stroke(traced: TracedPoints, *, closed: bool, sigma: float, stroke_width
     # Around a corner the axis is off the centre line for about a stroke width: leave it out.
     # (The corner joints below read the tip along this arc too.)
     arc = arc_lengths(xy)
-    at = arc[np.flatnonzero(corner)]  # ascending, as the arc is
-    if at.size:
-        # the distance along the line to the nearest corner, either side (one pass, not one
-        # per corner: TSP art has thousands)
-        k = np.searchsorted(at, arc)
-        after = np.abs(at[np.minimum(k, at.size - 1)] - arc)
-        before = np.abs(arc - at[np.maximum(k - 1, 0)])
-        keep &= np.minimum(before, after) > stroke_width
+    keep &= along_distance(arc, corner) > stroke_width
     mirror_keep(twins, keep)
+    # Next to an uncertain stretch (a junction, a corner) the fit bridges a stretch without
+    # points: there its shape, and where two passes cross, hangs on every point either side.
+    dense = along_distance(arc, ~keep) <= DENSE * stroke_width
     cuts = [0] + [int(i) for i in np.flatnonzero(split) if 0 < i < len(xy) - 1] + [len(xy) - 1]
     pieces = []
     previous = None
@@ -314,22 +345,26 @@ def fit_stroke(traced: TracedPoints, *, closed: bool, sigma: float, stroke_width
             mask[0] = mask[-1] = True
             mask[0] &= not corner[lo]
             mask[-1] &= not corner[hi]
-        piece = xy[lo:hi + 1][mask]
+        piece, near = xy[lo:hi + 1][mask], dense[lo:hi + 1][mask]
         if len(piece) < 2:
-            piece = xy[[lo, hi]]
+            piece, near = xy[[lo, hi]], None
         if previous is not None and len(piece) == len(previous) and np.array_equal(piece, previous[::-1]):
             # The way back from a retraced spike: exactly the way out, reversed, so the
             # two passes lie on each other instead of crossing back and forth.
             control = pieces[-1][::-1, ::-1]
         else:
-            control = fit_piece(piece, closed=closed and len(cuts) == 2, sigma=sigma,
-                                anchor=not (corner[lo] or corner[hi]))
-            if guard is not None:
+            settings = dict(closed=closed and len(cuts) == 2, sigma=sigma, anchor=not (corner[lo] or corner[hi]))
+            # Away from uncertain stretches one point per quarter width is plenty for the
+            # smoothing spline, at a fraction of FITPACK's time (linear in the points; the
+            # axis gives 3-5 per px). Where that fit leaves the ink, the piece is fitted on
+            # every point: thinned knots can swing across a long uncertain stretch.
+            control = fit_piece(piece, **settings, spacing=THIN * stroke_width, dense=near)
+            if guard is not None and curve_excess(guard, control)[0] > 0.0:
                 # Measured against every traced point of the piece, the uncertain ones too.
                 whole = xy[lo:hi + 1]
                 if closed and len(cuts) == 2:
                     whole = np.vstack([whole, whole[:1]])
-                control = keep_in_ink(whole, control, guard, _open_fit, sigma)
+                control = keep_in_ink(whole, fit_piece(piece, **settings), guard, _open_fit, sigma)
         previous = piece
         fitted[(lo, hi)] = len(pieces)
         pieces.append(np.array(control))  # writable: the joints move its ends
