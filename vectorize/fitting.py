@@ -40,11 +40,12 @@ class TracedPoints:
         return len(self.xy)
 
 
-def _dedupe(points: np.ndarray, min_step: float) -> np.ndarray:
-    """Drop points closer than `min_step` to the previous kept one (splprep needs distinct points)."""
-    if len(points) < 2:
-        return points
+def _distinct(points: np.ndarray, min_step: float) -> np.ndarray:
+    """Indices of the points to keep when those closer than `min_step` to the previous kept
+    one are dropped (splprep needs distinct points); the last point is always kept."""
     n = len(points)
+    if n < 2:
+        return np.arange(n)
     steps = np.linalg.norm(np.diff(points, axis=0), axis=1)
     keep = np.ones(n, dtype=bool)
     # A point is measured from the last kept one, which is its predecessor unless that one
@@ -61,7 +62,7 @@ def _dedupe(points: np.ndarray, min_step: float) -> np.ndarray:
     kept = np.flatnonzero(keep)
     if kept[-1] != n - 1 and np.linalg.norm(points[-1] - points[kept[-1]]) > 1e-9:
         kept[-1] = n - 1
-    return points[kept]
+    return kept
 
 
 def bspline_to_bezier(tck, u_start: float, u_end: float) -> np.ndarray:
@@ -84,16 +85,16 @@ def bspline_to_bezier(tck, u_start: float, u_end: float) -> np.ndarray:
 
 
 def thinned(points: np.ndarray, spacing: float, dense: np.ndarray | None = None) -> np.ndarray:
-    """(N, 2) ordered points -> the first point of every `spacing` px of arc length, the
-    last, and every point where `dense` ((N,) bool) says so."""
+    """Indices of (N, 2) ordered points to fit: the first point of every `spacing` px of arc
+    length, the last, and every point where `dense` ((N,) bool) says so (all when spacing is 0)."""
     if len(points) < 3 or spacing <= 0.0:
-        return points
+        return np.arange(len(points))
     bins = np.floor(arc_lengths(points) / spacing)
     keep = np.concatenate([[True], bins[1:] > bins[:-1]])
     keep[-1] = True
     if dense is not None:
         keep |= dense
-    return points[keep]
+    return np.flatnonzero(keep)
 
 
 def along_distance(arc: np.ndarray, marked: np.ndarray) -> np.ndarray:
@@ -116,24 +117,32 @@ def fit_piece(points: np.ndarray, *, closed: bool, sigma: float, anchor: bool = 
     sigma: expected noise of the points in px; the smoothing allows that much residual.
     anchor: make an open piece start and end exactly on its first and last points.
     spacing: fit one point per `spacing` px of arc length (0: every point), and every
-    point where `dense` ((N,) bool) says so.
+    point where `dense` ((N,) bool) says so; each point fitted weighs as much as the points
+    it stands for, so the fit minimises about the same sum as on every point.
     """
-    points = _dedupe(thinned(points, spacing, dense), 1e-3)
+    kept = thinned(points, spacing, dense)
+    count = np.diff(np.append(kept, len(points)))  # the points each kept one stands for
+    distinct = _distinct(points[kept], 1e-3)
+    points, count = points[kept][distinct], count[distinct]
     if closed and len(points) > 3 and np.linalg.norm(points[0] - points[-1]) < 1e-6:
-        points = points[:-1]
+        points, count = points[:-1], count[:-1]
     if len(points) < 4 or (closed and len(points) < 6):
         line = points if len(points) >= 2 else np.vstack([points, points + 1e-3])
         if closed:
             line = np.vstack([line, line[:1]])
         return Stroke.from_polyline(line).control
     if closed:
-        points = np.vstack([points, points[:1]])
+        points, count = np.vstack([points, points[:1]]), np.append(count, count[0])
     steps = np.linalg.norm(np.diff(points, axis=0), axis=1)
     u = np.concatenate([[0.0], np.cumsum(steps)])
     u /= u[-1]
-    smoothing = len(points) * sigma * sigma
+    # FITPACK minimises sum((w * residual)^2) within s: weights sqrt(count) and s over all the
+    # points stood for ask of the thinned points what the full fit asks of every point.
+    smoothing = float(count.sum()) * sigma * sigma
+    weight = np.sqrt(count) if (count != 1).any() else None
     try:
-        tck, _ = splprep([points[:, 0], points[:, 1]], u=u, k=3, s=smoothing, per=1 if closed else 0, quiet=2)
+        tck, _ = splprep([points[:, 0], points[:, 1]], w=weight, u=u, k=3, s=smoothing, per=1 if closed else 0,
+                         quiet=2)
     except (ValueError, TypeError):
         return Stroke.from_polyline(points).control
     control = bspline_to_bezier(tck, 0.0, 1.0)
