@@ -110,7 +110,8 @@ def thinned(points: np.ndarray, spacing: float, dense: np.ndarray | None = None)
         far = points[crossed + 1, axis] > points[crossed, axis]
         keep[np.where(far, crossed + 1, crossed)] = True
     kept = np.flatnonzero(keep)
-    bounds = np.concatenate([[0.0], (kept[:-1] + kept[1:]) / 2.0, [float(n)]])
+    # point i stands for [i - 1/2, i + 1/2]: the same counts either way along the line
+    bounds = np.concatenate([[-0.5], (kept[:-1] + kept[1:]) / 2.0, [n - 0.5]])
     return kept, np.diff(bounds)
 
 
