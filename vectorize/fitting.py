@@ -379,18 +379,20 @@ def fit_stroke(traced: TracedPoints, *, closed: bool, sigma: float, stroke_width
             control = pieces[-1][::-1, ::-1]
         else:
             settings = dict(closed=closed and len(cuts) == 2, sigma=sigma, anchor=not (corner[lo] or corner[hi]))
-            # Away from uncertain stretches one point per quarter width is plenty for the
-            # smoothing spline, at a fraction of FITPACK's time (linear in the points; the
-            # axis gives 3-5 per px). Where that fit leaves the ink, the piece is fitted on
-            # every point: thinned knots can swing across a long uncertain stretch.
+            # A long piece is first fitted on about one point per THIN widths away from its
+            # uncertain stretches: FITPACK's time is linear in the points, and the axis gives
+            # 3-5 per px. Where that fit leaves the ink, the piece is fitted on every point
+            # before the guard's ladder: thinned knots can swing across a long uncertain stretch.
             spacing = THIN * stroke_width if len(piece) > THIN_FROM else 0.0
             control = fit_piece(piece, **settings, spacing=spacing, dense=near)
             if guard is not None and curve_excess(guard, control)[0] > 0.0:
+                if spacing:
+                    control = fit_piece(piece, **settings)
                 # Measured against every traced point of the piece, the uncertain ones too.
                 whole = xy[lo:hi + 1]
                 if closed and len(cuts) == 2:
                     whole = np.vstack([whole, whole[:1]])
-                control = keep_in_ink(whole, fit_piece(piece, **settings), guard, _open_fit, sigma)
+                control = keep_in_ink(whole, control, guard, _open_fit, sigma)
         previous = piece
         fitted[(lo, hi)] = len(pieces)
         pieces.append(np.array(control))  # writable: the joints move its ends
