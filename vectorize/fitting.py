@@ -20,7 +20,7 @@ from vectorize.stroke import Stroke
 THIN = 0.3
 # Only pieces of more points than this are thinned: FITPACK's time is in the long ones.
 THIN_FROM = 2000
-DENSE = 2.0
+DENSE = 3.0
 
 
 @dataclass(frozen=True, kw_only=True)
