@@ -44,9 +44,11 @@ def medial_axis(rings: list[np.ndarray], gray: np.ndarray, level: float, *, tile
     samples = np.vstack(rings)
     if len(samples) < 8:
         raise VectorizeError("the ink is too small to find its centre line")
-    ring_of = np.repeat(np.arange(len(rings)), [len(r) for r in rings])
-    ring_size = np.array([len(r) for r in rings])[ring_of]
-    index_in_ring = np.concatenate([np.arange(len(r)) for r in rings])
+    # The next sample along each sample's ring (rings close: the last one's is the first).
+    sizes = np.array([len(r) for r in rings])
+    firsts = np.cumsum(sizes) - sizes
+    following = np.arange(1, len(samples) + 1)
+    following[firsts + sizes - 1] = firsts
     span = float(np.max(sides(samples))) + 1.0
 
     def inside_ridges(chosen=None, slab=(-np.inf, np.inf), core=(-np.inf, np.inf), axis=0):
@@ -54,9 +56,7 @@ def medial_axis(rings: list[np.ndarray], gray: np.ndarray, level: float, *, tile
         centres, radii); None when an inside vertex of its core does not fit its slab."""
         part = voronoi_part(samples, chosen, span=span, axis=axis, slab=slab)
         p, q = part.ridge_points[:, 0], part.ridge_points[:, 1]
-        gap = np.abs(index_in_ring[p] - index_in_ring[q])
-        gap = np.minimum(gap, ring_size[p] - gap)
-        keep = ~((ring_of[p] == ring_of[q]) & (gap <= 1))
+        keep = (following[p] != q) & (following[q] != p)  # not two neighbours on one ring
         ends = part.ridges[keep]
         inside = np.zeros(len(part.key), dtype=bool)
         asked = np.flatnonzero(np.bincount(ends.ravel(), minlength=len(part.key)))
