@@ -2,13 +2,13 @@
 
 from __future__ import annotations
 
-import os
 from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 from scipy.ndimage import map_coordinates
 
 from onestroke.errors import VectorizeError
+from vectorize.cores import idle_cores
 from vectorize.graph import Branch, MedialGraph, edge_lengths, lengths
 from vectorize.voronoi import empty_circle_bound, sides, tile_slabs, voronoi_part
 
@@ -75,11 +75,9 @@ def medial_axis(rings: list[np.ndarray], gray: np.ndarray, level: float, *, tile
 
     parts = None
     if tiles is None:
-        cores = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1)
-        # Threads only pay with idle cores: on a busy machine they wait for the same cores
-        # and add the tiles' overlap (the result is the same either way).
-        busy = os.getloadavg()[0] if hasattr(os, "getloadavg") else 0.0
-        tiles = min(cores, MAX_TILES) if len(samples) >= TILED_SAMPLES and busy < cores - 0.5 else 1
+        # Threads only pay with idle cores (on a busy machine they would also add the tiles'
+        # overlap).
+        tiles = min(idle_cores(), MAX_TILES) if len(samples) >= TILED_SAMPLES else 1
     if tiles > 1:
         spacing = max(float(np.max(edge_lengths(np.concatenate([ring, ring[:1]])))) for ring in rings)
         bound = empty_circle_bound(samples, gray, level, spacing)
