@@ -9,7 +9,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from vectorize.graph import Branch, MedialGraph, edge_lengths, measure_short
+from vectorize.graph import Branch, MedialGraph, edge_lengths, lengths, measure_short
 from vectorize.image_io import load_image
 from vectorize.options import VectorizeOptions
 from vectorize.vectorizer import _axis as axis_stages, _Clock
@@ -59,6 +59,25 @@ def test_edge_lengths_are_numpys_norm_to_the_bit():
         expected = np.linalg.norm(np.diff(points, axis=0), axis=1)
         assert np.array_equal(edge_lengths(points), expected)
         assert np.array_equal(edge_lengths(points[::-1])[::-1], expected)
+
+
+def test_lengths_and_two_term_sums_are_numpys_to_the_bit():
+    """`lengths` and the sums of two products written out (circumcentres, object angles,
+    edge midpoints) give numpy's reductions' numbers, infinities and NaNs included (flat
+    triangles' circumcentres are infinite)."""
+    rng = np.random.default_rng(5)
+    for size in (0, 1, 7, 8, 9, 1000, 50_000):
+        v = rng.normal(size=(size, 2)) * 10.0 ** rng.uniform(-8, 6, size=(size, 1))
+        w = rng.normal(size=(size, 2)) * 1e3
+        if size > 8:
+            v[3], v[5, 1], w[7] = np.inf, -np.inf, np.nan
+        with np.errstate(invalid="ignore", over="ignore"):
+            assert np.array_equal(lengths(v), np.linalg.norm(v, axis=1), equal_nan=True)
+            assert np.array_equal(v[:, 0] * w[:, 0] + v[:, 1] * w[:, 1], (v * w).sum(1), equal_nan=True)
+            pairs = rng.integers(0, max(size, 1), size=(size, 2))
+            ends = w if size else np.zeros((1, 2))
+            assert np.array_equal((ends[pairs[:, 0]] + ends[pairs[:, 1]]) / 2.0, ends[pairs].mean(axis=1),
+                                  equal_nan=True)
 
 
 def test_short_branches_measured_together_as_each_alone():

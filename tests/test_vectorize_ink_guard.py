@@ -55,6 +55,9 @@ def test_strays_is_the_excess_wherever_a_point_is_outside():
     full, cheap = guard.excess(points), guard.strays(points)
     outside = full > 0.0
     assert 500 < outside.sum() < len(points) - 500  # both kinds, many of each
+    # Some are beyond the search's reach (no centre-line point within it), some just inside.
+    nearest = guard.tree.query(points)[0]
+    assert 100 < (nearest > guard.reach).sum() and 100 < ((nearest < guard.reach) & outside).sum()
     assert np.array_equal(cheap[outside], full[outside])
     assert (cheap[~outside] <= 0.0).all()
     # Hence the same answer to "does it leave, how far at most, where".

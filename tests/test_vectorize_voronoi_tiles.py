@@ -169,3 +169,10 @@ def test_a_jitter_that_flips_a_near_cocircular_square_is_refused(monkeypatch):
             # vertex (a cocircular square's diagonal).
             assert edges(tossed) == edges(exact)
     assert refused > 0
+
+
+def test_sides_are_numpys_ptp():
+    rng = np.random.default_rng(2)
+    for size in (1, 2, 9, 20_000):
+        points = rng.normal(size=(size, 2)) * [300.0, 7.0] + [500.0, -3.0]
+        assert np.array_equal(voronoi.sides(points), np.ptp(points, axis=0))

@@ -3,6 +3,8 @@ ink components."""
 
 from __future__ import annotations
 
+from concurrent.futures import ThreadPoolExecutor
+from contextlib import nullcontext
 from dataclasses import dataclass
 
 import numpy as np
@@ -10,6 +12,7 @@ from scipy import ndimage
 from scipy.spatial import cKDTree
 
 from onestroke.errors import InputError
+from vectorize.cores import idle_cores
 
 MIN_SIDE = 16
 # Paper darker than this (after shading) is not paper: the division stops there.
@@ -108,7 +111,7 @@ def downscaled_gray(image: np.ndarray, *, max_size: int) -> tuple[np.ndarray, fl
 GAUSS_TRUNCATE = 4.0  # skimage.filters.gaussian's: the kernel reaches int(4 sigma + 0.5) px
 
 
-def blurred(gray: np.ndarray, blur: float) -> np.ndarray:
+def blurred(gray: np.ndarray, blur: float, *, threads: int | None = None) -> np.ndarray:
     """`gray` (H, W) float32 blurred by a Gaussian of sigma `blur` px
     (`skimage.filters.gaussian`, edges extended), a new array; `gray` itself when blur is 0.
 
@@ -116,13 +119,17 @@ def blurred(gray: np.ndarray, blur: float) -> np.ndarray:
     filtered: beyond it every window is white, which the filter leaves exactly white (its
     weights sum to 1 within far less than a float32 step: checked on a white patch), and
     inside it the box's white edge extended is what the whole image has there. A clean
-    drawing's paper is mostly such white; the filter over it was most of a blur's time."""
+    drawing's paper is mostly such white; the filter over it was most of a blur's time.
+    threads: 2 or more filters the box's top and bottom halves side by side (None: while
+    the machine has a core to spare), each with the kernel's reach of rows beyond its half:
+    every pixel of a half is then the same weighted sum of the same pixels (the filter goes
+    down the columns, then along the rows)."""
     if blur <= 0:
         return gray
     from skimage.filters import gaussian
 
     def blur_of(part: np.ndarray) -> np.ndarray:
-        return gaussian(part, sigma=blur, preserve_range=True, truncate=GAUSS_TRUNCATE).astype(np.float32)
+        return gaussian(part, sigma=blur, preserve_range=True, truncate=GAUSS_TRUNCATE).astype(np.float32, copy=False)
 
     reach = int(GAUSS_TRUNCATE * blur + 0.5) + 1
     patch = np.ones((2 * reach + 1, 2 * reach + 1), dtype=np.float32)
@@ -130,7 +137,16 @@ def blurred(gray: np.ndarray, blur: float) -> np.ndarray:
         return blur_of(gray)
     box = ink_box(gray != 1.0, reach)
     out = np.ones_like(gray)
-    out[box] = blur_of(gray[box])
+    part = gray[box]
+    half = len(part) // 2
+    if (idle_cores() if threads is None else threads) > 1 and half > 4 * reach:
+        with ThreadPoolExecutor(max_workers=1) as pool:
+            top = pool.submit(blur_of, part[:half + reach])
+            inside = out[box]
+            inside[half:] = blur_of(part[half - reach:])[reach:]
+            inside[:half] = top.result()[:half]
+    else:
+        out[box] = blur_of(part)
     return out
 
 
@@ -319,14 +335,16 @@ def frame_labels(labels: np.ndarray, count: int, longest: int | None = None) -> 
     return edge[np.asarray(radii) > FRAME_RADIUS * (longest or max(labels.shape))]
 
 
-def extract_ink(gray: np.ndarray, *, threshold: float | None) -> tuple[np.ndarray, float, float, bool]:
+def extract_ink(gray: np.ndarray, *, threshold: float | None,
+                threads: int | None = None) -> tuple[np.ndarray, float, float, bool]:
     """The ink mask to vectorize, its threshold, the stroke width and whether a frame was
     ignored.
 
     Specks (pieces smaller than a stroke-width square) are noise and vanish silently; every
     other piece is kept (single-line mode bridges and selects pieces later, on the medial
     axis: `gaps.py`). Small holes (pores inside ink blobs, pinholes where strokes nearly
-    touch) are filled.
+    touch) are filled. threads: 2 or more measures the width beside the labelling (None:
+    while the machine has a core to spare, `vectorize.cores.idle_cores`); the same result.
     """
     level = ink_threshold(gray, threshold)
     ink = gray < level
@@ -340,25 +358,32 @@ def extract_ink(gray: np.ndarray, *, threshold: float | None) -> tuple[np.ndarra
     # edge around the box, so the pieces, the frame, the holes and the width are the same as
     # over the whole image (see each step), at a fraction of the pixels.
     box = ink_box(ink, 1)
-    kept, width, framed = _kept_ink(ink[box], max(ink.shape))
+    kept, width, framed = _kept_ink(ink[box], max(ink.shape), threads=idle_cores() if threads is None else threads)
     ink = np.zeros_like(ink)
     ink[box] = kept
     return ink, level, width, framed
 
 
-def _kept_ink(ink: np.ndarray, longest: int) -> tuple[np.ndarray, float, bool]:
+def _kept_ink(ink: np.ndarray, longest: int, *, threads: int = 1) -> tuple[np.ndarray, float, bool]:
     """`extract_ink` on the crop `ink` (H, W) bool of the dark pixels around the ink (paper
     or the image's edge on every side); longest: the image's longest side. Returns the kept
-    ink of the crop, the stroke width and whether a frame was ignored."""
-    # Label numbers follow the raster order of each piece's first pixel, the same in a crop.
-    labels, count = ndimage.label(ink, structure=np.ones((3, 3)))
-    # The crop's outer rows and columns are the image's edge or paper (no label).
-    frame = frame_labels(labels, count, longest)
-    framed = 0 < frame.size < count  # a frame with nothing inside it stays: it is all there is
-    if framed:
-        ink &= ~np.isin(labels, frame)
-        labels[~ink] = 0
-    width = estimate_stroke_width(ink)
+    ink of the crop, the stroke width and whether a frame was ignored. threads: 2 or more
+    measures the width in a second thread while this one labels the pieces and, ahead of
+    knowing it is needed, the paper (both stages let go of the GIL)."""
+    with ThreadPoolExecutor(max_workers=1) if threads > 1 else nullcontext() as pool:
+        # The width of all the dark pixels: the width wanted unless a frame is dropped.
+        measured = pool.submit(estimate_stroke_width, ink) if pool is not None else None
+        # Label numbers follow the raster order of each piece's first pixel, the same in a crop.
+        labels, count = ndimage.label(ink, structure=np.ones((3, 3)))
+        # The crop's outer rows and columns are the image's edge or paper (no label).
+        frame = frame_labels(labels, count, longest)
+        framed = 0 < frame.size < count  # a frame with nothing inside it stays: it is all there is
+        if framed:
+            ink = ink & ~np.isin(labels, frame)  # (a new mask: the other thread reads the old one)
+            labels[~ink] = 0
+        # The paper's pieces of this ink: those of the kept ink when no speck is dropped.
+        ahead = ndimage.label(~ink) if measured is not None and not framed else None
+        width = measured.result() if measured is not None and not framed else estimate_stroke_width(ink)
     # Areas counted over the ink pixels only (paper is label 0, which is not a piece).
     areas = np.bincount(labels[ink], minlength=count + 1)[1:]
     speck = max(4.0, width * width)
@@ -371,7 +396,7 @@ def _kept_ink(ink: np.ndarray, longest: int) -> tuple[np.ndarray, float, bool]:
     # Holes are the 4-connected pieces of paper that do not reach the image edge (what
     # `binary_fill_holes` fills), found with one labelling instead of its dilation loop. A
     # piece reaching the crop's edge reaches the paper around the crop, and so the image's.
-    paper, count = ndimage.label(~ink)
+    paper, count = ahead if ahead is not None and keep.all() else ndimage.label(~ink)
     hole = np.ones(count + 1, dtype=bool)
     hole[0] = False  # ink
     hole[np.concatenate([paper[0], paper[-1], paper[:, 0], paper[:, -1]])] = False
@@ -404,9 +429,10 @@ def paper_gray(image: np.ndarray, *, max_size: int, blur: float,
     return flatten_paper(blurred(gray, blur)), scale
 
 
-def ink_image(gray: np.ndarray, scale: float, *, threshold: float | None) -> InkImage:
-    """The ink of a `paper_gray` image at this threshold (None: Li's)."""
-    ink, level, width, framed = extract_ink(gray, threshold=threshold)
+def ink_image(gray: np.ndarray, scale: float, *, threshold: float | None, threads: int | None = None) -> InkImage:
+    """The ink of a `paper_gray` image at this threshold (None: Li's); threads: as
+    `extract_ink`'s."""
+    ink, level, width, framed = extract_ink(gray, threshold=threshold, threads=threads)
     # Whiten everything that is not kept ink (specks, a frame) and blacken filled holes, so
     # that the sub-pixel outline of the gray image matches the kept ink exactly.
     # Only the box around the ink changes: the dilation cannot reach beyond 2 px of the ink.

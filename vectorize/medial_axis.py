@@ -2,15 +2,15 @@
 
 from __future__ import annotations
 
-import os
 from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 from scipy.ndimage import map_coordinates
 
 from onestroke.errors import VectorizeError
-from vectorize.graph import Branch, MedialGraph
-from vectorize.voronoi import empty_circle_bound, tile_slabs, voronoi_part
+from vectorize.cores import idle_cores
+from vectorize.graph import Branch, MedialGraph, edge_lengths, lengths
+from vectorize.voronoi import empty_circle_bound, sides, tile_slabs, voronoi_part
 
 # From this many outline samples on, the Voronoi diagram is computed in tiles, one thread per
 # core (qhull lets go of the GIL); below, starting the threads costs more than it saves.
@@ -44,19 +44,19 @@ def medial_axis(rings: list[np.ndarray], gray: np.ndarray, level: float, *, tile
     samples = np.vstack(rings)
     if len(samples) < 8:
         raise VectorizeError("the ink is too small to find its centre line")
-    ring_of = np.repeat(np.arange(len(rings)), [len(r) for r in rings])
-    ring_size = np.array([len(r) for r in rings])[ring_of]
-    index_in_ring = np.concatenate([np.arange(len(r)) for r in rings])
-    span = float(np.max(np.ptp(samples, axis=0))) + 1.0
+    # The next sample along each sample's ring (rings close: the last one's is the first).
+    sizes = np.array([len(r) for r in rings])
+    firsts = np.cumsum(sizes) - sizes
+    following = np.arange(1, len(samples) + 1)
+    following[firsts + sizes - 1] = firsts
+    span = float(np.max(sides(samples))) + 1.0
 
     def inside_ridges(chosen=None, slab=(-np.inf, np.inf), core=(-np.inf, np.inf), axis=0):
         """This tile's kept ridges (key pairs, sample pairs) and their vertices' (keys,
         centres, radii); None when an inside vertex of its core does not fit its slab."""
         part = voronoi_part(samples, chosen, span=span, axis=axis, slab=slab)
         p, q = part.ridge_points[:, 0], part.ridge_points[:, 1]
-        gap = np.abs(index_in_ring[p] - index_in_ring[q])
-        gap = np.minimum(gap, ring_size[p] - gap)
-        keep = ~((ring_of[p] == ring_of[q]) & (gap <= 1))
+        keep = (following[p] != q) & (following[q] != p)  # not two neighbours on one ring
         ends = part.ridges[keep]
         inside = np.zeros(len(part.key), dtype=bool)
         asked = np.flatnonzero(np.bincount(ends.ravel(), minlength=len(part.key)))
@@ -75,14 +75,11 @@ def medial_axis(rings: list[np.ndarray], gray: np.ndarray, level: float, *, tile
 
     parts = None
     if tiles is None:
-        cores = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1)
-        # Threads only pay with idle cores: on a busy machine they wait for the same cores
-        # and add the tiles' overlap (the result is the same either way).
-        busy = os.getloadavg()[0] if hasattr(os, "getloadavg") else 0.0
-        tiles = min(cores, MAX_TILES) if len(samples) >= TILED_SAMPLES and busy < cores - 0.5 else 1
+        # Threads only pay with idle cores (on a busy machine they would also add the tiles'
+        # overlap).
+        tiles = min(idle_cores(), MAX_TILES) if len(samples) >= TILED_SAMPLES else 1
     if tiles > 1:
-        spacing = max(float(np.max(np.linalg.norm(np.diff(ring, axis=0, append=ring[:1]), axis=1)))
-                      for ring in rings)
+        spacing = max(float(np.max(edge_lengths(np.concatenate([ring, ring[:1]])))) for ring in rings)
         bound = empty_circle_bound(samples, gray, level, spacing)
         # A kept ridge's two circles lie within twice the bound of its midpoint: a tile
         # widened by that finds every ridge whose midpoint is in its core.
@@ -116,10 +113,12 @@ def medial_axis(rings: list[np.ndarray], gray: np.ndarray, level: float, *, tile
     once = order[np.concatenate([[True], pair[order[1:]] != pair[order[:-1]]])]
     edges, ridge_points = ends[once], ridge_points[once]
     # Object angle: half the angle at the ridge midpoint between its two generating samples.
-    mid = xy[edges].mean(axis=1)
+    # (The same numbers as the mean over each edge's two ends, `.sum(1)` of the products and
+    # `np.linalg.norm(.., axis=1)`, without numpy's slow reductions over axes of two.)
+    mid = (xy[edges[:, 0]] + xy[edges[:, 1]]) / 2.0
     u = samples[ridge_points[:, 0]] - mid
     v = samples[ridge_points[:, 1]] - mid
-    cos = (u * v).sum(1) / np.maximum(np.linalg.norm(u, axis=1) * np.linalg.norm(v, axis=1), 1e-12)
+    cos = (u[:, 0] * v[:, 0] + u[:, 1] * v[:, 1]) / np.maximum(lengths(u) * lengths(v), 1e-12)
     sins = np.sin(np.arccos(np.clip(cos, -1.0, 1.0)) / 2.0)
     return _collapse_chains(xy, radius, edges, sins)
 

@@ -5,6 +5,8 @@ from __future__ import annotations
 import numpy as np
 from skimage.measure import find_contours
 
+from vectorize.graph import edge_lengths
+
 
 def outline_rings(gray: np.ndarray, level: float, spacing: float) -> list[np.ndarray]:
     """Closed outline rings of the ink, resampled every `spacing` px: list of (N, 2) x, y arrays.
@@ -20,7 +22,7 @@ def outline_rings(gray: np.ndarray, level: float, spacing: float) -> list[np.nda
             continue
         if np.linalg.norm(xy[0] - xy[-1]) > 1e-6:
             xy = np.vstack([xy, xy[:1]])
-        steps = np.linalg.norm(np.diff(xy, axis=0), axis=1)
+        steps = edge_lengths(xy)
         length = float(steps.sum())
         count = int(np.ceil(length / spacing))
         if count < 6:

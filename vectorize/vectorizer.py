@@ -14,7 +14,7 @@ from vectorize.drawing import Drawing
 from vectorize.edits import Edits
 from vectorize.fitting import TracedPoints, fit_stroke
 from vectorize.gaps import bridge_gaps, keep_largest_piece
-from vectorize.graph import MedialGraph
+from vectorize.graph import MedialGraph, lengths
 from vectorize.ink_guard import InkGuard, guard_margin
 from vectorize.classifiers import make_classifier, shipped_pass_scorer
 from vectorize.clusters import merge_triple_points, straightest_pairs
@@ -82,7 +82,7 @@ def _junctions(graph: MedialGraph, nodes, stroke_width: float) -> list[Junction]
             branch = graph.branches[bid]
             r = branch.radii if end == "a" else branch.radii[::-1]
             pts = branch.points if end == "a" else branch.points[::-1]
-            dist = np.linalg.norm(pts - pts[0], axis=1)
+            dist = lengths(pts - pts[0])
             band = r[(dist > 1.5 * stroke_width) & (dist < 3.5 * stroke_width)]
             radii.extend(band.tolist())
         width = 2.0 * float(np.median(radii)) if radii else stroke_width
@@ -202,7 +202,7 @@ def _trace(graph: MedialGraph, simple: Simplified, ordering: Ordering, junctions
         for base in sharp_points:
             split[np.all(xy == base, axis=1)] = True
         for center, reach, crossing in zones:
-            dist = np.linalg.norm(xy - center, axis=1)
+            dist = lengths(xy - center)
             near = dist < reach
             keep[near] &= crossing & (dist[near] < 1e-6)
         result.append((TracedPoints(xy=xy, keep=keep, split=split), closed, twins))

@@ -23,6 +23,8 @@ from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components
 from scipy.spatial import Delaunay
 
+from vectorize.graph import lengths
+
 # Circumcentres closer than this fraction of the drawing's extent are one Voronoi vertex
 # (cocircular samples; the error of the circumcentre formula is ~1e-13 of the extent).
 SAME_CENTER = 1e-10
@@ -70,7 +72,7 @@ def voronoi_part(samples: np.ndarray, chosen: np.ndarray | None = None, *, span:
     chosen = np.arange(len(samples)) if chosen is None else chosen
     points = samples[chosen]
     if span is None:
-        span = float(np.max(np.ptp(points, axis=0))) + 1.0
+        span = float(np.max(sides(points))) + 1.0
     # qhull is 1.5-2x slower on the exact points: evenly resampled straight outlines are full
     # of cocircular quadruples. Points moved by JITTER px triangulate fast, and that
     # triangulation is kept when it is one of the exact points' (any triangulation of a
@@ -107,7 +109,7 @@ def voronoi_part(samples: np.ndarray, chosen: np.ndarray | None = None, *, span:
         grouped[joined] = _circumcenters(points, triples[joined])
         centers = grouped
         with np.errstate(invalid="ignore"):
-            radius = np.linalg.norm(centers - points[triples[:, 0]], axis=1)
+            radius = lengths(centers - points[triples[:, 0]])
         ridges = label[ridges]
         # A chain of near-equal centres may join two triangles a ridge also joins directly.
         apart = ridges[:, 0] != ridges[:, 1]
@@ -143,9 +145,9 @@ def _triangulation(points: np.ndarray, jitter: np.ndarray | None, span: float) -
     first, second, opposite = first[shared], second[shared], opposite[shared]
     ridge_points = np.column_stack([simplices[first, (opposite + 1) % 3], simplices[first, (opposite + 2) % 3]])
     with np.errstate(invalid="ignore"):  # flat triangles' centres are infinite
-        radius = np.linalg.norm(centers - points[triples[:, 0]], axis=1)
+        radius = lengths(centers - points[triples[:, 0]])
         # Triangles with the same circumcentre are one vertex.
-        same = np.linalg.norm(centers[first] - centers[second], axis=1) <= SAME_CENTER * span
+        same = lengths(centers[first] - centers[second]) <= SAME_CENTER * span
         if jitter is not None:
             # Delaunay (each edge locally, hence all): each inner edge's far corner lies
             # outside the other triangle's circle (the same test from either side: made from
@@ -156,10 +158,17 @@ def _triangulation(points: np.ndarray, jitter: np.ndarray | None, span: float) -
             small = radius[second] < radius[first]
             near = np.where(small, second, first)
             beyond = far[np.arange(len(far)), (~small).astype(int)]
-            outside = np.linalg.norm(points[beyond] - centers[near], axis=1) >= radius[near] - ROUNDING * span
+            outside = lengths(points[beyond] - centers[near]) >= radius[near] - ROUNDING * span
             if not (outside | same | ~(radius[near] <= span)).all():
                 return None
     return triples, centers, radius, first, second, ridge_points, same
+
+
+def sides(points: np.ndarray) -> np.ndarray:
+    """(2,) the width and height (px) of the bounding box of `points` (N, 2): the same
+    numbers as `np.ptp(points, axis=0)`, without its slow reduction across rows of two."""
+    x, y = points[:, 0], points[:, 1]
+    return np.array([x.max() - x.min(), y.max() - y.min()])
 
 
 def _circumcenters(points: np.ndarray, triples: np.ndarray) -> np.ndarray:
@@ -170,7 +179,8 @@ def _circumcenters(points: np.ndarray, triples: np.ndarray) -> np.ndarray:
     b = corners[:, 1] - corners[:, 0]
     c = corners[:, 2] - corners[:, 0]
     d = 2.0 * (b[:, 0] * c[:, 1] - b[:, 1] * c[:, 0])
-    bb, cc = (b * b).sum(1), (c * c).sum(1)
+    # Each sum of two squares as `.sum(1)` adds them (the same bits, without its reduction).
+    bb, cc = b[:, 0] * b[:, 0] + b[:, 1] * b[:, 1], c[:, 0] * c[:, 0] + c[:, 1] * c[:, 1]
     with np.errstate(divide="ignore", invalid="ignore"):
         offset = np.column_stack([c[:, 1] * bb - b[:, 1] * cc, b[:, 0] * cc - c[:, 0] * bb]) / d[:, None]
     return corners[:, 0] + offset
@@ -216,7 +226,7 @@ def tile_slabs(samples: np.ndarray, margin: float, count: int) -> list[tuple] | 
     """`count` tiles of equal sample counts along the samples' longer side, each widened by
     `margin` px: [(chosen sample indices (ascending), (lo, hi) widened slab, (lo, hi) core,
     axis)]. None when a widened tile would hold most samples (tiling does not pay)."""
-    axis = int(np.argmax(np.ptp(samples, axis=0)))
+    axis = int(np.argmax(sides(samples)))
     coord = samples[:, axis]
     bounds = np.concatenate([[-np.inf], np.quantile(coord, np.arange(1, count) / count), [np.inf]])
     tiles = []
