@@ -18,6 +18,9 @@ from vectorize.stroke import Stroke
 # The first fit of a piece takes about one traced point per THIN stroke widths of arc
 # length (`thinned`), and every point within DENSE widths of an uncertain stretch.
 THIN = 0.3
+# ... and at most THIN_MAX px: the outline's samples are at most 1 px apart (`outline_rings`),
+# and a thick line's tight bend needs its points as much as a thin line's.
+THIN_MAX = 1.0
 # Only pieces of more points than this are thinned: FITPACK's time is in the long ones.
 THIN_FROM = 2000
 DENSE = 3.0
@@ -383,7 +386,7 @@ def fit_stroke(traced: TracedPoints, *, closed: bool, sigma: float, stroke_width
             # uncertain stretches: FITPACK's time is linear in the points, and the axis gives
             # 3-5 per px. Where that fit leaves the ink, the piece is fitted on every point
             # before the guard's ladder: thinned knots can swing across a long uncertain stretch.
-            spacing = THIN * stroke_width if len(piece) > THIN_FROM else 0.0
+            spacing = min(THIN * stroke_width, THIN_MAX) if len(piece) > THIN_FROM else 0.0
             control = fit_piece(piece, **settings, spacing=spacing, dense=near)
             if guard is not None and curve_excess(guard, control)[0] > 0.0:
                 if spacing:
