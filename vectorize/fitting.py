@@ -20,7 +20,7 @@ from vectorize.stroke import Stroke
 THIN = 0.3
 # ... and at most THIN_MAX px: the outline's samples are at most 1 px apart (`outline_rings`),
 # and a thick line's tight bend needs its points as much as a thin line's.
-THIN_MAX = 1.0
+THIN_MAX = 1.5
 # Only pieces of more points than this are thinned: FITPACK's time is in the long ones.
 THIN_FROM = 2000
 DENSE = 3.0
