@@ -34,7 +34,8 @@ COOKIE = "onestroke_studio"  # + a digest of the token: cookies ignore ports, tw
 def cookie_name(token: str) -> str:
     return f"{COOKIE}_{hashlib.sha256(token.encode()).hexdigest()[:10]}"
 STATIC = {"app.js": "text/javascript", "api.js": "text/javascript", "panels.js": "text/javascript",
-          "view.js": "text/javascript", "marks.js": "text/javascript",
+          "view.js": "text/javascript", "marks.js": "text/javascript", "edits.js": "text/javascript",
+          "hint.js": "text/javascript", "tools.js": "text/javascript",
           "style.css": "text/css", "index.html": "text/html"}
 # The toolpath player's files, served from its own package (`fabrication.player`).
 PLAYER = {"player.js": "text/javascript", "player.css": "text/css"}

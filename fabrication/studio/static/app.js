@@ -1,87 +1,16 @@
-// onestroke studio: the page. Plain JS, no build step; every computation is the server's
-// (the library's), the page only draws, keeps the edits history and sends edits back.
+// onestroke studio: the page's wiring, the drawing view (fit, draw, pan and zoom), the pen
+// (play, scrub, its place kept through an edit) and the Refine panel's lists of a state. Plain
+// JS, no build step; every computation is the server's (the library's). The edits and their
+// history: edits.js; clicks per tool: tools.js; the marks on the curve: marks.js.
 "use strict";
 import { $, busy, call, report } from "./api.js";
-import { arrows, bridges, drawPasses, junctionMarkers, markerHit, placeLabels, retraces, startMarkers,
+import { apply, redo, SETTINGS, setupEdits, undo, updateButtons, withEdit, withSettings } from "./edits.js";
+import { hint } from "./hint.js";
+import { arrows, bridges, drawPasses, junctionMarkers, placeLabels, retraces, startMarkers,
          startPlaces } from "./marks.js";
 import { fieldNames, refreshPanel, setupPanels } from "./panels.js";
+import { choosePasses, describeUnresolved, onClick, unresolvedFixes } from "./tools.js";
 import { COLORS, dist, passRank, percent, samePasses, studio, toImage, toScreen } from "./view.js";
-
-const PAIRINGS = ["crossing", "touching", "third"];
-
-
-// ---------------------------------------------------------------- edits and history
-function currentEdits() { return studio.history[studio.at]; }
-const SETTINGS = ["threshold", "blur", "multi"];
-// Only the answer to the latest request is shown: a slow re-run answered after a newer
-// edit (or while a slider moves on) is dropped, so the page never shows a stale state.
-async function apply(edits, push = true) {
-  if (push) {
-    studio.history = studio.history.slice(0, studio.at + 1);
-    studio.history.push(edits);
-    studio.at = studio.history.length - 1;
-  }
-  updateButtons();
-  const ticket = ++studio.requests;
-  const shown = studio.state ? studio.state.edits : null;
-  const rerun = !shown || SETTINGS.some((k) => edits[k] !== shown[k]);
-  busy(true);
-  if (rerun) rerunning(1);
-  const started = performance.now();
-  try {
-    const state = await call("api/state", { edits, page: studio.page });
-    state.answered = (performance.now() - started) / 1000;
-    if (ticket === studio.requests && !state.superseded) { studio.shown = edits; show(state); }
-  } catch (error) {
-    // A refused edits state (e.g. an opened file that is not an edits file) is no step.
-    if (push && studio.history[studio.at] === edits) { studio.history.pop(); studio.at -= 1; updateButtons(); }
-    if (ticket === studio.requests) tell(error.message, true);
-  } finally {
-    busy(false);
-    if (rerun) rerunning(-1);
-  }
-}
-
-// The visible busy state of a re-run from binarization (threshold, blur, mode: ~0.5-1 s).
-function rerunning(step) {
-  studio.rerunning += step;
-  $("rerun").hidden = studio.rerunning <= 0;
-  $("tab-refine").classList.toggle("rerunning", studio.rerunning > 0);
-}
-
-// Does edit e, of one of these kinds, lie within the edits' tolerance of `at` (by
-// `distance(e.at, at)`, image px: the radius within which the library matches an edit to
-// its junction or branch)?
-function isNear(e, edits, kinds, at, distance = dist) {
-  return kinds.includes(e.kind) && distance(e.at, at) <= edits.tolerance;
-}
-
-// A copy of `edits` without its edits of these kinds near `at`.
-function without(edits, kinds, at = null, distance = dist) {
-  const copy = JSON.parse(JSON.stringify(edits));
-  copy.edits = copy.edits.filter((e) => !isNear(e, copy, kinds, at, distance));
-  return copy;
-}
-
-// The current edits with these settings changed (threshold, blur, multi).
-function withSettings(change) { return Object.assign(without(currentEdits(), []), change); }
-
-// The current edits plus `edit`, which replaces the edits of the kinds `replaces` near its
-// place (one pairing per junction: a new choice replaces the old one instead of piling up).
-function withEdit(edit, replaces = []) {
-  const edits = without(currentEdits(), replaces, edit.at);
-  edits.edits.push(edit);
-  return edits;
-}
-
-function undo() { if (studio.at > 0) { studio.at -= 1; apply(currentEdits(), false); } }
-function redo() { if (studio.at < studio.history.length - 1) { studio.at += 1; apply(currentEdits(), false); } }
-
-function updateButtons() {
-  $("undo").disabled = studio.at <= 0;
-  $("redo").disabled = studio.at >= studio.history.length - 1;
-}
-
 
 // Fit the view to the drawing: the ink and the curve with a margin for the markers'
 // labels (a small drawing on a large sheet fills the view), else the whole image.
@@ -185,62 +114,6 @@ function draw() {
 }
 
 
-function middle([a, b]) { return { at: [(a[0] + b[0]) / 2, (a[1] + b[1]) / 2], ends: [a, b] }; }
-
-// Distance from point p to the segment a-b (image px).
-function toSegment(p, [a, b]) {
-  const dx = b[0] - a[0], dy = b[1] - a[1], n = dx * dx + dy * dy;
-  const t = n ? Math.max(0, Math.min(1, ((p[0] - a[0]) * dx + (p[1] - a[1]) * dy) / n)) : 0;
-  return dist(p, [a[0] + t * dx, a[1] + t * dy]);
-}
-
-// The branch a merge at unresolved junction j collapses: its shortest, to the degree-3 node
-// it leads to (the two are one crossing again), or undefined.
-function shortestBranch(j) {
-  return studio.state.graph.branches.filter((b) => (b.nodes || []).includes(j.id))
-    .sort((a, b) => a.length - b.length)[0];
-}
-
-// Merge unresolved junction j by its shortest branch (its button and the merge tool's click
-// on it); null when no branch leads from it.
-function mergeBranch(j) {
-  const branch = shortestBranch(j);
-  if (!branch) return null;
-  hint("");
-  return apply(withEdit({ kind: "merge", at: branch.at }));
-}
-
-// What an unresolved junction offers: merge it with the degree-3 node its shortest branch
-// leads to (one crossing again), and drop a split made there. Buttons, for the hint shown
-// on a click and the junction list.
-function unresolvedFixes(j) {
-  const s = studio.state, buttons = [];
-  const branch = shortestBranch(j);
-  if (branch) {
-    const other = s.graph.junctions.find((o) => o.id === branch.nodes.find((n) => n !== j.id));
-    const button = document.createElement("button");
-    button.className = "merge-here";
-    button.textContent = other ? `merge with (${other.at[0].toFixed(0)}, ${other.at[1].toFixed(0)}): one crossing`
-      : "merge by its shortest branch";
-    button.title = `collapse the ${branch.length.toFixed(0)} px branch between them into a degree-4 crossing`;
-    button.onclick = () => mergeBranch(j);
-    buttons.push(button);
-  }
-  const edits = currentEdits();
-  if (edits.edits.some((e) => isNear(e, edits, ["split"], j.at))) {
-    const button = document.createElement("button");
-    button.className = "unsplit";
-    button.textContent = "undo the split here";
-    button.onclick = () => { hint(""); apply(without(currentEdits(), ["split"], j.at)); };
-    buttons.push(button);
-  }
-  return buttons;
-}
-
-function describeUnresolved(j) {
-  return `(${j.at[0].toFixed(0)}, ${j.at[1].toFixed(0)}) unresolved: ${j.degree} branches meet and none ` +
-    "is read as going on through it, so the line's order here is a guess";
-}
 
 // A threshold or blur that leaves little of the ink (the line shrinks to a stub, the
 // drawing vanishes from the view) says so, beside the longest line this page has shown
@@ -431,125 +304,7 @@ function passChoice(j) {
   return box;
 }
 
-function choosePasses(j, option) {
-  return apply(withEdit({ kind: "passes", at: j.at, passes: option.passes }, ["passes"]));
-}
 
-// ---------------------------------------------------------------- clicks on the drawing
-function nearest(items, point, radius) {
-  let best = null, bestD = radius / studio.view.scale;
-  for (const item of items) {
-    const d = dist(item.at, point);
-    if (d <= bestD) { best = item; bestD = d; }
-  }
-  return best;
-}
-
-// What a click that finds nothing to act on says, per tool.
-const MISSED = {
-  pairing: () => "no crossing or triple point here: click on a junction's marker",
-  split: () => "no crossing or triple point here: click on a junction's marker",
-  merge: () => studio.state.graph.branches.length ? "no branch handle (◆) here: click on one"
-    : "no branch joins two degree-3 nodes in this reading: nothing to merge",
-  start: () => "no free end here: click on a stroke's end or a ring (◌)",
-  retrace: () => "no line here: click on the line",
-  reverse: () => "no stroke here: click on a stroke",
-  gap: () => (studio.state.graph.bridges || []).length + (studio.state.graph.unbridged || []).length
-    ? "no pen gap here: click on a dashed circle to open it, a struck-through one to close it"
-    : "no pen gap was bridged in this drawing (single-line mode bridges them; multi-stroke none)",
-};
-
-// What comes of the header's actions (undo, redo, save, load, open: at hand on every tab),
-// said in the panel in view: on Refine an error in its warnings and a note as the hint; on
-// the Embroidery or Laser tab both in that panel's list, where the user is looking.
-function tell(message, error = false) {
-  const list = studio.tab === "refine" ? "warnings" : `${studio.tab}-warnings`;
-  if (error) report(new Error(message), list);
-  else if (studio.tab === "refine") hint(message);
-  else { const li = document.createElement("li"); li.textContent = message; $(list).replaceChildren(li); }
-}
-
-function hint(text, buttons = []) {
-  $("hint").textContent = text || "";
-  for (const b of buttons) $("hint").append(" ", b);
-  $("hint").hidden = !text;
-}
-
-function onClick(event) {
-  const s = studio.state;
-  if (!s || studio.dragged) return;
-  const r = $("canvas").getBoundingClientRect();
-  const sx = event.clientX - r.left, sy = event.clientY - r.top;
-  const p = toImage(sx, sy);
-  const done = clickTool(s, p, sx, sy);
-  if (done !== "hint") hint(done ? "" : MISSED[studio.tool]());
-}
-
-// The edit a click at image point p (screen point sx, sy) makes with the current tool (its
-// request), "hint" when it only explains, or nothing.
-function clickTool(s, p, sx, sy) {
-  const tool = studio.tool;
-  if (tool === "pairing" || tool === "split" || tool === "merge") {
-    const open = markerHit(sx, sy, ["unresolved"]);
-    const merged = open && tool === "merge" ? mergeBranch(open) : null;
-    if (merged) return merged;
-    if (open && !markerHit(sx, sy, ["crossing", "triple"])) {
-      hint(describeUnresolved(open) + ".", unresolvedFixes(open));
-      return "hint";
-    }
-  }
-  if (tool === "pairing" || tool === "split") {
-    const j = markerHit(sx, sy, ["crossing", "triple"]);
-    if (!j) return;
-    if (tool === "split") {
-      // A pairing chosen at this junction has nothing left to act on once it is split.
-      return apply(withEdit({ kind: "split", at: j.at }, ["pairing", "passes"]));
-    }
-    if (j.role === "triple") {
-      // The next of the pairings that keep one stroke, in the order of their likelihood.
-      if (!j.options.length) return null;
-      const k = j.options.findIndex((o) => samePasses(o.passes, j.passes));
-      return choosePasses(j, j.options[(k + 1) % j.options.length]);
-    }
-    const next = PAIRINGS[(PAIRINGS.indexOf(j.decision) + 1) % 3];
-    return apply(withEdit({ kind: "pairing", at: j.at, pairing: next }, ["pairing"]));
-  }
-  if (tool === "merge") {
-    const b = nearest(s.graph.branches, p, 16);
-    return b ? apply(withEdit({ kind: "merge", at: b.at })) : null;
-  }
-  if (tool === "start") {
-    // A stroke's end, or a free end the line passes (the tip of a stem drawn down and back
-    // up): starting there, the line retraces other branches instead.
-    const ends = (s.graph.ends || []).map((at) => ({ at }));
-    for (const stroke of s.strokes) if (!stroke.closed) {
-      ends.push({ at: stroke.points[0] }, { at: stroke.points[stroke.points.length - 1] });
-    }
-    const e = nearest(ends, p, 24);
-    return e ? apply(withEdit({ kind: "start", at: e.at.slice(0, 2) })) : null;
-  }
-  if (tool === "retrace") {
-    // On a stretch drawn twice: draw it once; elsewhere on the line: go back over it here
-    // (route inspection then retraces this branch rather than another).
-    const twice = (s.graph.retraces || []).flatMap((r) => r.points.map((q) => ({ at: q })));
-    const onBand = nearest(twice, p, 14);
-    const q = onBand || nearest(studio.line.pts.map((q) => ({ at: q })), p, 16);
-    if (!q) return;
-    return apply(withEdit({ kind: onBand ? "once" : "twice", at: q.at.slice(0, 2) }, ["twice", "once"]));
-  }
-  if (tool === "gap") {
-    // A gap kept open: close it again (drop the edits that opened it); a bridged gap: open it.
-    const open = nearest((s.graph.unbridged || []).map(middle), p, 24);
-    if (open) return apply(without(currentEdits(), ["unbridge"], open.ends, toSegment));
-    const gap = nearest((s.graph.bridges || []).map(middle), p, 24);
-    return gap ? apply(withEdit({ kind: "unbridge", at: gap.at })) : null;
-  }
-  if (tool === "reverse") {
-    const points = studio.line.pts.map((q) => ({ at: q }));
-    const q = nearest(points, p, 16);
-    return q ? apply(withEdit({ kind: "reverse", at: q.at.slice(0, 2) })) : null;
-  }
-}
 
 function setupView() {
   const c = $("canvas");
@@ -625,7 +380,6 @@ function preview(change) {
 
 function setup() {
   setupView();
-  $("undo").onclick = undo; $("redo").onclick = redo;
   document.addEventListener("keydown", (e) => {
     // Space plays and pauses the pen (as in the player), unless a control has the key.
     if (e.key === " " && !e.ctrlKey && !["INPUT", "BUTTON", "SELECT", "TEXTAREA", "LABEL"].includes(e.target.tagName) &&
@@ -657,30 +411,7 @@ function setup() {
   $("play").onclick = play;
   $("scrub").oninput = () => { studio.playing = false; $("play").textContent = "▶ Play"; studio.pen = $("scrub").value / 1000; draw(); };
   setupPanels(() => studio.shown);
-  $("save").onclick = async () => {
-    try {
-      const r = await call("api/edits", { edits: currentEdits() });
-      if (studio.tab === "refine") $("summary").textContent += ` · saved ${r.saved}`;
-      else tell(`saved ${r.saved}`);
-    } catch (error) { tell(error.message, true); }
-  };
-  $("load").onclick = async () => {
-    try {
-      const r = await call("api/edits");
-      // No file yet: nothing to load (applying "no edits" would throw the user's away).
-      if (!r.exists) tell(`no edits saved yet: ${r.path} does not exist (Save edits writes it)`);
-      else if (JSON.stringify(r.edits) === JSON.stringify(currentEdits())) tell(`the edits are those of ${r.path} already`);
-      else { hint(""); apply(r.edits); }
-    } catch (error) { tell(error.message, true); }
-  };
-  $("open").onchange = async () => {
-    const file = $("open").files[0]; if (!file) return;
-    let data;
-    try { data = JSON.parse(await file.text()); }
-    catch (error) { tell(`${file.name} is not an edits file (not JSON)`, true); }
-    if (data !== undefined) apply(data);
-    $("open").value = "";
-  };
+  setupEdits(show);
   // The first view fits the ink too: the first state is drawn once the image is read.
   const loaded = new Promise((done) => {
     studio.image.onload = () => {
