@@ -9,7 +9,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.interpolate import splev, splprep
 
-from vectorize.graph import arc_lengths
+from vectorize.graph import arc_lengths, edge_lengths
 from vectorize.ink_guard import MARGIN, STEP, InkGuard, curve_excess, keep_in_ink
 from vectorize.retraces import Twin, mirror_flags, mirror_keep, rolled, share_pieces, twin_piece, valid_twins
 from vectorize.stroke import Stroke
@@ -18,8 +18,8 @@ from vectorize.stroke import Stroke
 # The first fit of a piece takes about one traced point per THIN stroke widths of arc
 # length (`thinned`), and every point within DENSE widths of an uncertain stretch.
 THIN = 0.3
-# ... and at most THIN_MAX px: the outline's samples are at most 1 px apart (`outline_rings`),
-# and a thick line's tight bend needs its points as much as a thin line's.
+# ... and at most THIN_MAX px: a thick line's tight bend needs its points as much as a thin
+# line's (on a 2.4 px grid the 8 px filled-outline figure eight came 1 px off at its bend).
 THIN_MAX = 1.5
 # Only pieces of more points than this are thinned: FITPACK's time is in the long ones.
 THIN_FROM = 2000
@@ -51,7 +51,7 @@ def _distinct(points: np.ndarray, min_step: float) -> np.ndarray:
     n = len(points)
     if n < 2:
         return np.arange(n)
-    steps = np.linalg.norm(np.diff(points, axis=0), axis=1)
+    steps = edge_lengths(points)
     keep = np.ones(n, dtype=bool)
     # A point is measured from the last kept one, which is its predecessor unless that one
     # was dropped: only the runs that start with a short step need walking point by point.
@@ -141,8 +141,9 @@ def fit_piece(points: np.ndarray, *, closed: bool, sigma: float, anchor: bool = 
     weighing as much as the points it stands for: about the same sum is minimised.
     """
     kept, count = thinned(points, spacing, dense)
-    distinct = _distinct(points[kept], 1e-3)
-    points, count = points[kept][distinct], count[distinct]
+    points = points[kept]
+    distinct = _distinct(points, 1e-3)
+    points, count = points[distinct], count[distinct]
     if closed and len(points) > 3 and np.linalg.norm(points[0] - points[-1]) < 1e-6:
         points, count = points[:-1], count[:-1]
     if len(points) < 4 or (closed and len(points) < 6):
@@ -152,8 +153,7 @@ def fit_piece(points: np.ndarray, *, closed: bool, sigma: float, anchor: bool = 
         return Stroke.from_polyline(line).control
     if closed:
         points, count = np.vstack([points, points[:1]]), np.append(count, count[0])
-    steps = np.linalg.norm(np.diff(points, axis=0), axis=1)
-    u = np.concatenate([[0.0], np.cumsum(steps)])
+    u = arc_lengths(points)
     u /= u[-1]
     # FITPACK minimises sum((w * residual)^2) within s: weights sqrt(count) and s over all the
     # points stood for ask of the thinned points what the full fit asks of every point.
