@@ -16,7 +16,9 @@ from fabrication.embroidery.hooping import check_plan_in_hoop, fit_to_hoop
 from fabrication.embroidery.arrows import ArrowOptions
 from fabrication.embroidery.needles import BODY, MOTIF
 from fabrication.embroidery.plan import FIXED_DATE, PlanOptions, StitchPlan, plan_embroidery, style_reach
+from fabrication.embroidery.quality import HOLE_GAP, HOLE_WINDOW, hole_places, repeated_holes, where
 from fabrication.embroidery.stats import EmbroideryStats, embroidery_stats
+from fabrication.embroidery.triple import TripleOptions
 from fabrication.embroidery.zigzag import ZigzagOptions
 from fabrication.placement import PlacementOptions, place
 from machines.hoops import Hoop, hoop_named
@@ -90,10 +92,36 @@ def embroider(drawing: Drawing, job: EmbroideryJob = EmbroideryJob(), *, progres
     warnings.extend(_long_stitch_warnings(plan, style))
     plan = replace(plan, name=job.name, field=(job.hoop.width, job.hoop.height), date=job.date)
     stats = embroidery_stats(plan, stitches_per_minute=job.stitches_per_minute,
-                             trim_seconds=job.trim_seconds)
+                             trim_seconds=job.trim_seconds, density_advice=density_advice(style))
     warnings.extend(stats.warnings)
+    warnings.extend(_hole_warnings(plan))
     return EmbroideryResult(drawing=plan.sewn, plan=plan, stats=stats, hoop=job.hoop,
                             fit_scale=float(scale), warnings=tuple(warnings))
+
+
+def density_advice(style) -> str:
+    """What to change where a design of `style` is too dense (its own options first)."""
+    for kind, advice in _DENSITY_ADVICE.items():
+        if isinstance(style, kind):
+            return advice
+    return "use a longer --stitch-length or a larger --size"
+
+
+_DENSITY_ADVICE = {
+    ZigzagOptions: "use a wider --spacing, --underlay none or a larger --size",
+    ArrowOptions: "use a wider --spacing, a smaller --arrow-size or a larger --size",
+    TripleOptions: "use a longer --stitch-length, --style running or a larger --size",
+}
+
+
+def _hole_warnings(plan: StitchPlan) -> list[str]:
+    """A warning naming the places where a needle re-enters a hole it made a moment before."""
+    rows = repeated_holes(plan)
+    if not len(rows):
+        return []
+    return [f"{len(rows)} needle points re-enter a hole made a moment before (within {HOLE_GAP:g} mm of "
+            f"one of the last {HOLE_WINDOW} on their side of the line) {where(hole_places(plan, rows))}; "
+            "the thread there may be cut or pile up; a larger --size or another --style avoids it"]
 
 
 # Stitches longer than this (mm) lie loose on the fabric and snag; zigzags wider than
