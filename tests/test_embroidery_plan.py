@@ -147,6 +147,24 @@ def test_stats_count_time_thread_and_size():
     assert any(line.startswith("stitches") for line in stats.lines())
 
 
+def test_bobbin_thread_is_estimated_beside_the_top_thread():
+    """Running stitches: the bobbin lies under every stitch (as long as the top thread).
+    A zigzag column: a third of its body stitches, the whole of its walks and locks."""
+    line = Drawing((_line([0, 0], [40, 0]),), 40, 1, "mm")
+    running = plan_embroidery(line, PlanOptions())
+    stats = embroidery_stats(running)
+    assert stats.bobbin_length == pytest.approx(stats.thread_length)
+    assert "top" in stats.lines()[2] and "bobbin" in stats.lines()[2]
+    zigzag = plan_embroidery(line, PlanOptions(style=ZigzagOptions()))
+    column = embroidery_stats(zigzag, column=True)
+    a, b = zigzag.stitches()
+    length = np.hypot(*(b - a).T)
+    body = zigzag.roles[zigzag.stitch_mask] == BODY
+    assert column.bobbin_length == pytest.approx(length[body].sum() / 3 + length[~body].sum())
+    assert 0.3 * column.thread_length < column.bobbin_length < 0.5 * column.thread_length
+    assert "third" in column.bobbin_rule
+
+
 def test_density_warning_above_six_needle_points_within_half_a_millimetre():
     def plan_of(points, roles=None):
         n = len(points)

@@ -143,3 +143,24 @@ def test_a_short_stroke_just_above_min_stroke_never_knots(style, angle):
     assert (plan.roles[long_rows[1:5]] == TACK).all() and (plan.roles[long_rows[-4:]] == LOCK).all()
     # What was made lighter is on record, at the short stroke.
     assert plan.lighter and all(np.hypot(t.x, t.y) < 1.3 for t in plan.lighter)
+
+
+def test_a_dropped_speck_is_measured_to_the_nearest_stitch_of_its_thread():
+    """The warning used to measure from the neighbouring strokes' ends only; it now gives
+    the distance to the nearest needle point of the speck's thread, and says why a speck
+    near the middle of a stroke is still left out."""
+    line = _line([0.0, 0.0], [30.0, 0.0])
+    beside = _line([15.0, 1.5], [15.4, 1.7])  # 1.5 mm from the line's middle, 15 mm from its ends
+    far = _line([10.0, 12.0], [10.4, 12.2])
+    other = _line([0.0, 25.0], [30.0, 25.0])
+    drawing = Drawing((line, beside, far, other), 30, 25, "mm")
+    plan = plan_embroidery(drawing, PlanOptions())
+    assert len(plan.dropped) == 2
+    needles = plan.points[plan.kinds == STITCH]
+    near_beside = np.linalg.norm(needles - beside.points_at(np.linspace(0, 1, 9))[:, None], axis=2).min()
+    near_far = np.linalg.norm(needles - far.points_at(np.linspace(0, 1, 9))[:, None], axis=2).min()
+    assert near_beside < 3.0 < near_far
+    first, second = plan.dropped
+    assert first.startswith("stroke 2 ") and f"nearest stitch of its thread, {near_beside:.1f} mm" in first
+    assert "sewn before and after it end more than --trim-distance 3 mm away" in first
+    assert second.startswith("stroke 3 ") and f"every stitch of its thread (the nearest is {near_far:.1f} mm" in second

@@ -9,8 +9,9 @@ back exactly, and its pure-Python encoder (a third of the write time) is skipped
 .pes/.pec thumbnails are drawn by `pec_thumbnail` (same bytes, vectorised).
 Per-format numbers and writer settings (PES version, JEF trims) come from the profile.
 The bytes depend on the plan alone: the design name, the JEF date (pyembroidery would
-stamp the current time) and the JEF hoop code come from the plan, not from the clock or
-the design's extent.
+stamp the current time), the JEF hoop code and the PES hoop fields come from the plan,
+not from the clock or the design's extent (pyembroidery always writes a 130x180 hoop
+indicator into .pes, and 100x100 mm into version 6's hoop size).
 """
 
 from __future__ import annotations
@@ -34,6 +35,12 @@ _COMMANDS = np.array([pyembroidery.STITCH, pyembroidery.JUMP, pyembroidery.TRIM,
 JEF_HOOPS = ((1, 50.0, 50.0), (0, 110.0, 110.0), (3, 126.0, 110.0), (2, 140.0, 200.0), (4, 200.0, 200.0))
 _JEF_HOOP_OFFSET = 0x20  # int32 after the offsets, 0x14, the date, 2 pad bytes and 2 counts
 PES_VERSIONS = (1, 6)
+# PES header (libpes' description of PE-Design's files): after "#PES0001"/"#PES0060" and
+# the PEC offset, a u16 hoop size indicator (0: 100x100 mm, 1: 130x180 mm and larger).
+# Version 6 then has 2 characters, five length-prefixed strings, two u16 flags and the hoop
+# size in mm (u16 width, u16 height).
+_PES_HOOP_INDICATOR = 12
+SMALL_PES_HOOP = (100.0, 100.0)
 
 
 def plan_units(plan: StitchPlan) -> np.ndarray:
@@ -105,6 +112,24 @@ def jef_hoop_code(plan: StitchPlan) -> int | None:
     return None
 
 
+def pes_hoop_fields(data: bytes, field: tuple[float, float]) -> bytes:
+    """`data` (a .pes file as pyembroidery writes it) with its hoop fields saying `field`
+    (width, height) mm: the indicator 0 when it fits 100x100 mm, else 1; in version 6
+    also the hoop size in whole mm."""
+    w, h = field
+    small = w <= SMALL_PES_HOOP[0] + 1e-9 and h <= SMALL_PES_HOOP[1] + 1e-9
+    out = bytearray(data)
+    out[_PES_HOOP_INDICATOR:_PES_HOOP_INDICATOR + 2] = (0 if small else 1).to_bytes(2, "little")
+    if bytes(out[:8]) == b"#PES0060":
+        at = _PES_HOOP_INDICATOR + 2 + 2  # the indicator, then 2 characters ("02")
+        for _ in range(5):  # name, category, author, keywords, comments
+            at += 1 + out[at]
+        at += 4  # "optimize hoop change", "design page is custom"
+        size = int(round(w)).to_bytes(2, "little") + int(round(h)).to_bytes(2, "little")
+        out[at:at + 4] = size
+    return bytes(out)
+
+
 def writer_settings(plan: StitchPlan, fmt: EmbroideryFormat, *, pes_version: int | None = None) -> dict:
     """pyembroidery writer settings for `plan` in `fmt` (the profile's, the JEF date)."""
     settings = {**fmt.settings}
@@ -144,6 +169,8 @@ def embroidery_bytes(plan: StitchPlan, fmt: EmbroideryFormat, *, pes_version: in
     with fast_pec_thumbnails():  # identical bytes, 40 % less .pes write time
         writer(pattern, buffer, settings)
     data = buffer.getvalue()
+    if fmt.extension == "pes" and plan.field is not None:
+        data = pes_hoop_fields(data, plan.field)
     code = jef_hoop_code(plan) if fmt.extension == "jef" else None
     if code is not None:
         # pyembroidery picks the code from the design's extent; the user named the hoop.
@@ -158,4 +185,4 @@ def write_embroidery(plan: StitchPlan, path: str | os.PathLike, *, pes_version: 
 
 
 __all__ = ["write_embroidery", "embroidery_bytes", "to_pattern", "plan_units", "writer_settings",
-           "jef_hoop_code", "STITCH", "JUMP", "TRIM", "COLOR"]
+           "jef_hoop_code", "pes_hoop_fields", "STITCH", "JUMP", "TRIM", "COLOR"]

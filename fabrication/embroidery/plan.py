@@ -213,11 +213,12 @@ def _lock_paths(body: NeedlePoints) -> tuple[np.ndarray, np.ndarray]:
     return body.points[ahead], body.points[::-1][back][::-1]
 
 
-def _chains(drawing: Drawing, block: tuple[int, ...], options: PlanOptions) -> tuple[list[list[int]], list[str]]:
+def _chains(drawing: Drawing, block: tuple[int, ...], options: PlanOptions) -> tuple[list[list[int]], list[int]]:
     """Group sewn strokes into chains sewn with one tack and one lock. A stroke shorter
-    than `min_stroke` joins its nearer neighbour (same thread, within the trim distance)
-    by a travel stitch; a chain still shorter than `min_stroke` in all is dropped (a knot
-    of tacks and locks on a speck), with a line naming its strokes."""
+    than `min_stroke` joins its nearer neighbour in sewing order (same thread, within the
+    trim distance) by a travel stitch; a chain still shorter than `min_stroke` in all is
+    dropped (a knot of tacks and locks on a speck). Returns the chains and the dropped
+    strokes."""
     strokes = drawing.strokes
     n = len(strokes)
     lengths = [s.length for s in strokes]
@@ -241,16 +242,36 @@ def _chains(drawing: Drawing, block: tuple[int, ...], options: PlanOptions) -> t
             chains.append([i])
     kept, dropped = [], []
     for chain in chains:
-        total = sum(lengths[i] for i in chain)
-        if total >= max(options.min_stroke, options.min_stitch):
+        if sum(lengths[i] for i in chain) >= max(options.min_stroke, options.min_stitch):
             kept.append(chain)
-            continue
-        for i in chain:
-            x, y = strokes[i].start
-            dropped.append(f"stroke {i + 1} ({lengths[i]:.2f} mm at {x:.1f}, {y:.1f} mm) was left out: "
-                           f"shorter than --min-stroke {options.min_stroke:g} mm and more than "
-                           f"--trim-distance {options.trim_distance:g} mm from a stroke of its thread")
+        else:
+            dropped += chain
     return kept, dropped
+
+
+def _dropped_lines(drawing: Drawing, dropped: list[int], block: tuple[int, ...], source: tuple[int, ...],
+                   points: np.ndarray, blocks: np.ndarray, options: PlanOptions) -> tuple[str, ...]:
+    """One line per dropped stroke (numbered as in the input), with the distance from it to
+    the nearest needle point of its thread in the plan (`points` (N, 2) mm, `blocks` (N,)
+    of the needle rows)."""
+    lines = []
+    for i in dropped:
+        stroke = drawing.strokes[i]
+        mine = points[blocks == block[i]]
+        along = stroke.points_at(np.linspace(0.0, 1.0, 9))
+        near = float(cKDTree(mine).query(along)[0].min()) if len(mine) else np.inf
+        x, y = stroke.start
+        if near > options.trim_distance:
+            why = (f"more than --trim-distance {options.trim_distance:g} mm from every stitch of its "
+                   f"thread (the nearest is {near:.1f} mm away)" if np.isfinite(near) else
+                   "no stitch of its thread is sewn")
+        else:
+            why = (f"the strokes sewn before and after it end more than --trim-distance "
+                   f"{options.trim_distance:g} mm away (the nearest stitch of its thread, {near:.1f} mm "
+                   "away, is in the middle of a stroke)")
+        lines.append(f"stroke {source[i] + 1} ({stroke.length:.2f} mm at {x:.1f}, {y:.1f} mm) was left out: "
+                     f"shorter than --min-stroke {options.min_stroke:g} mm and {why}")
+    return tuple(lines)
 
 
 def _chain_points(drawing: Drawing, chain: list[int], options: PlanOptions, offset: float):
@@ -289,7 +310,7 @@ def _stitch_chains(drawing: Drawing, block: tuple[int, ...], options: PlanOption
     if not chains:
         raise InputError("no stroke is long enough to stitch (all shorter than --min-stroke "
                          f"{options.min_stroke:g} mm and far from the others)")
-    return chains, bodies, tuple(dropped)
+    return chains, bodies, dropped
 
 
 def _assemble(chains: list[list[int]], bodies: list, block: tuple[int, ...], options: PlanOptions,
@@ -394,11 +415,21 @@ def _crowding_ties(points: np.ndarray, kinds: np.ndarray, ties: np.ndarray,
     return crowding
 
 
+def _centring_shift(units: np.ndarray, kinds: np.ndarray) -> np.ndarray:
+    """Whole grid steps (2,) that centre the box of the needle points and jumps on (0, 0)
+    (to within half a step)."""
+    box = units[kinds <= JUMP]
+    return -np.rint((box.min(axis=0) + box.max(axis=0)) / 2).astype(np.int64)
+
+
 def plan_embroidery(drawing: Drawing, options: PlanOptions = PlanOptions(), *,
-                    progress: ProgressCallback | None = None) -> StitchPlan:
+                    progress: ProgressCallback | None = None, centre: bool = False) -> StitchPlan:
     """Stitch every stroke of `drawing` (mm, centred on (0, 0)) into one `StitchPlan`:
     colour blocks in sewing order (see `order.sewing_order`), rows indexing `plan.sewn`.
-    progress: an `onestroke.progress.ProgressCallback` (strokes stitched)."""
+    progress: an `onestroke.progress.ProgressCallback` (strokes stitched); centre: move
+    the stitches (and `plan.sewn`) by whole grid steps so that the bounding box of the
+    needle points and jumps is centred on (0, 0) (the curve's box is not the stitches': a
+    zigzag or arrows reach further on one side of it)."""
     if drawing.unit != "mm":
         raise InputError(f"place the drawing in mm before stitching (it is in {drawing.unit})")
     if not drawing.strokes:
@@ -419,23 +450,24 @@ def plan_embroidery(drawing: Drawing, options: PlanOptions = PlanOptions(), *,
         if not lighter:
             break
         levels.update({tie: levels.get(tie, 0) + 1 for tie in lighter})
-    # Source stroke numbers in the messages, not positions in the sewing order.
-    dropped = tuple(_renumber(line, order.source) for line in dropped)
     if not np.any(kinds == STITCH):
         raise FabricationError("no needle points left after merging short stitches")
+    shift = _centring_shift(units, kinds) if centre else np.zeros(2, dtype=np.int64)
+    if shift.any():
+        units = units + shift
+        dx, dy = shift * options.grid
+        sewn = sewn.transformed(np.array([[1.0, 0.0, dx], [0.0, 1.0, dy]]), width=sewn.width,
+                                height=sewn.height, unit=sewn.unit, stroke_width=sewn.stroke_width)
+    needle = kinds == STITCH
+    dropped = _dropped_lines(sewn, dropped, order.block, order.source, units[needle] * options.grid,
+                             blocks[needle], options)
     used = np.unique(blocks)
     # A block whose strokes were all dropped has no thread in the file.
     remap = np.full(len(order.threads), -1, dtype=np.int64)
     remap[used] = np.arange(len(used))
     lighter = tuple(LighterTie(x=float(x), y=float(y), lock=bool(tie % 2), level=level)
                     for tie, level in sorted(levels.items())
-                    for x, y in [np.rint(anchors[tie] / options.grid) * options.grid])
+                    for x, y in [(np.rint(anchors[tie] / options.grid) + shift) * options.grid])
     return StitchPlan(points=units * options.grid, kinds=kinds, roles=roles, params=params,
                       strokes=owners, threads=tuple(order.threads[i] for i in used),
                       blocks=remap[blocks], sewn=sewn, dropped=dropped, lighter=lighter)
-
-
-def _renumber(line: str, source: tuple[int, ...]) -> str:
-    """'stroke 3 ...' (position in the sewing order) -> the stroke's number in the input."""
-    head, number, rest = line.split(" ", 2)
-    return f"{head} {source[int(number) - 1] + 1} {rest}"

@@ -1,4 +1,13 @@
-"""Stats of a stitch plan: counts, thread, size, sewing time and a density check."""
+"""Stats of a stitch plan: counts, thread, size, sewing time and a density check.
+
+Thread: the top thread is the sum of the needle-down stitch lengths. The bobbin thread is
+an estimate from the lockstitch's balance: under a running stitch (walks, triple stitch,
+arrows, tacks, locks, travel) the bobbin lies along the back of every stitch, as long as
+the top thread; under a column (zigzag, satin) the top thread is pulled round to the back
+and the bobbin shows only in the middle third, so the column's body stitches count a third
+(`COLUMN_BOBBIN_SHARE`; the embroiderers' rule of 2/3 top, 1/3 bobbin for satin). Neither
+counts the thread inside the fabric or the tails at trims.
+"""
 
 from __future__ import annotations
 
@@ -6,9 +15,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from fabrication.embroidery.needles import JUMP, STITCH, TRIM
+from fabrication.embroidery.needles import BODY, JUMP, STITCH, TRIM
 from fabrication.embroidery.plan import StitchPlan
 from fabrication.embroidery.quality import DENSITY_LIMIT, DENSITY_RADIUS, Place, needle_density, where
+
+COLUMN_BOBBIN_SHARE = 1.0 / 3.0
 from fabrication.embroidery.thread import Thread
 
 
@@ -31,6 +42,7 @@ class EmbroideryStats:
     seconds: estimated sewing time; max_density: most needle points within
     `density_radius` of one needle point (every needle point counted, tacks and locks
     included, itself too); dense_points: needle points with more than `density_limit`;
+    bobbin_length: the bobbin thread, mm, estimated by `bobbin_rule` (see the module);
     dense_places: where (densest first); density_advice: what to change there (the
     style's option); lighter_tacks / lighter_locks: tacks and locks the planner made
     lighter or left out so as not to crowd a place (`StitchPlan.lighter`); colors: per
@@ -53,6 +65,8 @@ class EmbroideryStats:
     density_advice: str = "use a longer stitch or a wider spacing"
     lighter_tacks: int = 0
     lighter_locks: int = 0
+    bobbin_length: float = 0.0
+    bobbin_rule: str = "as long as the top thread under running stitches"
     colors: tuple[ColorStats, ...] = ()
 
     @property
@@ -73,7 +87,8 @@ class EmbroideryStats:
         return [
             f"stitches  {self.stitches:,}",
             f"jumps     {self.jumps}   trims {self.trims}",
-            f"thread    {self.thread_length / 1000:.2f} m",
+            f"thread    {self.thread_length / 1000:.2f} m top, about {self.bobbin_length / 1000:.2f} m bobbin "
+            f"({self.bobbin_rule})",
             f"size      {self.width:.1f} x {self.height:.1f} mm",
             f"time      {minutes} min {seconds:02d} s at {self.stitches_per_minute:g} spm",
             f"density   max {self.max_density} within {self.density_radius:g} mm, every needle point"
@@ -101,15 +116,23 @@ class EmbroideryStats:
 def embroidery_stats(plan: StitchPlan, *, stitches_per_minute: float = 600.0,
                      trim_seconds: float = 10.0, color_changes: int | None = None,
                      density_radius: float = DENSITY_RADIUS, density_limit: int = DENSITY_LIMIT,
-                     density_advice: str | None = None) -> EmbroideryStats:
+                     density_advice: str | None = None, column: bool = False) -> EmbroideryStats:
     """Measure `plan`. Time = stitches / stitches_per_minute + (trims + colour changes) x
     trim_seconds; colour changes default to the plan's own. density_advice: what the
-    density warning tells the user to change (default: a longer stitch or a wider spacing)."""
+    density warning tells the user to change (default: a longer stitch or a wider spacing);
+    column: the body stitches cross a column (zigzag, satin): the bobbin under them is a
+    third of their length (see the module)."""
     if color_changes is None:
         color_changes = plan.color_changes
     needles = plan.points[plan.kinds == STITCH]
     a, b = plan.stitches()
     thread = float(np.linalg.norm(b - a, axis=1).sum()) if len(a) else 0.0
+    share = np.ones(len(a))
+    if column:
+        share[plan.roles[plan.stitch_mask] == BODY] = COLUMN_BOBBIN_SHARE
+    bobbin = float(np.linalg.norm(b - a, axis=1) @ share) if len(a) else 0.0
+    rule = ("a third of the column's stitches, the whole of walks, tacks and locks" if column
+            else "as long as the top thread under running stitches")
     kinds = plan.kinds
     is_jump = kinds == JUMP
     run_start = is_jump & np.concatenate([[True], ~is_jump[:-1]])
@@ -140,6 +163,7 @@ def embroidery_stats(plan: StitchPlan, *, stitches_per_minute: float = 600.0,
                            max_density=density.maximum, dense_points=density.dense,
                            density_radius=density_radius, density_limit=density_limit,
                            dense_places=density.places, colors=tuple(colors),
+                           bobbin_length=bobbin, bobbin_rule=rule,
                            lighter_tacks=sum(not t.lock for t in plan.lighter),
                            lighter_locks=sum(t.lock for t in plan.lighter),
                            **({"density_advice": density_advice} if density_advice else {}))
