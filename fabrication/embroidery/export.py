@@ -130,6 +130,42 @@ def pes_hoop_fields(data: bytes, field: tuple[float, float]) -> bytes:
     return bytes(out)
 
 
+def _vp3_layout(data: bytes) -> tuple[int, list[int]]:
+    """Byte offsets in a .vp3 file (as pyembroidery writes it: big-endian blocks tagged
+    00 0N 00 with a length) of the design's centre and of each colour block's start."""
+    def skip_string(at: int) -> int:  # a length-prefixed string
+        return at + 2 + int.from_bytes(data[at:at + 2], "big")
+
+    at = skip_string(6)  # "%vsm%", 0, the producer
+    at = skip_string(at + 7)  # 00 02 00, length, settings
+    at += 16 + 4 + 4 + 1 + 7  # extents, count, 4 bytes, designs; 00 03 00, length
+    centre = at
+    at = skip_string(at + 8 + 3 + 16 + 8)  # centre, 3 bytes, extents, size; notes
+    at = skip_string(at + 2 + 16 + 6)  # "dd", four int32, "xxPP\x01\x00"; producer
+    count = int.from_bytes(data[at:at + 2], "big")
+    at += 2
+    starts = []
+    for _ in range(count):
+        starts.append(at + 7)
+        at += 7 + int.from_bytes(data[at + 3:at + 7], "big")
+    return centre, starts
+
+
+def vp3_exact_block_starts(data: bytes, rows: np.ndarray) -> bytes:
+    """`data` (a .vp3 file pyembroidery wrote from `rows` (M, 3): x, y in 0.1 mm and our
+    kinds) with each colour block after the first starting where the thread left off.
+    pyembroidery truncates the design's centre and each start measured from it, so with a
+    centre on half a unit the next colour was sewn 0.1 mm off."""
+    centre, starts = _vp3_layout(data)
+    cx = int.from_bytes(data[centre:centre + 4], "big", signed=True) // 100
+    cy = -int.from_bytes(data[centre + 4:centre + 8], "big", signed=True) // 100
+    out = bytearray(data)
+    for at, (x, y) in zip(starts[1:], rows[rows[:, 2] == COLOR, :2].tolist()):
+        out[at:at + 8] = ((x - cx) * 100).to_bytes(4, "big", signed=True) + \
+            (-(y - cy) * 100).to_bytes(4, "big", signed=True)
+    return bytes(out)
+
+
 def writer_settings(plan: StitchPlan, fmt: EmbroideryFormat, *, pes_version: int | None = None) -> dict:
     """pyembroidery writer settings for `plan` in `fmt` (the profile's, the JEF date)."""
     settings = {**fmt.settings}
@@ -169,6 +205,8 @@ def embroidery_bytes(plan: StitchPlan, fmt: EmbroideryFormat, *, pes_version: in
     with fast_pec_thumbnails():  # identical bytes, 40 % less .pes write time
         writer(pattern, buffer, settings)
     data = buffer.getvalue()
+    if fmt.extension == "vp3" and plan.color_changes:
+        data = vp3_exact_block_starts(data, normalized_rows(plan, fmt))
     if fmt.extension == "pes" and plan.field is not None:
         data = pes_hoop_fields(data, plan.field)
     code = jef_hoop_code(plan) if fmt.extension == "jef" else None
