@@ -206,7 +206,7 @@ def main() -> None:
             np.fill_diagonal(d, np.inf)
             gaps.append(float(d.min()))
     print(f"zigzag: closest two needle points on inner curves  {min(gaps):.3f} mm  (radius 1.5-5 mm, width 2-3 mm)")
-    stats = embroidery_stats(plan_embroidery(drawing, PlanOptions(style=style_options("zigzag"))))
+    stats = embroidery_stats(plan_embroidery(drawing, PlanOptions(style=style_options("zigzag"))), column=True)
     print("zigzag design stats: " + "; ".join(line.split(None, 1)[0] + " " + line.split(None, 1)[1].strip()
                                               for line in stats.lines()))
 
