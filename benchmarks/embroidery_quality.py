@@ -22,7 +22,7 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 sys.path.insert(0, str(ROOT / "tests"))
 
-from embroidery_fixtures import FORMATS, STYLE_NAMES, design, lock_figure_ok, spiral, stroke_rows  # noqa: E402
+from embroidery_fixtures import FORMATS, STYLE_NAMES, THREE_COLOURS, design, lock_figure_ok, spiral, stroke_rows  # noqa: E402
 from fabrication.embroidery.export import write_embroidery  # noqa: E402
 from fabrication.embroidery.needles import BODY, LOCK, TACK, UNDERLAY  # noqa: E402
 from fabrication.embroidery.plan import STITCH, PlanOptions, plan_embroidery, style_options  # noqa: E402
@@ -43,16 +43,6 @@ def seg_dist(p, a, b):
 EXAMPLES = ("closed-drawing.png", "hershey-HersheySans1-ampersand.png", "hershey-HersheySans1-eight.png",
             "loop-drawing.png", "loops.png", "shallow-crossing-drawing.png", "spike-drawing.png",
             "touch-drawing.png", "embroidery/wave.svg")
-# Three colours, red twice (tests/test_embroidery_threads.py's drawing).
-RGB3 = """<svg xmlns="http://www.w3.org/2000/svg" width="100" height="100" viewBox="0 0 100 100">
-<path d="M10 10 C 30 0 50 20 60 10" stroke="#c81e28" fill="none"/>
-<path d="M10 40 C 30 30 50 50 60 40" stroke="rgb(20,120,40)" fill="none"/>
-<g stroke="navy" fill="none"><path d="M10 70 C 30 60 50 80 60 70"/></g>
-<path d="M70 10 L 90 90" stroke="#c81e28" fill="none"/>
-</svg>
-"""
-
-
 def _short_strokes() -> Drawing:
     """1.2 mm strokes (just above --min-stroke) at six angles, 6 mm apart, and a long line."""
     strokes = []
@@ -71,7 +61,7 @@ def benchmark_drawings(folder: str) -> dict[str, tuple[Drawing, float | None]]:
     drawings = {name: (vectorize_file(str(ROOT / "examples" / name), VectorizeOptions()).drawing, 90.0)
                 for name in EXAMPLES}
     svg = Path(folder) / "rgb3.svg"
-    svg.write_text(RGB3)
+    svg.write_text(THREE_COLOURS)  # tests/test_embroidery_threads.py's drawing
     drawings["rgb3.svg"] = (vectorize_file(str(svg), VectorizeOptions()).drawing, 90.0)
     drawings["test design"] = (design(), None)
     drawings["tight spiral"] = (Drawing((spiral(0, 0, 2.0, 9.0, 3.0, n=48),), 20, 20, "mm"), None)

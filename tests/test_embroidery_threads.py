@@ -12,7 +12,7 @@ import pytest
 from click.testing import CliRunner
 from PIL import Image
 
-from embroidery_fixtures import FORMATS
+from embroidery_fixtures import FORMATS, THREE_COLOURS
 from fabrication.cli import main
 from fabrication.embroidery.export import jef_hoop_code
 from fabrication.embroidery.needles import UNDERLAY
@@ -23,14 +23,6 @@ from fabrication.embroidery.zigzag import ZigzagOptions, zigzag_stitch
 from vectorize.drawing import Drawing
 from vectorize.stroke import Stroke
 
-# Three colours; red twice, far apart, so one colour block holds two strokes.
-THREE_COLOURS = """<svg xmlns="http://www.w3.org/2000/svg" width="100" height="100" viewBox="0 0 100 100">
-<path d="M10 10 C 30 0 50 20 60 10" stroke="#c81e28" fill="none"/>
-<path d="M10 40 C 30 30 50 50 60 40" stroke="rgb(20,120,40)" fill="none"/>
-<g stroke="navy" fill="none"><path d="M10 70 C 30 60 50 80 60 70"/></g>
-<path d="M70 10 L 90 90" stroke="#c81e28" fill="none"/>
-</svg>
-"""
 COLOUR_FORMATS = ("pes", "jef", "vp3")  # the formats that store thread colours
 
 
