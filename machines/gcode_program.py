@@ -81,6 +81,10 @@ def load_program(path: str | os.PathLike) -> Program:
     """Read a G-code file (UTF-8 text) into a `Program`; InputError if unreadable."""
     name = str(path)
     text = read_text(path, what="G-code file", expect="a .gcode/.nc file")
+    if text.lstrip("\ufeff \t\r\n").startswith("<"):  # G-code never starts with '<'; XML always does
+        kind = "an SVG drawing" if "<svg" in text[:4096].lower() else "XML (or HTML)"
+        raise InputError(f"G-code file {name!r} is {kind}, not G-code; make G-code from a drawing with "
+                         "'onestroke laser DRAWING -o JOB.gcode'")
     program = program_from_text(text, source=name)
     if not program.lines:
         raise InputError(f"G-code file {name!r} has no G-code lines")
