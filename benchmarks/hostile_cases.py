@@ -39,7 +39,10 @@ def _comment(megabytes: int) -> str:
 
 
 def _gcode(*middle: str) -> str:
-    return "\n".join(["G21", "G90", "M4 S0", "G0 X1 Y1", "G1 X5 Y5 F600 S300", *middle, "G1 X9 Y2", "M5", ""])
+    """A small job with `middle` after a dwell (G4 P0: the machine is Idle there, where GRBL
+    takes any `$` command), then more moves."""
+    return "\n".join(["G21", "G90", "M4 S0", "G0 X1 Y1", "G1 X5 Y5 F600 S300", "G4 P0", *middle, "G1 X9 Y2", "M5",
+                      ""])
 
 
 def _png(folder: Path, name: str, width: int, height: int) -> None:

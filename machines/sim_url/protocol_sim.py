@@ -20,8 +20,9 @@ DEFAULT_SPEED = 10.0
 
 
 # Integer parameters: (lowest, highest). GRBL boards have RX buffers of 64-1024 bytes and
-# planners of 8-32 blocks; the emulator accepts a little more either way.
-_INTEGERS = {"rx": (16, 4096), "blocks": (2, 64), "drop_hold": (0, 1000), "laser": (0, 1)}
+# planners of 8-32 blocks; the emulator takes any buffer from 1 byte (to rehearse a line
+# that cannot fit: the sender refuses it by name) and 2-256 blocks.
+_INTEGERS = {"rx": (1, 65536), "blocks": (2, 256), "drop_hold": (0, 1000), "laser": (0, 1)}
 MAX_SPEED = 1000.0  # the emulator command's own --speed range: above 0 to 1000
 
 
