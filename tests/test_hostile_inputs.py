@@ -172,7 +172,8 @@ def test_a_good_json_drawing_still_reads(tmp_path):
     ("[1,2,3]", "not an onestroke edits file"),
     ('{"format": "onestroke-edits", "version": 1, "edits": [{"kind": "split", "at": "here"}]}',
      '$.edits[0].at: expected array, got a string'),
-    ('{"format": "onestroke-edits", "version": 1, "blur": -1}', "$.blur: -1 must be at least 0"),
+    ('{"format": "onestroke-edits", "version": 1, "blur": "1"}', '$.blur: expected number or null, got a string'),
+    ('{"format": "onestroke-edits", "version": 1, "blur": -1}', "--blur -1 must be from 0 px to 25 px"),
 ])
 def test_bad_edits_files_are_refused_naming_the_file(tmp_path, text, words):
     edits = tmp_path / "e.json"

@@ -14,7 +14,7 @@ import urllib.parse
 import serial
 from serial.serialutil import PortNotOpenError, SerialBase, SerialException
 
-from machines.emulator import EmulatorOptions, Faults, GrblEmulator
+from machines.emulator import TIME_SCALE, EmulatorOptions, Faults, GrblEmulator
 
 DEFAULT_SPEED = 10.0
 
@@ -23,7 +23,6 @@ DEFAULT_SPEED = 10.0
 # planners of 8-32 blocks; the emulator takes any buffer from 1 byte (to rehearse a line
 # that cannot fit: the sender refuses it by name) and 2-256 blocks.
 _INTEGERS = {"rx": (1, 65536), "blocks": (2, 256), "drop_hold": (0, 1000), "laser": (0, 1)}
-MAX_SPEED = 1000.0  # the emulator command's own --speed range: above 0 to 1000
 
 
 def parse_sim_url(url: str) -> EmulatorOptions:
@@ -41,9 +40,7 @@ def parse_sim_url(url: str) -> EmulatorOptions:
         what = f"sim:// parameter {key!r}"
         try:
             if key == "speed":
-                speed = parse_number(value, what=what)
-                if not 0 < speed <= MAX_SPEED:
-                    raise ValueError(f"bad value {value!r} for {what}: give a speed-up above 0 to {MAX_SPEED:g}")
+                speed = TIME_SCALE.named(what).check(parse_number(value, what=what), shown=repr(value))
             elif key in _INTEGERS:
                 low, high = _INTEGERS[key]
                 numbers[key] = parse_integer(value, what=what)
