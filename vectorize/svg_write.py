@@ -29,8 +29,21 @@ def path_data(stroke: Stroke) -> str:
     return "".join(parts)
 
 
+def widths_data(stroke: Stroke) -> str:
+    """A stroke's ink widths as written in `data-widths`: "t w t w ...", t the path's
+    parameter (segment k of K spans t in [k/K, (k+1)/K]) to 6 decimals, w the width in the
+    drawing's unit to 3."""
+    return " ".join(f"{_num6(t)} {_num(w)}" for t, w in stroke.widths)
+
+
+def _num6(value: float) -> str:
+    text = f"{value:.6f}".rstrip("0").rstrip(".")
+    return "0" if text in ("-0", "") else text
+
+
 def drawing_to_svg(drawing: Drawing, *, color: str = "#000000") -> str:
-    """The SVG text of `drawing`: viewBox = its canvas, stroke width = its measured width."""
+    """The SVG text of `drawing`: viewBox = its canvas, stroke width = its measured width;
+    each stroke whose ink widths are known carries them in `data-widths` (`widths_data`)."""
     w, h = _num(drawing.width), _num(drawing.height)
     size = f'width="{w}mm" height="{h}mm"' if drawing.unit == "mm" else f'width="{w}" height="{h}"'
     lines = [
@@ -42,13 +55,16 @@ def drawing_to_svg(drawing: Drawing, *, color: str = "#000000") -> str:
     for index, stroke in enumerate(drawing.strokes):
         # A stroke's own colour overrides the group's; uncoloured strokes inherit it.
         paint = "" if stroke.color is None else ' stroke="#{:02x}{:02x}{:02x}"'.format(*stroke.color)
-        lines.append(f'<path id="stroke-{index + 1}"{paint} d="{path_data(stroke)}"/>')
+        widths = "" if stroke.widths is None else f' data-widths="{widths_data(stroke)}"'
+        lines.append(f'<path id="stroke-{index + 1}"{paint}{widths} d="{path_data(stroke)}"/>')
     lines += ["</g>", "</svg>", ""]
     return "\n".join(lines)
 
 
 def drawing_to_json(drawing: Drawing) -> str:
-    """JSON with the canvas and each stroke's control points, shape (K, 4, 2)."""
+    """JSON with the canvas and each stroke's control points, shape (K, 4, 2); "widths"
+    (when a stroke has them): one entry per stroke, its `Stroke.widths` rows [t, width] or
+    null."""
     payload = {
         "format": "onestroke-drawing",
         "version": 1,
@@ -61,6 +77,10 @@ def drawing_to_json(drawing: Drawing) -> str:
     if any(s.color is not None for s in drawing.strokes):
         # One entry per stroke: [r, g, b] or null (written only when a stroke has a colour).
         payload["colors"] = [None if s.color is None else list(s.color) for s in drawing.strokes]
+    if any(s.widths is not None for s in drawing.strokes):
+        payload["widths"] = [None if s.widths is None else np.column_stack([np.round(s.widths[:, 0], 6),
+                                                                            np.round(s.widths[:, 1], 4)]).tolist()
+                             for s in drawing.strokes]
     return json.dumps(payload, separators=(",", ":")) + "\n"
 
 
@@ -75,7 +95,8 @@ def _drawing_schema() -> dict:
         "format": {"const": "onestroke-drawing"}, "version": {"const": 1}, "unit": {"enum": list(UNITS)},
         "width": side, "height": side, "stroke_width": {"type": "number", "minimum": 0, "maximum": MAX_COORDINATE},
         "strokes": {"type": "array", "items": {"shape": [None, 4, 2]}},
-        "colors": {"type": ["array", "null"], "items": {"type": ["array", "null"], **rgb}}}}
+        "colors": {"type": ["array", "null"], "items": {"type": ["array", "null"], **rgb}},
+        "widths": {"type": ["array", "null"], "items": {"type": ["array", "null"], "items": {"shape": [2]}}}}}
 
 
 def drawing_from_json(text: str | bytes, *, name: str = "JSON drawing") -> Drawing:
@@ -89,10 +110,14 @@ def drawing_from_json(text: str | bytes, *, name: str = "JSON drawing") -> Drawi
     colors = payload.get("colors") or [None] * len(strokes)
     if len(colors) != len(strokes):
         raise InputError(f"{name}: $.colors: {len(colors)} colours for {len(strokes)} strokes")
+    widths = payload.get("widths") or [None] * len(strokes)
+    if len(widths) != len(strokes):
+        raise InputError(f"{name}: $.widths: {len(widths)} width profiles for {len(strokes)} strokes")
     try:
         return Drawing(
-            strokes=tuple(Stroke(np.array(c, dtype=float), None if rgb is None else tuple(rgb))
-                          for c, rgb in zip(strokes, colors)),
+            strokes=tuple(Stroke(np.array(c, dtype=float), None if rgb is None else tuple(rgb),
+                                 None if w is None else np.array(w, dtype=float))
+                          for c, rgb, w in zip(strokes, colors, widths)),
             width=float(payload["width"]),
             height=float(payload["height"]),
             unit=payload.get("unit", "px"),
