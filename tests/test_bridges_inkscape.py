@@ -15,8 +15,11 @@ from __future__ import annotations
 
 import base64
 import json
+import os
 import shutil
 import subprocess
+import sys
+import xml.etree.ElementTree as ET
 from pathlib import Path
 
 import numpy as np
@@ -25,6 +28,7 @@ import shapely
 import svgelements as se
 from PIL import Image
 
+import fabrication.bridges
 from bridges_fixtures import affine, moved, onestroke, rotation, svg_curves
 from conftest import ARTIFACTS, alpha_loop, render_polylines
 
@@ -225,3 +229,41 @@ def test_a_missing_onestroke_is_named(work, tmp_path):
     result = run_extension(moved_away, document, ["bitmap"])
     assert result.returncode != 0 and "Traceback" not in result.stderr
     assert "/nowhere/bin/python" in result.stderr and "onestroke inkscape install" in result.stderr
+
+
+def test_inkscape_loads_the_extension_installed_for_the_user(tmp_path):
+    # `onestroke inkscape install` without --dir asks `inkscape --user-data-directory`, which
+    # follows INKSCAPE_PROFILE_DIR; Inkscape then loads every extension there at start-up and
+    # logs those it refuses (a missing script, a parse error) in extension-errors.log or stderr.
+    env = {**os.environ, "INKSCAPE_PROFILE_DIR": str(tmp_path / "profile")}
+    installed = subprocess.run([sys.executable, "-m", "fabrication.cli", "inkscape", "install"], env=env,
+                               capture_output=True, text=True)
+    assert installed.returncode == 0, installed.stderr
+    folder = tmp_path / "profile" / "extensions"
+    assert f"installed in {folder}" in installed.stdout
+
+    def refused() -> str:
+        log = tmp_path / "profile" / "extension-errors.log"
+        log.unlink(missing_ok=True)
+        started = subprocess.run([INKSCAPE, "--action-list"], env=env, capture_output=True, text=True)
+        assert started.returncode == 0
+        text = started.stderr + (log.read_text() if log.exists() else "")
+        return "\n".join(line for line in text.splitlines() if "onestroke" in line or "Single-line" in line)
+
+    assert refused() == ""
+    (folder / "onestroke_vectorize.py").unlink()  # the check can fail: Inkscape names what is missing
+    assert "Single-line vectorize" in refused()
+
+
+def test_dialog_offers_the_clis_ranges_and_choices():
+    from fabrication.bridges.inkstitch import STITCHES
+    from fabrication.cli.options import MAX_BLUR_PX
+
+    inx = ET.parse(Path(fabrication.bridges.__file__).parent / "inkscape" / "onestroke_vectorize.inx").getroot()
+    params = {p.get("name"): p for p in inx.iter("{http://www.inkscape.org/namespace/inkscape/extension}param")}
+    assert float(params["blur"].get("max")) == MAX_BLUR_PX and float(params["blur"].get("min")) == 0
+    assert 0 < float(params["threshold"].get("max")) < 1
+    options = {name: [o.get("value") for o in params[name]] for name in ("classifier", "inkstitch")}
+    assert options == {"classifier": ["cnn", "geometric"], "inkstitch": ["none", *STITCHES]}
+    script = (Path(fabrication.bridges.__file__).parent / "inkscape" / "onestroke_vectorize.py").read_text()
+    assert all(f'"--{name}"' in script for name in params)

@@ -170,3 +170,11 @@ def test_inkstitch_refuses_json_output(drawings, tmp_path):
                                        "--inkstitch", "running"])
     assert result.exit_code == 2
     assert "--inkstitch writes an SVG" in result.output
+
+
+def test_the_cli_offers_every_stitch_the_bridge_writes():
+    from fabrication.bridges.inkstitch import STITCHES
+    from fabrication.cli.vectorize_cmd import vectorize as command
+
+    choice = next(p for p in command.params if p.name == "inkstitch").type
+    assert tuple(choice.choices) == STITCHES

@@ -56,17 +56,13 @@ def stroke_attributes(stitch: str, options=None) -> tuple[tuple[str, str], ...]:
     options: that style's options (`RunningOptions`, `TripleOptions`, `ZigzagOptions`); None
     for the defaults. A zigzag's width is the path's stroke width, not an attribute.
     """
-    if stitch == "running":
-        o = options or RunningOptions()
-        return (("inkstitch:stroke_method", "running_stitch"),
-                ("inkstitch:running_stitch_length_mm", _mm(o.stitch_length)),
-                ("inkstitch:running_stitch_tolerance_mm", _mm(o.tolerance)))
-    if stitch == "triple":
-        o = options or TripleOptions()
-        return (("inkstitch:stroke_method", "running_stitch"),
-                ("inkstitch:running_stitch_length_mm", _mm(o.stitch_length)),
-                ("inkstitch:running_stitch_tolerance_mm", _mm(o.tolerance)),
-                ("inkstitch:bean_stitch_repeats", str(o.repeats)))
+    if stitch in ("running", "triple"):
+        o = options or (RunningOptions() if stitch == "running" else TripleOptions())
+        running = (("inkstitch:stroke_method", "running_stitch"),
+                   ("inkstitch:running_stitch_length_mm", _mm(o.stitch_length)),
+                   ("inkstitch:running_stitch_tolerance_mm", _mm(o.tolerance)))
+        # Ink/Stitch's bean repeats count the extra passes, as our triple stitch's repeats do.
+        return running + ((("inkstitch:bean_stitch_repeats", str(o.repeats)),) if stitch == "triple" else ())
     if stitch == "zigzag":
         o = options or ZigzagOptions()
         # Both add the pull compensation to the whole width (half each side).

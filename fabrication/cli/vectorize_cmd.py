@@ -53,10 +53,10 @@ def vectorize(source: str, output: str, multi: bool, threshold: float | None, bl
     for message in result.report.warnings:
         warn(message)
     drawing = result.drawing
-    if inkstitch is not None or any(v is not None for v in (size, width, height)) or rotate:
+    sized = any(v is not None for v in (size, width, height)) or bool(rotate)
+    if inkstitch is not None or sized:
         from fabrication.placement import PlacementOptions, place_on_page
 
-        sized = any(v is not None for v in (size, width, height)) or rotate
         drawing = place_on_page(drawing, PlacementOptions(size=size, width=width, height=height, rotate=rotate)
                                 if sized else None)
     if inkstitch is not None:
