@@ -257,11 +257,11 @@ def test_inkscape_loads_the_extension_installed_for_the_user(tmp_path):
 
 def test_dialog_offers_the_clis_ranges_and_choices():
     from fabrication.bridges.inkstitch import STITCHES
-    from fabrication.cli.options import MAX_BLUR_PX
+    from vectorize.options import BLUR
 
     inx = ET.parse(Path(fabrication.bridges.__file__).parent / "inkscape" / "onestroke_vectorize.inx").getroot()
     params = {p.get("name"): p for p in inx.iter("{http://www.inkscape.org/namespace/inkscape/extension}param")}
-    assert float(params["blur"].get("max")) == MAX_BLUR_PX and float(params["blur"].get("min")) == 0
+    assert float(params["blur"].get("max")) == BLUR.high and float(params["blur"].get("min")) == BLUR.low
     assert 0 < float(params["threshold"].get("max")) < 1
     options = {name: [o.get("value") for o in params[name]] for name in ("classifier", "inkstitch")}
     assert options == {"classifier": ["cnn", "geometric"], "inkstitch": ["none", *STITCHES]}
