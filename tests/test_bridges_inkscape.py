@@ -30,7 +30,7 @@ from PIL import Image
 
 import fabrication.bridges
 from bridges_fixtures import affine, moved, onestroke, rotation, svg_curves
-from conftest import ARTIFACTS, alpha_loop, render_polylines
+from conftest import ARTIFACTS, alpha_loop, circle, render_polylines
 
 INKSCAPE = shutil.which("inkscape")
 PYTHON = "/usr/bin/python3"  # Debian's, as Inkscape's package runs extensions with it
@@ -151,6 +151,23 @@ def test_filled_outline_matches_the_cli(work, tmp_path):
     # The outline's own rings come first in the document; the curve after them.
     assert_same(curves[len(rings):], svg_curves(tmp_path / "reference.svg"))
     assert 'stroke:#aa2200' in out.read_text(), "the curve takes the outline's colour"
+
+
+def test_multi_stroke_gives_one_path_per_stroke_in_order(work, tmp_path):
+    png = tmp_path / "two.png"
+    Image.fromarray(render_polylines([circle(120, 130, 70), alpha_loop()[:250] * 0.5 + 160], width=6)).save(png)
+    made = onestroke("vectorize", png, "-o", tmp_path / "reference.svg", "--multi")
+    assert made.returncode == 0, made.stderr
+    document = tmp_path / "two.svg"
+    document.write_text(f'<svg {SVG} width="400" height="400" viewBox="0 0 400 400">'
+                        f'<image id="bitmap" x="0" y="0" width="400" height="400" xlink:href="{embedded(png)}"/>'
+                        '</svg>')
+    out = written(run_extension(work["extension"], document, ["bitmap"], multi="true"), tmp_path, "out.svg")
+    reference = svg_curves(tmp_path / "reference.svg")
+    assert len(reference) == 2
+    assert_same(new_curves(out, 0), reference)
+    group = next(e for e in ET.parse(out).getroot().iter("{http://www.w3.org/2000/svg}g"))
+    assert len(list(group.iter("{http://www.w3.org/2000/svg}path"))) == 2, "the strokes are grouped, in order"
 
 
 def test_satin_for_ink_stitch_and_inkscape_reads_it(work, tmp_path):
