@@ -27,7 +27,7 @@ import svgelements as se
 from onestroke.errors import InputError
 from onestroke.progress import ProgressCallback, Stage, counted
 from vectorize.drawing import Drawing
-from vectorize.stroke import MAX_COORDINATE, Stroke
+from vectorize.stroke import MAX_COORDINATE, Stroke, checked_widths, recut_widths
 
 SVG_NS = "http://www.w3.org/2000/svg"
 MAX_SVG_BYTES = 200_000_000  # a 200 MB SVG is far past any drawing; refuse before parsing
@@ -78,30 +78,60 @@ def _segment_row(segment) -> tuple[float, ...] | None:
     return None
 
 
-def _subpaths(path) -> list[np.ndarray]:
-    """Cubic control arrays (K, 4, 2), one per sub-path, zero-length pieces dropped."""
-    result: list[np.ndarray] = []
+def _subpaths(path) -> list[tuple[np.ndarray, np.ndarray, int]]:
+    """Per sub-path: cubic control array (K, 4, 2) with zero-length pieces dropped, the index
+    of each kept piece among the sub-path's drawn pieces (a closing Z's straight piece is not
+    one of them) and how many drawn pieces there were."""
+    result: list[tuple[np.ndarray, np.ndarray, int]] = []
     current: list[tuple[float, ...]] = []
+    closing: list[bool] = []
 
     def close() -> None:
         if current:
             control = np.array(current, dtype=float).reshape(-1, 4, 2)
             keep = np.ptp(control, axis=1).max(axis=1) > 1e-9
+            drawn = ~np.array(closing)
             if keep.any():
-                result.append(control[keep])
+                index = np.cumsum(drawn) - 1
+                result.append((control[keep], index[keep], int(drawn.sum())))
 
     for segment in path:
         if isinstance(segment, se.Move):
             close()
-            current = []
+            current, closing = [], []
             continue
         if isinstance(segment, se.Arc):
             rows = [_segment_row(c) for c in segment.as_cubic_curves()]
         else:
             rows = [_segment_row(segment)]
-        current.extend(row for row in rows if row is not None)
+        rows = [row for row in rows if row is not None]
+        current.extend(rows)
+        closing.extend([isinstance(segment, se.Close)] * len(rows))
     close()
     return result
+
+
+def _widths(element, path: str, index: np.ndarray, drawn: int) -> np.ndarray | None:
+    """The `Stroke.widths` of an element's `data-widths` (onestroke's own SVGs: "t w t w ...",
+    t the path's parameter over its drawn pieces, w in user units), for the pieces `index`
+    kept of `drawn`; None without the attribute. Widths are scaled by the element's
+    transform (the viewBox included)."""
+    text = element.values.get("data-widths")
+    if text is None:
+        return None
+    try:
+        rows = np.array(str(text).replace(",", " ").split(), dtype=float).reshape(-1, 2)
+        scale = float(np.sqrt(abs(se.Matrix(element.values.get("transform", "")).determinant)))
+        widths = checked_widths(np.column_stack([rows[:, 0], rows[:, 1] * scale]))
+    except (ValueError, InputError) as error:
+        raise InputError(f"SVG {path!r}: {_element_name(element)} has data-widths that are not "
+                         f"(t, width) pairs with t rising from 0 to 1: {error}") from None
+    if len(index) == drawn and np.array_equal(index, np.arange(drawn)):
+        return widths
+    # Pieces of zero length were dropped: the kept pieces' old parameters, in turn.
+    old = np.column_stack([index, index + 1]).ravel() / drawn
+    kept = np.arange(len(index))
+    return recut_widths(widths, old, np.column_stack([kept, kept + 1]).ravel() / len(index))
 
 
 def _has_paint(value) -> bool:
@@ -234,11 +264,13 @@ def read_svg(path: str | os.PathLike, *, progress: ProgressCallback | None = Non
         stroked = _has_paint(element.stroke)
         filled = _has_paint(element.fill)
         color = _rgb(element.stroke) if stroked else None
-        for control in _subpaths(path_obj):
+        pieces = _subpaths(path_obj)
+        for control, index, drawn in pieces:
             _check_coordinates(control, element, path)
             if stroked or not filled:
                 # Unpainted shapes are treated as strokes: a line drawing has no other use.
-                strokes.append(Stroke(control, color))
+                profile = _widths(element, path, index, drawn) if len(pieces) == 1 else None
+                strokes.append(Stroke(control, color, profile))
                 width = element.stroke_width
                 widths.append(float(width) if width and np.isfinite(float(width)) else 1.0)
             else:

@@ -32,6 +32,18 @@ def path_data(stroke: Stroke) -> str:
     return "".join(parts)
 
 
+def widths_data(stroke: Stroke) -> str:
+    """A stroke's ink widths as written in `data-widths`: "t w t w ...", t the path's
+    parameter (segment k of K spans t in [k/K, (k+1)/K]) to 6 decimals, w the width in the
+    drawing's unit to 3."""
+    return " ".join(f"{_num6(t)} {_num(w)}" for t, w in stroke.widths)
+
+
+def _num6(value: float) -> str:
+    text = f"{value:.6f}".rstrip("0").rstrip(".")
+    return "0" if text in ("-0", "") else text
+
+
 @dataclass(frozen=True)
 class SvgPath:
     """One `<path>` of the document: its sub-paths in order (one `M` each) and extra attributes.
@@ -50,9 +62,10 @@ def drawing_to_svg(drawing: Drawing, *, color: str = "#000000", namespaces: Mapp
                    paths: Sequence[SvgPath] | None = None) -> str:
     """The SVG text of `drawing`: viewBox = its canvas, stroke width = its measured width.
 
-    By default one `<path>` per stroke, in drawing order. `paths` replaces them (the same
-    canvas and group style), e.g. with a bridge's parameters on each; `namespaces`
-    (prefix -> URI) are declared on the root for their attributes.
+    By default one `<path>` per stroke, in drawing order, each whose ink widths are known
+    carrying them in `data-widths` (`widths_data`). `paths` replaces them (the same canvas
+    and group style), e.g. with a bridge's parameters on each; `namespaces` (prefix -> URI)
+    are declared on the root for their attributes.
     """
     w, h = _num(drawing.width), _num(drawing.height)
     size = f'width="{w}mm" height="{h}mm"' if drawing.unit == "mm" else f'width="{w}" height="{h}"'
@@ -64,7 +77,8 @@ def drawing_to_svg(drawing: Drawing, *, color: str = "#000000", namespaces: Mapp
         'stroke-linecap="round" stroke-linejoin="round">',
     ]
     if paths is None:
-        paths = [SvgPath((stroke,), (), stroke.color) for stroke in drawing.strokes]
+        paths = [SvgPath((stroke,), () if stroke.widths is None else (("data-widths", widths_data(stroke)),),
+                         stroke.color) for stroke in drawing.strokes]
     for index, path in enumerate(paths):
         # A path's own colour overrides the group's; uncoloured paths inherit it.
         paint = "" if path.color is None else ' stroke="#{:02x}{:02x}{:02x}"'.format(*path.color)
@@ -76,7 +90,9 @@ def drawing_to_svg(drawing: Drawing, *, color: str = "#000000", namespaces: Mapp
 
 
 def drawing_to_json(drawing: Drawing) -> str:
-    """JSON with the canvas and each stroke's control points, shape (K, 4, 2)."""
+    """JSON with the canvas and each stroke's control points, shape (K, 4, 2); "widths"
+    (when a stroke has them): one entry per stroke, its `Stroke.widths` rows [t, width] or
+    null."""
     payload = {
         "format": "onestroke-drawing",
         "version": 1,
@@ -89,6 +105,10 @@ def drawing_to_json(drawing: Drawing) -> str:
     if any(s.color is not None for s in drawing.strokes):
         # One entry per stroke: [r, g, b] or null (written only when a stroke has a colour).
         payload["colors"] = [None if s.color is None else list(s.color) for s in drawing.strokes]
+    if any(s.widths is not None for s in drawing.strokes):
+        payload["widths"] = [None if s.widths is None else np.column_stack([np.round(s.widths[:, 0], 6),
+                                                                            np.round(s.widths[:, 1], 4)]).tolist()
+                             for s in drawing.strokes]
     return json.dumps(payload, separators=(",", ":")) + "\n"
 
 
@@ -103,9 +123,13 @@ def drawing_from_json(text: str) -> Drawing:
         colors = payload.get("colors") or [None] * len(payload["strokes"])
         if len(colors) != len(payload["strokes"]):
             raise ValueError(f"{len(colors)} colours for {len(payload['strokes'])} strokes")
+        widths = payload.get("widths") or [None] * len(payload["strokes"])
+        if len(widths) != len(payload["strokes"]):
+            raise ValueError(f"{len(widths)} width profiles for {len(payload['strokes'])} strokes")
         return Drawing(
-            strokes=tuple(Stroke(np.array(c, dtype=float), None if rgb is None else tuple(rgb))
-                          for c, rgb in zip(payload["strokes"], colors)),
+            strokes=tuple(Stroke(np.array(c, dtype=float), None if rgb is None else tuple(rgb),
+                                 None if w is None else np.array(w, dtype=float))
+                          for c, rgb, w in zip(payload["strokes"], colors, widths)),
             width=float(payload["width"]),
             height=float(payload["height"]),
             unit=payload.get("unit", "px"),

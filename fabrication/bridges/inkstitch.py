@@ -12,7 +12,8 @@ against it. Stitches:
 - zigzag: a stroke with `stroke_method` zigzag_stitch; its width is the path's stroke width,
   the measured ink width at the design's size;
 - satin: a satin column per stretch between sharp corners: two rails half the ink width either
-  side of the curve, both running in the drawing's direction, and rungs across them.
+  side of the curve (the width measured along the stroke where the vectorizer gives it),
+  both running in the drawing's direction, and rungs across them.
 """
 
 from __future__ import annotations
@@ -97,12 +98,13 @@ def satin_attributes(options: ZigzagOptions) -> tuple[tuple[str, str], ...]:
 
 
 def satin_columns(stroke: Stroke, width: float) -> list[tuple[Stroke, ...]]:
-    """The satin columns of `stroke` (mm) `width` wide: per stretch between corners sharper
-    than SATIN_CORNER, in drawing order, its sub-paths (rail, rail, rung, rung, ...)."""
+    """The satin columns of `stroke` (mm): per stretch between corners sharper than
+    SATIN_CORNER, in drawing order, its sub-paths (rail, rail, rung, rung, ...). The rails lie
+    half the ink width either side of the curve: the width measured along the stroke
+    (`Stroke.widths`), else `width`."""
     curve = dense_curve(stroke)
     corners = np.flatnonzero(np.abs(curve.turns) > np.radians(SATIN_CORNER))
     cuts = np.concatenate([[0.0], curve.s[corners], [curve.length]])
-    half = width / 2
     columns = []
     for s0, s1 in zip(cuts[:-1], cuts[1:]):
         if s1 - s0 <= 1e-6:
@@ -111,13 +113,15 @@ def satin_columns(stroke: Stroke, width: float) -> list[tuple[Stroke, ...]]:
         # Just inside the stretch: at a corner vertex the tangent is that of either side.
         t = curve.t_at(np.clip(s, s0 + 1e-6 * (s1 - s0), s1 - 1e-6 * (s1 - s0)))
         points, tangents = stroke.points_at(t), stroke.tangents_at(t)
+        measured = stroke.widths_at(t)
+        half = (np.full(len(t), width) if measured is None else measured)[:, None] / 2
         normal = np.c_[-tangents[:, 1], tangents[:, 0]]
         rails = (Stroke.from_polyline(points + half * normal), Stroke.from_polyline(points - half * normal))
         count = max(1, int(round((s1 - s0) / RUNG_STEP)))
         at = np.round((np.arange(count) + 0.5) * (len(s) - 1) / count).astype(int)
         reach = half * (1 + RUNG_OVERHANG)
-        rungs = tuple(Stroke.from_polyline(np.array([points[i] + reach * normal[i], points[i] - reach * normal[i]]))
-                      for i in at)
+        rungs = tuple(Stroke.from_polyline(np.array([points[i] + reach[i] * normal[i],
+                                                     points[i] - reach[i] * normal[i]])) for i in at)
         columns.append(rails + rungs)
     return columns
 
