@@ -112,31 +112,56 @@ def drawing_to_json(drawing: Drawing) -> str:
     return json.dumps(payload, separators=(",", ":")) + "\n"
 
 
-def drawing_from_json(text: str) -> Drawing:
-    """Parse what `drawing_to_json` wrote."""
-    from onestroke.errors import InputError
+def _drawing_schema() -> dict:
+    """What `drawing_to_json` writes, as `onestroke.json_check` reads it."""
+    from vectorize.drawing import UNITS
+    from vectorize.stroke import MAX_COORDINATE
 
+    side = {"type": "number", "exclusiveMinimum": 0, "maximum": MAX_COORDINATE}
+    rgb = {"type": "array", "minItems": 3, "maxItems": 3, "items": {"type": "integer", "minimum": 0, "maximum": 255}}
+    return {"type": "object", "required": ["format", "width", "height", "strokes"], "properties": {
+        "format": {"const": "onestroke-drawing"}, "version": {"const": 1}, "unit": {"enum": list(UNITS)},
+        "width": side, "height": side, "stroke_width": {"type": "number", "minimum": 0, "maximum": MAX_COORDINATE},
+        "strokes": {"type": "array", "items": {"shape": [None, 4, 2]}},
+        "colors": {"type": ["array", "null"], "items": {"type": ["array", "null"], **rgb}},
+        "widths": {"type": ["array", "null"], "items": {"type": ["array", "null"], "items": {"shape": [2]}}}}}
+
+
+def drawing_from_json(text: str | bytes, *, name: str = "JSON drawing") -> Drawing:
+    """Parse what `drawing_to_json` wrote; `InputError` naming `name` (the file) and what in
+    it is wrong (checked against the schema before anything is built)."""
+    from onestroke.errors import InputError
+    from onestroke.json_check import parse_json
+
+    payload = parse_json(text, _drawing_schema(), what=name)
+    strokes = payload["strokes"]
+    colors = payload.get("colors") or [None] * len(strokes)
+    if len(colors) != len(strokes):
+        raise InputError(f"{name}: $.colors: {len(colors)} colours for {len(strokes)} strokes")
+    widths = payload.get("widths") or [None] * len(strokes)
+    if len(widths) != len(strokes):
+        raise InputError(f"{name}: $.widths: {len(widths)} width profiles for {len(strokes)} strokes")
     try:
-        payload = json.loads(text)
-        if payload.get("format") != "onestroke-drawing":
-            raise ValueError("not an onestroke drawing")
-        colors = payload.get("colors") or [None] * len(payload["strokes"])
-        if len(colors) != len(payload["strokes"]):
-            raise ValueError(f"{len(colors)} colours for {len(payload['strokes'])} strokes")
-        widths = payload.get("widths") or [None] * len(payload["strokes"])
-        if len(widths) != len(payload["strokes"]):
-            raise ValueError(f"{len(widths)} width profiles for {len(payload['strokes'])} strokes")
         return Drawing(
             strokes=tuple(Stroke(np.array(c, dtype=float), None if rgb is None else tuple(rgb),
                                  None if w is None else np.array(w, dtype=float))
-                          for c, rgb, w in zip(payload["strokes"], colors, widths)),
+                          for c, rgb, w in zip(strokes, colors, widths)),
             width=float(payload["width"]),
             height=float(payload["height"]),
             unit=payload.get("unit", "px"),
             stroke_width=float(payload.get("stroke_width", 1.0)),
         )
-    except (ValueError, KeyError, TypeError) as error:
-        raise InputError(f"not a valid onestroke JSON drawing: {error}") from None
+    except InputError as error:
+        raise InputError(f"{name}: {error}") from None
+
+
+def read_drawing_json(path: str | os.PathLike) -> Drawing:
+    """A .json drawing file (`drawing_from_json`), refused in one line when it is not one."""
+    from onestroke.paths import check_input_file
+
+    name = check_input_file(path, what="drawing", expect="a .json drawing")
+    with open(name, "rb") as handle:
+        return drawing_from_json(handle.read(), name=f"drawing {name!r}")
 
 
 def write_drawing(drawing: Drawing, path: str | os.PathLike) -> None:
