@@ -1,9 +1,9 @@
 """The Inkscape extension, run the way Inkscape 1.2 runs it, checked against `onestroke vectorize`.
 
 Inkscape 1.2 cannot run an effect extension without its window: effects become actions only
-in GUI mode (`inkscape --action-list` lists none, and `--actions=org.inkscape.color.grayscale`
-answers "could not find action" even for Inkscape's own extensions), and an effect with
-parameters opens its dialog. So the script runs as Inkscape's Script::execute runs it: Debian's
+in GUI mode (`inkscape --action-list` lists none, and `--actions=select-by-id:img1;
+org.onestroke.vectorize;export-do` answers "could not find action", as it does for Inkscape's
+own org.inkscape.color.grayscale), and in the GUI an effect with parameters opens its dialog. So the script runs as Inkscape's Script::execute runs it: Debian's
 /usr/bin/python3 (the interpreter Inkscape's Debian package depends on, with python3-lxml) with
 Inkscape's bundled inkex on PYTHONPATH, the extension's folder as working directory,
 `--id=...` and one `--name=value` per parameter, a copy of the document as the last argument,
