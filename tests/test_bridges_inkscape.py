@@ -14,6 +14,7 @@ DOCUMENT_PATH naming the saved document, and the new document read from stdout. 
 from __future__ import annotations
 
 import base64
+import functools
 import json
 import os
 import shutil
@@ -40,6 +41,7 @@ PX_PER_MM = 96 / 25.4
 SVG = 'xmlns="http://www.w3.org/2000/svg" xmlns:xlink="http://www.w3.org/1999/xlink"'
 
 
+@functools.cache
 def inkex_folder() -> str:
     """Inkscape's own extensions folder (where its inkex lives)."""
     data = subprocess.run([INKSCAPE, "--system-data-directory"], capture_output=True, text=True).stdout
