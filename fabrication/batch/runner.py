@@ -23,6 +23,10 @@ from fabrication.batch.report import BatchSummary, FileRecord, report_paths, wri
 from fabrication.batch.work import BatchJob, FileResult, process_file, warm_up
 from onestroke.atomic import atomic_write_bytes
 from onestroke.errors import FabricationError, InputError
+from onestroke.ranges import Range
+
+# Worker processes of one batch (a pool of more than a thousand is a mistake, not a plan).
+JOBS = Range(1, 1024, name="--jobs", integer=True)
 
 # Seconds between manifest saves while results come in (and always at the end).
 SAVE_EVERY = 2.0
