@@ -264,12 +264,14 @@ def _dropped_lines(drawing: Drawing, dropped: list[int], block: tuple[int, ...],
     """One line per dropped stroke (numbered as in the input), with the distance from it to
     the nearest needle point of its thread in the plan (`points` (N, 2) mm, `blocks` (N,)
     of the needle rows)."""
-    lines = []
+    lines, trees = [], {}
     for i in dropped:
         stroke = drawing.strokes[i]
-        mine = points[blocks == block[i]]
+        if block[i] not in trees:
+            mine = points[blocks == block[i]]
+            trees[block[i]] = cKDTree(mine) if len(mine) else None
         along = stroke.points_at(np.linspace(0.0, 1.0, 9))
-        near = float(cKDTree(mine).query(along)[0].min()) if len(mine) else np.inf
+        near = float(trees[block[i]].query(along)[0].min()) if trees[block[i]] is not None else np.inf
         x, y = stroke.start
         if near > options.trim_distance:
             why = (f"more than --trim-distance {options.trim_distance:g} mm from every stitch of its "
@@ -411,7 +413,7 @@ def _crowding_ties(points: np.ndarray, kinds: np.ndarray, ties: np.ndarray,
         return set()
     reach = DENSITY_RADIUS + 1e-9
     # Only places near a tie can be helped by a lighter tie: count there, not everywhere.
-    tree = cKDTree(pts)
+    tree = cKDTree(pts, balanced_tree=False, compact_nodes=False)  # 3x quicker to build
     near = np.zeros(len(pts), dtype=bool)
     for found in tree.query_ball_point(pts[at_tie], reach):
         near[found] = True
