@@ -161,6 +161,7 @@ def embroider(source: str, output: str, style: str, size: float | None, width: f
         console.print(line, soft_wrap=True)
     extra = f" and {preview_path}" if preview_path else ""
     done(f"wrote {output}{extra}: {stats.stitches} stitches, {stats.trims} trims, "
-         f"{stats.thread_length / 1000:.2f} m thread, {stats.width:.1f} x {stats.height:.1f} mm "
+         f"{stats.thread_length / 1000:.2f} m thread (+ {stats.bobbin_length / 1000:.2f} m bobbin), "
+         f"{stats.width:.1f} x {stats.height:.1f} mm "
          f"in hoop {the_hoop.name}, about {stats.seconds / 60:.1f} min "
          f"({time.perf_counter() - started:.1f} s)")

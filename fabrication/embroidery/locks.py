@@ -4,6 +4,10 @@ A lock walks back along the needle path from its end by fractions of a lock leng
 returns (Ink/Stitch's "half stitch": 0.5, 1, 0.5, 0 of min(path, 1.5 mm)); a tack is the
 same figure at the start, sewn forward along the path before the path itself. We make
 them ourselves: pyembroidery's `tie_off` emits zero-length stitches and nothing useful.
+
+Where a tack or lock would crowd the needle points around it (a short stroke, a tight
+start), the planner asks for a lighter one: `level` 1 sews a single stitch there and
+back (`SINGLE`), level 2 (`TIE_LEVELS` - 1) none at all.
 """
 
 from __future__ import annotations
@@ -22,6 +26,20 @@ LOCK_FORMS: dict[str, tuple[float, ...]] = {
     "half": (0.5, 1.0, 0.5, 0.0),
     "back_forth": (1.0, 0.0, 1.0, 0.0),
 }
+# The lighter figure of level 1: one stitch back (forward for a tack) and return.
+SINGLE = (1.0, 0.0)
+TIE_LEVELS = 3  # 0: the chosen form, 1: SINGLE, 2: none
+
+
+@dataclass(frozen=True, kw_only=True)
+class LighterTie:
+    """A tack (lock=False) or lock made lighter for density: where it starts (tack) or
+    ends (lock), x, y in mm; level 1: a single stitch there and back, 2: left out."""
+
+    x: float
+    y: float
+    lock: bool
+    level: int
 
 
 LOCK_LENGTH = Range(0.0, None, unit="mm", name="lock length", low_open=True)
@@ -52,10 +70,17 @@ def _lock_length(path: np.ndarray, options: LockOptions) -> float:
     return min(options.length, total)
 
 
-def lock_points(path: np.ndarray, options: LockOptions = LockOptions()) -> np.ndarray:
-    """Needle points (4, 2) to sew after `path` (N, 2) ends; the last one is its end."""
+def _form(options: LockOptions, level: int) -> np.ndarray:
+    if not 0 <= level < TIE_LEVELS:
+        raise ValueError(f"tie level {level} is not in [0, {TIE_LEVELS})")
+    return np.asarray(LOCK_FORMS[options.form] if level == 0 else SINGLE if level == 1 else ())
+
+
+def lock_points(path: np.ndarray, options: LockOptions = LockOptions(), level: int = 0) -> np.ndarray:
+    """Needle points (4, 2) to sew after `path` (N, 2) ends, the last one its end; (2, 2)
+    at `level` 1, (0, 2) at level 2."""
     length = _lock_length(path, options)
-    return walk_back(path, length * np.asarray(LOCK_FORMS[options.form]))
+    return walk_back(path, length * _form(options, level))
 
 
 # A tack's holes keep this far (mm, along the path) from the holes the stitches after it
@@ -83,10 +108,13 @@ def _clear_length(path: np.ndarray, length: float, form: np.ndarray) -> float:
     return float(candidates[int(np.argmax(gaps))])  # the first of the widest gaps, as before
 
 
-def tack_points(path: np.ndarray, options: LockOptions = LockOptions()) -> np.ndarray:
+def tack_points(path: np.ndarray, options: LockOptions = LockOptions(), level: int = 0) -> np.ndarray:
     """Needle points (4, 2) to sew before `path` (N, 2) begins: its start, then the lock
     figure forward along it; the path then continues from its own start. The figure is
-    shortened (to half at most) to keep clear of the path's first holes."""
-    form = np.asarray(LOCK_FORMS[options.form])
+    shortened (to half at most) to keep clear of the path's first holes. (2, 2) at
+    `level` 1, (0, 2) at level 2."""
+    form = _form(options, level)
+    if not len(form):
+        return np.zeros((0, 2))
     length = _clear_length(path, _lock_length(path, options), form)
     return np.vstack([path[:1], walk_back(path[::-1], length * form[:-1])])
