@@ -74,7 +74,10 @@ def test_out_of_range_values_get_the_command_lines_answer(client, tmp_path, endp
     assert time.perf_counter() - started < 2.0
     assert answer.status_code == 400, answer.text
     result = CliRunner().invoke(main, [argv[0], str(drawing)] + [a.replace("{out}", str(tmp_path)) for a in argv[1:]])
-    assert result.exit_code == 2 and result.stderr.strip() == f"error: {answer.json()['error']}"
+    # A value read from the edits is named with the file it came from ("edits: --blur ...").
+    where = "edits: " if "edits" in body else ""
+    assert result.exit_code == 2 and f"error: {where}{result.stderr.strip()[len('error: '):]}" == \
+        f"error: {answer.json()['error']}"
 
 
 # -- the fuzz, against a server in its own process ---------------------------------------------
