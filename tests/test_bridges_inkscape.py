@@ -1,9 +1,9 @@
 """The Inkscape extension, run the way Inkscape 1.2 runs it, checked against `onestroke vectorize`.
 
 Inkscape 1.2 cannot run an effect extension without its window: effects become actions only
-in GUI mode (`inkscape --action-list` lists none, and `--actions=org.inkscape.color.grayscale`
-answers "could not find action" even for Inkscape's own extensions), and an effect with
-parameters opens its dialog. So the script runs as Inkscape's Script::execute runs it: Debian's
+in GUI mode (`inkscape --action-list` lists none, and `--actions=select-by-id:img1;
+org.onestroke.vectorize;export-do` answers "could not find action", as it does for Inkscape's
+own org.inkscape.color.grayscale), and in the GUI an effect with parameters opens its dialog. So the script runs as Inkscape's Script::execute runs it: Debian's
 /usr/bin/python3 (the interpreter Inkscape's Debian package depends on, with python3-lxml) with
 Inkscape's bundled inkex on PYTHONPATH, the extension's folder as working directory,
 `--id=...` and one `--name=value` per parameter, a copy of the document as the last argument,
@@ -14,6 +14,7 @@ DOCUMENT_PATH naming the saved document, and the new document read from stdout. 
 from __future__ import annotations
 
 import base64
+import functools
 import json
 import os
 import shutil
@@ -40,6 +41,7 @@ PX_PER_MM = 96 / 25.4
 SVG = 'xmlns="http://www.w3.org/2000/svg" xmlns:xlink="http://www.w3.org/1999/xlink"'
 
 
+@functools.cache
 def inkex_folder() -> str:
     """Inkscape's own extensions folder (where its inkex lives)."""
     data = subprocess.run([INKSCAPE, "--system-data-directory"], capture_output=True, text=True).stdout

@@ -88,3 +88,15 @@ def test_multi_stroke_order_kept_through_order_keeping_commands(tmp_path):
     assert len(lines) == len(curves) == 2
     for line, curve in zip(lines, curves):
         assert follows(line, curve, tolerance=(0.05 + 0.01) * PX_PER_MM + 0.01)
+
+
+def test_bad_input_is_one_line_from_vpype(tmp_path):
+    blank = tmp_path / "blank.png"
+    Image.new("L", (200, 200), 255).save(blank)
+    for args, message in ((["--threshold", "2", EXAMPLE], "Error: --threshold 2 must be above 0 to below 1"),
+                          ([blank], "Error: no ink found: the image is blank")):
+        result = subprocess.run([VPYPE, "onestroke", *map(str, args), "write", "x.svg"], capture_output=True,
+                                text=True, cwd=tmp_path)
+        assert result.returncode != 0
+        assert result.stderr.strip() == message
+        assert not (tmp_path / "x.svg").exists()
