@@ -169,11 +169,16 @@ def test_laser_svg_at_physical_size_one_path_per_stroke_in_order(drawings, tmp_p
         assert float(page[3]) / PX_PER_MM == pytest.approx(float(root.get("width")[:-2]), abs=0.05)
 
 
-def test_inkstitch_refuses_json_output(drawings, tmp_path):
-    result = CliRunner().invoke(main, ["vectorize", str(drawings["single"]), "-o", str(tmp_path / "x.json"),
-                                       "--inkstitch", "running"])
+@pytest.mark.parametrize("args,message", [
+    (["-o", "x.json", "--inkstitch", "running"], "--inkstitch writes an SVG"),
+    (["-o", "x.svg", "--size", "90mm", "--width", "30mm"], "give only one of --size, --width, --height"),
+])
+def test_page_options_are_refused_before_any_work(drawings, tmp_path, args, message):
+    result = CliRunner().invoke(main, ["vectorize", str(drawings["single"]),
+                                       *[str(tmp_path / a) if a.startswith("x.") else a for a in args]])
     assert result.exit_code == 2
-    assert "--inkstitch writes an SVG" in result.output
+    assert message in result.output
+    assert list(tmp_path.iterdir()) == []
 
 
 def test_the_cli_offers_every_stitch_the_bridge_writes():

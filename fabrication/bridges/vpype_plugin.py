@@ -44,16 +44,15 @@ def onestroke(document: vp.Document, drawing: str, multi: bool, threshold: float
     from fabrication.placement import PlacementOptions, place_on_page
     from vectorize import VectorizeOptions, vectorize_file
 
-    try:
-        result = vectorize_file(drawing, VectorizeOptions(multi=multi, threshold=threshold, blur=blur,
-                                                          classifier=classifier))
+    if not tolerance > 0:
+        raise click.BadParameter(f"--tolerance {tolerance:g} px must be greater than zero")
+    try:  # every option is checked (by the option types) before any work
+        options = VectorizeOptions(multi=multi, threshold=threshold, blur=blur, classifier=classifier)
         sides = {"size": size, "width": width, "height": height}
         placement = None
         if any(v is not None for v in sides.values()):
             placement = PlacementOptions(**{k: None if v is None else v / PX_PER_MM for k, v in sides.items()})
-        placed = place_on_page(result.drawing, placement)
-        if not tolerance > 0:
-            raise click.BadParameter(f"--tolerance {tolerance:g} px must be greater than zero")
+        placed = place_on_page(vectorize_file(drawing, options).drawing, placement)
     except OnestrokeError as error:
         raise click.ClickException(str(error)) from None
     lines = vp.LineCollection()

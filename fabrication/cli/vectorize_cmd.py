@@ -44,6 +44,11 @@ def vectorize(source: str, output: str, multi: bool, threshold: float | None, bl
     from vectorize.edits import read_edits
     from vectorize.svg_write import write_drawing
 
+    placement = None  # the page at the design's size; None: the input's own page (in mm with --inkstitch)
+    if any(v is not None for v in (size, width, height)) or rotate:
+        from fabrication.placement import PlacementOptions
+
+        placement = PlacementOptions(size=size, width=width, height=height, rotate=rotate)
     replay = read_edits(edits) if edits is not None else None
     started = time.perf_counter()
     options = VectorizeOptions(multi=multi, threshold=threshold, blur=blur, classifier=classifier,
@@ -53,12 +58,10 @@ def vectorize(source: str, output: str, multi: bool, threshold: float | None, bl
     for message in result.report.warnings:
         warn(message)
     drawing = result.drawing
-    sized = any(v is not None for v in (size, width, height)) or bool(rotate)
-    if inkstitch is not None or sized:
-        from fabrication.placement import PlacementOptions, place_on_page
+    if inkstitch is not None or placement is not None:
+        from fabrication.placement import place_on_page
 
-        drawing = place_on_page(drawing, PlacementOptions(size=size, width=width, height=height, rotate=rotate)
-                                if sized else None)
+        drawing = place_on_page(drawing, placement)
     if inkstitch is not None:
         from fabrication.bridges.inkstitch import inkstitch_svg
         from onestroke.atomic import atomic_write_text
