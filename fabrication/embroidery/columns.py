@@ -359,7 +359,7 @@ def stroke_columns(stroke: Stroke, curve: DenseCurve, half_at, spacing: float, *
 
 
 def _thin_crowded(rows: list[Rows]) -> None:
-    """In place: rows whose rail points crowd (more than CROWDED rail points of other rows
+    """In place: rows whose rail points crowd (more than CROWDED needle points of other rows
     within DENSITY_RADIUS mm: the inside of a tight bend, the ground where corners meet) are
     left out, in sewing order, while they still crowd. Whole rows go, so the sides still
     alternate; only the rows whose points crowd at first are visited."""
@@ -372,18 +372,19 @@ def _thin_crowded(rows: list[Rows]) -> None:
     tree = cKDTree(ends)
     pairs = tree.query_pairs(DENSITY_RADIUS, output_type="ndarray")
     pairs = pairs[row_of[pairs[:, 0]] != row_of[pairs[:, 1]]]
+    # Each row has both ends but sews one (the sides alternate): two ends per needle point.
     count = np.bincount(pairs.ravel(), minlength=len(ends))
-    if count.max(initial=0) <= CROWDED:
+    if count.max(initial=0) <= 2 * CROWDED:
         return
     alive = np.ones(row_of.max() + 1, dtype=bool)
-    suspects = np.unique(row_of[count > CROWDED]).tolist()
+    suspects = np.unique(row_of[count > 2 * CROWDED]).tolist()
     for row in suspects:
         mine = np.flatnonzero(row_of == row)
         crowded = False
         for point in mine.tolist():
             near = tree.query_ball_point(ends[point], DENSITY_RADIUS)
             others = row_of[near]
-            if int(np.count_nonzero(alive[others] & (others != row))) > CROWDED:
+            if int(np.count_nonzero(alive[others] & (others != row))) > 2 * CROWDED:
                 crowded = True
                 break
         if crowded:

@@ -1,18 +1,17 @@
 """Zigzag across the curve (paper Fig. 13 middle): needle points alternate side to side.
 
-A constant-width column (`fabrication.embroidery.columns`): rows every spacing/2 along the
-longer rail, each pushed perpendicular to the local direction by width/2 +
-pull_compensation/2, alternating sides. The direction is the chord over +-reach around the
-point: the tangent on straight parts and arcs, a fan round a bend. Corners sharper than
-`corner_angle` are mitred, or split into two columns that overlap by `overlap` mm where the
-mitre would reach past `mitre_limit` half widths (the wave drawing's 150 degree fold): no
-spur, no pile-up, no slit. On tight inner curves the inside points crowd: every other
-crowded inner point is inset (Ink/Stitch's short stitches: 30 % of the reach where points
-on the rail come closer than 0.35 mm) and a point still within `min_gap` of one of the
-last two on its rail is inset deeper (`fabrication.embroidery.column_stitches`): no needle
-goes into a hole next to one it made a moment before. Zigs longer than `max_stitch` are
-split at staggered points. Underlay (sewn first, there and back so the zigzag starts where
-the stroke does), as satin columns use: 'center' a walk along the curve (back between the
+Centre points every spacing/2 along the curve (an even number of them), each pushed
+perpendicular to the local direction by width/2 + pull_compensation/2, alternating sides.
+The direction is the chord over +-reach around the point: the tangent on straight parts
+and arcs, a fan round a sharp corner.
+On tight inner curves the inside points crowd: every other inner point is inset
+(Ink/Stitch's short stitches; 30 % where points on the rail come closer than 0.35 mm,
+deep enough that the inset holes stay 0.35 mm from their rail neighbours), the inside
+reach is capped below the curve radius, and a rail point still closer than `min_gap` to
+one of the last few on its rail is dropped (the outside fans round a shared inner point):
+no needle goes into a hole next to one it made a moment before. Zigs longer than `max_stitch` are split at
+staggered points. Underlay (sewn first, there and back so the zigzag starts where the
+stroke does), as satin columns use: 'center' a walk along the curve (back between the
 holes of the way out), 'edge' a walk along each rail inset from the edge, 'zigzag' a
 sparse zigzag inset from the edges, out and back in opposite phase; by default a centre
 walk once the zigzag is wider than `underlay_min_width`.
@@ -20,14 +19,15 @@ walk once the zigzag is wider than `underlay_min_width`.
 
 from __future__ import annotations
 
+import heapq
+import itertools
 from dataclasses import dataclass
 
 import numpy as np
 
-from fabrication.embroidery.column_stitches import ColumnStitching, column_needles
-from fabrication.embroidery.columns import CORNER_ANGLE, MITRE_LIMIT, OVERLAP, stroke_columns
-from fabrication.embroidery.needles import GRID, NeedlePoints
-from fabrication.embroidery.running import DENSE_TOLERANCE, STITCH_LENGTH, TOLERANCE
+from fabrication.embroidery.needles import BODY, GRID, SNAP_ALLOWANCE, UNDERLAY, NeedlePoints
+from fabrication.embroidery.running import (DENSE_TOLERANCE, STITCH_LENGTH, TOLERANCE, RunningOptions,
+                                            running_stitch)
 from fabrication.embroidery.sampling import dense_curve
 from onestroke.errors import InputError
 from onestroke.ranges import Range, check_ranges, ranged
@@ -43,6 +43,9 @@ UNDERLAY_SPACING = Range(0.5, None, unit="mm", name="underlay spacing")
 SHORT_STITCH_INSET = Range(0.0, 1.0, name="short-stitch inset", high_open=True)
 ZIG_MAX_STITCH = Range(1.0, None, unit="mm", name="zigzag max stitch", low_open=True)
 
+# The inside reach stays below this fraction of the curve radius, so inner points never
+# pass the centre of curvature (they would sew loops and run backwards).
+MAX_INNER_REACH = 0.75
 UNDERLAYS = ("center", "edge", "zigzag", "none")
 
 
@@ -57,9 +60,7 @@ class ZigzagOptions:
     short_stitch_distance / short_stitch_inset: inset every other inner point by this
     fraction of the reach where inner points come closer than that distance; min_gap: the
     closest two needle points may come on one rail (0.35 mm keeps them >= 0.2 mm apart
-    after snapping to the files' 0.1 mm grid); max_stitch: longer zigs are split;
-    corner_angle (degrees), mitre_limit (half widths), overlap (mm): corners, as satin's
-    (`fabrication.embroidery.columns`)."""
+    after snapping to the files' 0.1 mm grid); max_stitch: longer zigs are split."""
 
     width: float = ranged(2.0, STITCH_WIDTH)
     spacing: float = ranged(0.4, SPACING)
@@ -74,9 +75,6 @@ class ZigzagOptions:
     min_gap: float = 0.35
     max_stitch: float = ranged(12.1, ZIG_MAX_STITCH)
     tolerance: float = ranged(0.2, TOLERANCE)
-    corner_angle: float = ranged(45.0, CORNER_ANGLE)
-    mitre_limit: float = ranged(2.0, MITRE_LIMIT)
-    overlap: float = ranged(0.3, OVERLAP)
 
     def __post_init__(self) -> None:
         check_ranges(self)
@@ -107,22 +105,140 @@ class ZigzagOptions:
         return self.underlay_kind != "none"
 
 
+def _drop_crowded(points: np.ndarray, min_gap: float, inner: np.ndarray, *, window: int = 6) -> np.ndarray:
+    """Mask of points to keep so that no `inner` point comes within `min_gap` of the last
+    `window` kept points on its rail (rails alternate: even and odd indices; on a very
+    tight curve the inner rail winds round a small circle, so not only the previous point
+    can be near). Points outside curves or on straight parts keep the requested spacing.
+    Only crowded points and the ones after a dropped point are visited one by one."""
+    n = len(points)
+    keep = np.ones(n, dtype=bool)
+    nearest = np.full(n, np.inf)
+    for lag in range(2, 2 * window + 1, 2):
+        d = np.linalg.norm(points[lag:] - points[:-lag], axis=1)
+        nearest[lag:] = np.minimum(nearest[lag:], d)
+    work = np.flatnonzero((nearest < min_gap) & inner).tolist()
+    heapq.heapify(work)
+    queued = set(work)
+    while work:
+        i = heapq.heappop(work)
+        if i == n - 1 or not inner[i]:
+            continue  # the end point anchors the lock
+        kept = list(itertools.islice((k for k in range(i - 2, -1, -2) if keep[k]), window))
+        if kept and np.min(np.hypot(*(points[kept] - points[i]).T)) < min_gap:
+            keep[i] = False
+            for nxt in range(i + 2, min(n, i + 2 * window + 1), 2):
+                if inner[nxt] and nxt not in queued:
+                    queued.add(nxt)
+                    heapq.heappush(work, nxt)
+    return keep
+
+
+def _split_long(points: np.ndarray, t: np.ndarray, max_length: float) -> tuple[np.ndarray, np.ndarray]:
+    """Split stitches longer than `max_length` into real stitches at staggered fractions so
+    that the split points of neighbouring zigs do not line up into a ridge."""
+    seg = np.diff(points, axis=0)
+    length = np.linalg.norm(seg, axis=1)
+    # Staggers up to 1/3 of a piece make the longest piece (1 + 1/3) / n of the stitch.
+    n = np.maximum(1, np.ceil(length * (4.0 / 3.0) / max_length)).astype(int)
+    n[length <= max_length] = 1
+    if n.max() == 1:
+        return points, t
+    stagger = np.array([0.0, 1.0 / 3.0, -1.0 / 3.0])[np.arange(len(n)) % 3]
+    extra = n - 1
+    owner = np.repeat(np.arange(len(n)), extra)
+    k = np.arange(extra.sum()) - np.repeat(np.cumsum(extra) - extra, extra) + 1
+    frac = (k - stagger[owner]) / n[owner]
+    new_pts = points[owner] + seg[owner] * frac[:, None]
+    new_t = t[owner] + (t[owner + 1] - t[owner]) * frac
+    # Insert after the start of each owning stitch, keeping the order along each stitch.
+    order = np.argsort(np.concatenate([np.arange(len(points)) * 1.0, owner + frac * 0.999]), kind="stable")
+    return np.concatenate([points, new_pts])[order], np.concatenate([t, new_t])[order]
+
+
 def zigzag_stitch(stroke: Stroke, options: ZigzagOptions = ZigzagOptions()) -> NeedlePoints:
-    """Zigzag along `stroke` (mm), preceded by a there-and-back underlay when wide."""
+    """Zigzag along `stroke` (mm), preceded by a there-and-back centre walk when wide."""
     curve = dense_curve(stroke, DENSE_TOLERANCE)
+    length = curve.length
+    steps = max(1, int(round(2.0 * length / options.spacing)))
+    if steps % 2 == 0:
+        steps += 1  # an even number of points: the zigzag ends on the other rail
+    s = np.linspace(0.0, length, steps + 1)
+    t = curve.t_at(s)
+    centre = stroke.points_at(t)
+    # Direction of the chord over +-reach around each point: the tangent on straight parts
+    # and arcs, and a fan that turns smoothly round a sharp corner instead of jumping
+    # (which would leave a wedge outside the corner and cross over inside it).
+    # The window stays symmetric near the ends, where it shrinks to the exact tangent.
+    w = np.minimum(options.reach, np.minimum(s, length - s))
+    chord = stroke.points_at(curve.t_at(s + w)) - stroke.points_at(curve.t_at(s - w))
+    norm = np.linalg.norm(chord, axis=1, keepdims=True)
+    tangent = np.where(norm > 1e-6, chord / np.maximum(norm, 1e-12), stroke.tangents_at(t))
+    normal = np.column_stack([-tangent[:, 1], tangent[:, 0]])
+    theta = np.unwrap(np.arctan2(tangent[:, 1], tangent[:, 0]))
+    kappa = np.gradient(theta, s) if len(s) > 2 else np.zeros(len(s))
+    side = np.where(np.arange(len(s)) % 2 == 0, 1.0, -1.0)
+    reach = np.full(len(s), options.reach)
+    inner = side * kappa > 0
+    radius = 1.0 / np.maximum(np.abs(kappa), 1e-12)
+    reach[inner] = np.minimum(reach[inner], MAX_INNER_REACH * radius[inner])
+    # Same-rail spacing on the inside shrinks by (1 - reach / radius).
+    rail_gap = 2.0 * (length / steps) * (1.0 - reach * np.abs(kappa))
+    short = inner & (rail_gap < options.short_stitch_distance) & ((np.arange(len(s)) // 2) % 2 == 1)
+    reach[short] *= 1.0 - options.short_stitch_inset
+    points = centre + normal * (side * reach)[:, None]
+    # Inner points of a real curve (radius under 50 mm) may be dropped when crowded.
+    keep = _drop_crowded(points, options.min_gap, inner & (np.abs(kappa) > 0.02))
+    points, t = points[keep], t[keep]
+    points, t = _split_long(points, t, options.max_stitch - 2 * SNAP_ALLOWANCE)
+    zig = NeedlePoints.of(points, t, BODY)
+    # An underlay goes there and back and ends on the start; along a stroke no longer than
+    # one underlay stitch it would re-enter its first hole two stitches later (a knot on a
+    # short stroke), and so short a column does not pucker without it.
+    if not options.has_underlay or length <= options.underlay_stitch_length:
+        return zig
+    return NeedlePoints.concat([_underlay(stroke, curve, options), zig])
 
-    def half_at(s: np.ndarray) -> np.ndarray:
-        return np.full(len(s), options.reach)
 
-    columns = stroke_columns(stroke, curve, half_at, options.spacing, corner_angle=options.corner_angle,
-                             mitre_limit=options.mitre_limit, overlap=options.overlap)
+def _offset(stroke: Stroke, t: np.ndarray, offset: np.ndarray) -> np.ndarray:
+    """Points at parameters t pushed along the left normal by `offset` (mm, signed)."""
+    tangent = stroke.tangents_at(t)
+    normal = np.column_stack([-tangent[:, 1], tangent[:, 0]])
+    return stroke.points_at(t) + normal * np.asarray(offset, dtype=float).reshape(-1, 1)
+
+
+def _underlay(stroke: Stroke, curve, options: ZigzagOptions) -> NeedlePoints:
+    """Underlay needle points, there and back: they end on the stroke's start."""
+    walk = running_stitch(stroke, RunningOptions(stitch_length=options.underlay_stitch_length,
+                                                 tolerance=options.tolerance), curve=curve)
     kind = options.underlay_kind
-    # The zigzag's underlay inset counts from the drawn edge, the columns' from the rail.
-    inset = options.reach - max(0.0, options.width / 2.0 - options.underlay_inset)
-    how = ColumnStitching(
-        spacing=options.spacing, short_stitch_distance=options.short_stitch_distance,
-        # the zigzag's inset is a share of its reach, the columns' of the row's width (twice it)
-        short_stitch_inset=options.short_stitch_inset / 2.0, min_gap=options.min_gap, max_stitch=options.max_stitch,
-        underlays=() if kind == "none" else (kind,), underlay_stitch_length=options.underlay_stitch_length,
-        edge_inset=inset, zigzag_inset=inset, underlay_spacing=options.underlay_spacing, tolerance=options.tolerance)
-    return column_needles(stroke, curve, columns, how)
+    inset = max(0.0, options.width / 2.0 - options.underlay_inset)
+    if kind == "center" or inset < 0.2:
+        # The walk back pierces halfway between the holes of the walk out, ending on the start.
+        back_t = np.concatenate([0.5 * (walk.t[:-1] + walk.t[1:])[::-1], [walk.t[0]]])
+        return NeedlePoints.of(np.concatenate([walk.points, stroke.points_at(back_t)]),
+                               np.concatenate([walk.t, back_t]), UNDERLAY)
+    # The inner side of a tight curve cannot reach past its centre of curvature.
+    kappa = np.interp(walk.t, curve.t, curve.curvature)
+    room = MAX_INNER_REACH / np.maximum(np.abs(kappa), 1e-12)
+    left = np.minimum(inset, np.where(kappa > 0, room, np.inf))
+    right = np.minimum(inset, np.where(kappa < 0, room, np.inf))
+    if kind == "edge":
+        out = _offset(stroke, walk.t, left)
+        back = _offset(stroke, walk.t[::-1], -right[::-1])
+        pts = np.concatenate([walk.points[:1], out, back, walk.points[:1]])
+        t = np.concatenate([walk.t[:1], walk.t, walk.t[::-1], walk.t[:1]])
+        return NeedlePoints.of(pts, t, UNDERLAY)
+    # Zigzag underlay: a sparse zigzag out, the opposite phase back.
+    steps = max(2, int(round(2.0 * curve.length / options.underlay_spacing)))
+    s = np.linspace(0.0, curve.length, steps + 1)
+    t = curve.t_at(s)
+    k = np.interp(t, curve.t, curve.curvature)
+    room = MAX_INNER_REACH / np.maximum(np.abs(k), 1e-12)
+    side = np.where(np.arange(len(s)) % 2 == 0, 1.0, -1.0)
+    reach = np.minimum(inset, np.where(side * k > 0, room, np.inf))
+    out = _offset(stroke, t, side * reach)
+    back = _offset(stroke, t[::-1], (-side * np.minimum(inset, np.where(-side * k > 0, room, np.inf)))[::-1])
+    pts = np.concatenate([walk.points[:1], out, back, walk.points[:1]])
+    tt = np.concatenate([walk.t[:1], t, t[::-1], walk.t[:1]])
+    return NeedlePoints.of(pts, tt, UNDERLAY)
