@@ -13,8 +13,19 @@ import os
 from pathlib import Path
 
 from onestroke.atomic import atomic_write_text
+from onestroke.errors import InputError
+from onestroke.json_check import parse_json
 
 MANIFEST_NAME = "onestroke-batch-manifest.json"
+# What `save` writes, as `onestroke.json_check` reads it.
+_OUTPUT = {"type": "object", "properties": {"input": {"type": "string"}, "key": {"type": "string"}}}
+_FAILED = {"type": "object", "properties": {"key": {"type": "string"}, "error": {"type": "string"},
+                                            "stamp": {"type": "array", "minItems": 2, "maxItems": 2,
+                                                      "items": {"type": "integer"}}}}
+SCHEMA = {"type": "object", "required": ["format"], "properties": {
+    "format": {"const": "onestroke-batch-manifest"},
+    "outputs": {"type": "object", "additionalProperties": _OUTPUT},
+    "failed": {"type": "object", "additionalProperties": _FAILED}}}
 
 
 def _stamp(path: Path) -> tuple[int, int]:
@@ -30,12 +41,11 @@ class Manifest:
         self.outputs: dict[str, dict] = {}
         self.failed: dict[str, dict] = {}
         try:
-            payload = json.loads(self.path.read_text(encoding="utf-8"))
-            if payload.get("format") == "onestroke-batch-manifest":
-                self.outputs = dict(payload.get("outputs", {}))
-                self.failed = dict(payload.get("failed", {}))
-        except (OSError, ValueError, AttributeError):
-            pass  # no manifest yet, or an unreadable one: everything is made again
+            payload = parse_json(self.path.read_bytes(), SCHEMA, what="manifest")
+            self.outputs = dict(payload.get("outputs", {}))
+            self.failed = dict(payload.get("failed", {}))
+        except (OSError, InputError):
+            pass  # no manifest yet, or one that is not ours (checked first): everything is made again
         self.root = Path(out_dir).resolve()
 
     def _key(self, output: Path) -> str:
