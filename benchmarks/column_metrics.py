@@ -4,8 +4,8 @@ is along its stroke, and where its stitches leave the fabric bare between them (
 - Sewn width: along each stroke, every `step` mm, the top (BODY) needle points within one
   `window` mm of that place along the curve (their nearest point on it) give the column's
   extent either side; the width is the widest reach left plus the widest right.
-- Slits: points of the column's band (within the expected half width less `margin`, every
-  0.1 mm along and across) farther than half the spacing plus `slack` from every top stitch
+- Slits: points of the column's band (within the expected half width less `margin` and the
+  short stitches' inset, every 0.1 mm along, 9 across) farther than half the spacing plus `slack` from every top stitch
   of the stroke: there adjacent stitches are more than the spacing apart (the thread
   covers up to half the spacing either side of a stitch in a sound column). Grouped into
   places 1 mm apart.
@@ -97,9 +97,11 @@ def shared_ground(s: np.ndarray, where: np.ndarray, half: np.ndarray) -> np.ndar
 
 
 def slits(plan, k: int, half_at, spacing: float, *, margin: float = 0.15, slack: float = 0.1,
-          corners: np.ndarray | None = None) -> list[np.ndarray]:
+          inset: float = 0.0, corners: np.ndarray | None = None) -> list[np.ndarray]:
     """Places (mm) where the top stitches of sewn stroke `k` leave a gap wider than
-    `spacing` (module doc). half_at: arc lengths (n,) -> the expected needle half width (n,)."""
+    `spacing` (module doc). half_at: arc lengths (n,) -> the expected needle half width (n,);
+    inset: a share of the half width next to each rail not probed (where short stitches
+    end short of the rail by design)."""
     stroke = plan.sewn.strokes[k]
     curve, _, tangent = _frame(stroke)
     rows = _top(plan, k)
@@ -116,7 +118,7 @@ def slits(plan, k: int, half_at, spacing: float, *, margin: float = 0.15, slack:
     centre = np.column_stack([np.interp(s, curve.s, curve.points[:, 0]), np.interp(s, curve.s, curve.points[:, 1])])
     tx, ty = np.interp(s, curve.s, tangent[:, 0]), np.interp(s, curve.s, tangent[:, 1])
     normal = np.column_stack([-ty, tx]) / np.maximum(np.hypot(tx, ty), 1e-12)[:, None]
-    half = np.maximum(half_at(s) - margin, 0.0)
+    half = np.maximum(half_at(s) * (1.0 - inset) - margin, 0.0)
     across = np.linspace(-1.0, 1.0, 9)
     probes = (centre[:, None, :] + normal[:, None, :] * (half[:, None] * across[None, :])[..., None]).reshape(-1, 2)
     if corners is not None and len(corners):
