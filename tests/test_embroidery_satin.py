@@ -154,3 +154,29 @@ def test_five_formats_same_bytes_every_run(tmp_path):
         write_embroidery(plan_embroidery(drawing, PlanOptions(style=SatinOptions(random_width=0.1))), a)
         write_embroidery(plan_embroidery(drawing, PlanOptions(style=SatinOptions(random_width=0.1))), b)
         assert a.read_bytes() == b.read_bytes()
+
+
+def test_the_command_line_sews_a_brush_drawing_as_wide_as_it_is_drawn(tmp_path):
+    from click.testing import CliRunner
+    from PIL import Image
+
+    from benchmarks.render import render_profile, to_uint8
+    from fabrication.cli import main
+    from fabrication.embroidery.read import read_embroidery
+
+    # a line 900 px long whose ink swells from 12 to 36 px and back, at 90 mm: 1.2-3.6 mm
+    drawn = Drawing((line(length=900.0).transformed(np.array([[1.0, 0, 50.0], [0, 1.0, 500.0]])),), 1000, 1000,
+                    "px", 36.0)
+    profile = (np.array([0.0, 0.5, 1.0]), np.array([12.0, 36.0, 12.0]))
+    Image.fromarray(to_uint8(render_profile(drawn, profile))).save(tmp_path / "brush.png")
+    result = CliRunner().invoke(main, ["embroider", str(tmp_path / "brush.png"), "-o", str(tmp_path / "b.pes"),
+                                       "--style", "satin", "--underlay", "edge+zigzag", "--random-width", "5%",
+                                       "--seed", "2", "--hoop", "130x180"])
+    assert result.exit_code == 0, result.output
+    back = read_embroidery(tmp_path / "b.pes").plan
+    needles = back.points[back.kinds == STITCH]
+    across = np.ptp(needles[:, 1][np.abs(needles[:, 0]) < 3.0])  # the middle, mm
+    assert across == pytest.approx(3.6, rel=0.15)  # +-5 % random width on top of the drawn 3.6 mm
+    result = CliRunner().invoke(main, ["embroider", str(tmp_path / "brush.png"), "-o", str(tmp_path / "c.pes"),
+                                       "--style", "satin", "--min-width", "3mm", "--max-width", "2mm"])
+    assert result.exit_code == 2 and "--min-width" in result.output
