@@ -109,7 +109,7 @@ def top_stitches(rows: Rows, how: ColumnStitching, rng: np.random.Generator | No
     offset = offset - side * depth
     points = rows.centre + rows.normal * offset[:, None]
     points = _keep_holes_apart(points, rows, side, offset, step, width, how.min_gap)
-    points, t = _split_long(points, rows.t, how.max_stitch - 2 * SNAP_ALLOWANCE,
+    points, t = split_long(points, rows.t, how.max_stitch - 2 * SNAP_ALLOWANCE,
                             rng if how.random_phase else None)
     return NeedlePoints.of(points, t, BODY)
 
@@ -144,8 +144,8 @@ def _keep_holes_apart(points, rows: Rows, side, offset, step, width, min_gap) ->
     return points
 
 
-def _split_long(points: np.ndarray, t: np.ndarray, max_length: float,
-                rng: np.random.Generator | None) -> tuple[np.ndarray, np.ndarray]:
+def split_long(points: np.ndarray, t: np.ndarray, max_length: float,
+               rng: np.random.Generator | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Split stitches longer than `max_length` into real stitches: at staggered fractions so
     that the split points of neighbouring stitches do not line up into a ridge, or at a
     random phase (`rng`)."""
