@@ -162,7 +162,7 @@ def test_bobbin_thread_is_estimated_beside_the_top_thread():
     body = zigzag.roles[zigzag.stitch_mask] == BODY
     assert column.bobbin_length == pytest.approx(length[body].sum() / 3 + length[~body].sum())
     assert 0.3 * column.thread_length < column.bobbin_length < 0.5 * column.thread_length
-    assert "third" in column.bobbin_rule
+    assert "1/3" in column.bobbin_rule and "1/3" in column.lines()[2]
 
 
 def test_density_warning_above_six_needle_points_within_half_a_millimetre():

@@ -4,6 +4,9 @@ from __future__ import annotations
 
 import json
 import os
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from xml.sax.saxutils import quoteattr
 
 import numpy as np
 
@@ -41,22 +44,47 @@ def _num6(value: float) -> str:
     return "0" if text in ("-0", "") else text
 
 
-def drawing_to_svg(drawing: Drawing, *, color: str = "#000000") -> str:
-    """The SVG text of `drawing`: viewBox = its canvas, stroke width = its measured width;
-    each stroke whose ink widths are known carries them in `data-widths` (`widths_data`)."""
+@dataclass(frozen=True)
+class SvgPath:
+    """One `<path>` of the document: its sub-paths in order (one `M` each) and extra attributes.
+
+    attributes: (name, value) pairs written on the element, e.g. ("stroke-width", "0.1") or a
+    namespaced ("inkstitch:satin_column", "true") whose prefix `drawing_to_svg` declares;
+    color: RGB 0-255 overriding the group's stroke colour, None to inherit it.
+    """
+
+    subpaths: tuple[Stroke, ...]
+    attributes: tuple[tuple[str, str], ...] = ()
+    color: tuple[int, int, int] | None = None
+
+
+def drawing_to_svg(drawing: Drawing, *, color: str = "#000000", namespaces: Mapping[str, str] | None = None,
+                   paths: Sequence[SvgPath] | None = None) -> str:
+    """The SVG text of `drawing`: viewBox = its canvas, stroke width = its measured width.
+
+    By default one `<path>` per stroke, in drawing order, each whose ink widths are known
+    carrying them in `data-widths` (`widths_data`). `paths` replaces them (the same canvas
+    and group style), e.g. with a bridge's parameters on each; `namespaces` (prefix -> URI)
+    are declared on the root for their attributes.
+    """
     w, h = _num(drawing.width), _num(drawing.height)
     size = f'width="{w}mm" height="{h}mm"' if drawing.unit == "mm" else f'width="{w}" height="{h}"'
+    declared = "".join(f" xmlns:{prefix}={quoteattr(uri)}" for prefix, uri in (namespaces or {}).items())
     lines = [
         '<?xml version="1.0" encoding="UTF-8"?>',
-        f'<svg xmlns="http://www.w3.org/2000/svg" {size} viewBox="0 0 {w} {h}">',
+        f'<svg xmlns="http://www.w3.org/2000/svg"{declared} {size} viewBox="0 0 {w} {h}">',
         f'<g fill="none" stroke="{color}" stroke-width="{_num(drawing.stroke_width)}" '
         'stroke-linecap="round" stroke-linejoin="round">',
     ]
-    for index, stroke in enumerate(drawing.strokes):
-        # A stroke's own colour overrides the group's; uncoloured strokes inherit it.
-        paint = "" if stroke.color is None else ' stroke="#{:02x}{:02x}{:02x}"'.format(*stroke.color)
-        widths = "" if stroke.widths is None else f' data-widths="{widths_data(stroke)}"'
-        lines.append(f'<path id="stroke-{index + 1}"{paint}{widths} d="{path_data(stroke)}"/>')
+    if paths is None:
+        paths = [SvgPath((stroke,), () if stroke.widths is None else (("data-widths", widths_data(stroke)),),
+                         stroke.color) for stroke in drawing.strokes]
+    for index, path in enumerate(paths):
+        # A path's own colour overrides the group's; uncoloured paths inherit it.
+        paint = "" if path.color is None else ' stroke="#{:02x}{:02x}{:02x}"'.format(*path.color)
+        extra = "".join(f" {name}={quoteattr(str(value))}" for name, value in path.attributes)
+        data = "".join(path_data(sub) for sub in path.subpaths)
+        lines.append(f'<path id="stroke-{index + 1}"{paint}{extra} d="{data}"/>')
     lines += ["</g>", "</svg>", ""]
     return "\n".join(lines)
 

@@ -15,7 +15,10 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.spatial import cKDTree
 
+from fabrication.embroidery.needles import STITCH
+from fabrication.embroidery.quality import DENSITY_LIMIT, DENSITY_RADIUS
 from onestroke.errors import InputError
 from onestroke.ranges import Range, check_ranges, ranged
 from vectorize.graph import arc_lengths
@@ -118,3 +121,33 @@ def tack_points(path: np.ndarray, options: LockOptions = LockOptions(), level: i
         return np.zeros((0, 2))
     length = _clear_length(path, _lock_length(path, options), form)
     return np.vstack([path[:1], walk_back(path[::-1], length * form[:-1])])
+
+
+def crowding_ties(points: np.ndarray, kinds: np.ndarray, ties: np.ndarray,
+                   levels: dict[int, int]) -> set[int]:
+    """The ties (tacks and locks, by number) to make lighter, each one level: `points`
+    (N, 2) mm and `kinds` (N,) of a plan's rows, `ties` (N,) the tie of each row (2 c: the
+    tack of chain c, 2 c + 1: its lock, -1: none), `levels` the ties' levels so far. They are the ties that make a place too dense: needle points
+    within the density radius of a needle point with more than the density limit around it
+    (every needle point counted) that would be within the limit without the ties' points.
+    Where the stitches alone are too dense, the ties stay (the warning names the place)."""
+    needle = kinds == STITCH
+    pts, tie = points[needle], ties[needle]
+    at_tie = tie >= 0
+    if not at_tie.any():
+        return set()
+    reach = DENSITY_RADIUS + 1e-9
+    # Only places near a tie can be helped by a lighter tie: count there, not everywhere.
+    tree = cKDTree(pts, balanced_tree=False, compact_nodes=False)  # 3x quicker to build
+    near = np.zeros(len(pts), dtype=bool)
+    for found in tree.query_ball_point(pts[at_tie], reach):
+        near[found] = True
+    crowding: set[int] = set()
+    for found in tree.query_ball_point(pts[near], reach):
+        ours = tie[found]
+        if len(found) > DENSITY_LIMIT and len(found) - int((ours >= 0).sum()) <= DENSITY_LIMIT:
+            ours = set(ours[ours >= 0].tolist())
+            tacks = {t for t in ours if t % 2 == 0 and levels.get(t, 0) < TIE_LEVELS - 1}
+            # A lock holds the thread against the trim after it: tacks give way first.
+            crowding |= tacks or {t for t in ours if levels.get(t, 0) < TIE_LEVELS - 1}
+    return crowding

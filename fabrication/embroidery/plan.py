@@ -21,11 +21,11 @@ from scipy.spatial import cKDTree
 
 from fabrication.embroidery.arrows import ArrowOptions, arrow_stitch
 from fabrication.embroidery.grid import merge_short, split_long
-from fabrication.embroidery.locks import TIE_LEVELS, LighterTie, LockOptions, lock_points, tack_points
+from fabrication.embroidery.locks import (TIE_LEVELS, LighterTie, LockOptions, crowding_ties, lock_points,
+                                          tack_points)
 from fabrication.embroidery.needles import (COLOR, GRID, JUMP, LOCK, LONGEST_STITCH, STITCH, TACK, TRAVEL,
                                             TRIM, NeedlePoints)
 from fabrication.embroidery.order import Start, check_start, sewing_order
-from fabrication.embroidery.quality import DENSITY_LIMIT, DENSITY_RADIUS
 from fabrication.embroidery.running import STITCH_LENGTH, RunningOptions, running_stitch
 from fabrication.embroidery.thread import RGB, Thread, check_chart
 from fabrication.embroidery.triple import TripleOptions, triple_stitch
@@ -264,12 +264,14 @@ def _dropped_lines(drawing: Drawing, dropped: list[int], block: tuple[int, ...],
     """One line per dropped stroke (numbered as in the input), with the distance from it to
     the nearest needle point of its thread in the plan (`points` (N, 2) mm, `blocks` (N,)
     of the needle rows)."""
-    lines = []
+    lines, trees = [], {}
     for i in dropped:
         stroke = drawing.strokes[i]
-        mine = points[blocks == block[i]]
+        if block[i] not in trees:
+            mine = points[blocks == block[i]]
+            trees[block[i]] = cKDTree(mine) if len(mine) else None
         along = stroke.points_at(np.linspace(0.0, 1.0, 9))
-        near = float(cKDTree(mine).query(along)[0].min()) if len(mine) else np.inf
+        near = float(trees[block[i]].query(along)[0].min()) if trees[block[i]] is not None else np.inf
         x, y = stroke.start
         if near > options.trim_distance:
             why = (f"more than --trim-distance {options.trim_distance:g} mm from every stitch of its "
@@ -398,34 +400,6 @@ def _on_grid(rows, options: PlanOptions):
     return units, kinds, roles, params, owners, blocks, ties
 
 
-def _crowding_ties(points: np.ndarray, kinds: np.ndarray, ties: np.ndarray,
-                   levels: dict[int, int]) -> set[int]:
-    """The ties (tacks and locks, by number) that make a place too dense: needle points
-    within the density radius of a needle point with more than the density limit around it
-    (every needle point counted) that would be within the limit without the ties' points.
-    Where the stitches alone are too dense, the ties stay (the warning names the place)."""
-    needle = kinds == STITCH
-    pts, tie = points[needle], ties[needle]
-    at_tie = tie >= 0
-    if not at_tie.any():
-        return set()
-    reach = DENSITY_RADIUS + 1e-9
-    # Only places near a tie can be helped by a lighter tie: count there, not everywhere.
-    tree = cKDTree(pts)
-    near = np.zeros(len(pts), dtype=bool)
-    for found in tree.query_ball_point(pts[at_tie], reach):
-        near[found] = True
-    crowding: set[int] = set()
-    for found in tree.query_ball_point(pts[near], reach):
-        ours = tie[found]
-        if len(found) > DENSITY_LIMIT and len(found) - int((ours >= 0).sum()) <= DENSITY_LIMIT:
-            ours = set(ours[ours >= 0].tolist())
-            tacks = {t for t in ours if t % 2 == 0 and levels.get(t, 0) < TIE_LEVELS - 1}
-            # A lock holds the thread against the trim after it: tacks give way first.
-            crowding |= tacks or {t for t in ours if levels.get(t, 0) < TIE_LEVELS - 1}
-    return crowding
-
-
 def _centring_shift(units: np.ndarray, kinds: np.ndarray) -> np.ndarray:
     """Whole grid steps (2,) that centre the box of the needle points and jumps on (0, 0)
     (to within half a step)."""
@@ -457,7 +431,7 @@ def plan_embroidery(drawing: Drawing, options: PlanOptions = PlanOptions(), *,
     for _ in range(2 * TIE_LEVELS):
         *rows, anchors = _assemble(chains, bodies, order.block, options, levels, made)
         units, kinds, roles, params, owners, blocks, ties = _on_grid(rows, options)
-        lighter = _crowding_ties(units * options.grid, kinds, ties, levels)
+        lighter = crowding_ties(units * options.grid, kinds, ties, levels)
         if not lighter:
             break
         levels.update({tie: levels.get(tie, 0) + 1 for tie in lighter})

@@ -66,7 +66,7 @@ class EmbroideryStats:
     lighter_tacks: int = 0
     lighter_locks: int = 0
     bobbin_length: float = 0.0
-    bobbin_rule: str = "as long as the top thread under running stitches"
+    bobbin_rule: str = "as long as the top"
     colors: tuple[ColorStats, ...] = ()
 
     @property
@@ -131,8 +131,7 @@ def embroidery_stats(plan: StitchPlan, *, stitches_per_minute: float = 600.0,
     if column:
         share[plan.roles[plan.stitch_mask] == BODY] = COLUMN_BOBBIN_SHARE
     bobbin = float(np.linalg.norm(b - a, axis=1) @ share) if len(a) else 0.0
-    rule = ("a third of the column's stitches, the whole of walks, tacks and locks" if column
-            else "as long as the top thread under running stitches")
+    rule = "1/3 of the top under the column, all under walks" if column else "as long as the top"
     kinds = plan.kinds
     is_jump = kinds == JUMP
     run_start = is_jump & np.concatenate([[True], ~is_jump[:-1]])
