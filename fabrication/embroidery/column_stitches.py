@@ -9,7 +9,8 @@ side (a needle entering a hole it made a moment before) is inset deeper, step by
 to half the row's width. Stitches longer than `max_stitch` are split at staggered points
 (or at a random phase). `random_width` varies each row's reach on either side (seeded).
 
-Underlays (sewn first, each out and back so the top starts where the column does):
+Underlays (sewn first, each out and back so the top starts near where the column does, none
+on a column under 2 mm):
 'center' a walk along the centre line (back between the holes of the way out), 'edge' a
 walk along each rail inset from the edge (Ink/Stitch's contour underlay), 'zigzag' a sparse
 zigzag inset from the edges, out and back in opposite phase.
@@ -28,6 +29,7 @@ from fabrication.embroidery.sampling import DenseCurve
 from vectorize.stroke import Stroke
 
 UNDERLAYS = ("center", "edge", "zigzag")
+SHORT_COLUMN = 2.0  # mm
 # A crowded point is inset deeper, one short-stitch step at a time, up to this share of its
 # row's width.
 MAX_INSET = 0.5
@@ -75,7 +77,9 @@ def column_needles(stroke: Stroke, curve: DenseCurve, columns: list[Column], how
             t = curve.t_at(s)
             parts.append(NeedlePoints.of(stroke.points_at(t), t, UNDERLAY))
             continue
-        for kind in how.underlays:
+        # A column shorter than SHORT_COLUMN (a corner's jog, a short stroke) has no room
+        # for an underlay: its walks would only pile needle points on its start.
+        for kind in how.underlays if hi - lo >= SHORT_COLUMN else ():
             parts.append(_UNDERLAY[kind](column, s, how))
         parts.append(top_stitches(column.rows, how, rng))
     return NeedlePoints.concat(parts)
@@ -195,7 +199,7 @@ def _span(column: Column) -> tuple[float, float]:
 def _centre_underlay(column: Column, s: np.ndarray, how: ColumnStitching) -> NeedlePoints:
     """Centre walk out (needle points at arc lengths `s`), and back between the holes of the
     way out, ending on the start."""
-    back = np.concatenate([0.5 * (s[:-1] + s[1:])[::-1], s[:1]])
+    back = 0.5 * (s[:-1] + s[1:])[::-1]  # ends between the first two holes, not in the first
     everywhere = np.concatenate([s, back])
     points, t = _offsets(column, everywhere, 0.0, np.zeros(len(everywhere)))
     return NeedlePoints.of(points, t, UNDERLAY)
@@ -204,11 +208,9 @@ def _centre_underlay(column: Column, s: np.ndarray, how: ColumnStitching) -> Nee
 def _edge_underlay(column: Column, s: np.ndarray, how: ColumnStitching) -> NeedlePoints:
     """Along the left rail, `edge_inset` inside it, then back along the right one (needle
     points at arc lengths `s`)."""
-    start, t0 = _offsets(column, s[:1], 0.0, np.zeros(1))
     out, t_out = _offsets(column, s, how.edge_inset, np.ones(len(s)))
     back, t_back = _offsets(column, s[::-1], how.edge_inset, -np.ones(len(s)))
-    return NeedlePoints.of(np.concatenate([start, out, back, start]), np.concatenate([t0, t_out, t_back, t0]),
-                           UNDERLAY)
+    return NeedlePoints.of(np.concatenate([out, back]), np.concatenate([t_out, t_back]), UNDERLAY)
 
 
 def _zigzag_underlay(column: Column, s: np.ndarray, how: ColumnStitching) -> NeedlePoints:
@@ -218,11 +220,9 @@ def _zigzag_underlay(column: Column, s: np.ndarray, how: ColumnStitching) -> Nee
     steps = max(2, int(round(2.0 * (hi - lo) / how.underlay_spacing)))
     s = np.linspace(lo, hi, steps + 1)
     side = np.where(np.arange(len(s)) % 2 == 0, 1.0, -1.0)
-    start, t0 = _offsets(column, s[:1], 0.0, np.zeros(1))
     out, t_out = _offsets(column, s, how.zigzag_inset, side)
     back, t_back = _offsets(column, s[::-1], how.zigzag_inset, -side[::-1])
-    return NeedlePoints.of(np.concatenate([start, out, back, start]), np.concatenate([t0, t_out, t_back, t0]),
-                           UNDERLAY)
+    return NeedlePoints.of(np.concatenate([out, back]), np.concatenate([t_out, t_back]), UNDERLAY)
 
 
 _UNDERLAY = {"center": _centre_underlay, "edge": _edge_underlay, "zigzag": _zigzag_underlay}
