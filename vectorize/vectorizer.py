@@ -312,7 +312,8 @@ def _single_route(graph: MedialGraph, simple: Simplified, ranked: dict, costs: d
     routes = plan_routes(graph, {**simple.through, **pairing}, stroke_width=w, directions=dirs, end_cost=end_cost,
                          weight=weight)
     choice = tuple(pairing.get(n, ranked[n][0]) for n in simple.crossings)
-    return Ordering(tuple(r.passes for r in routes), tuple(r.closed for r in routes), choice), tried
+    return Ordering(tuple(r.passes for r in routes), tuple(r.closed for r in routes), choice,
+                    sum(r.odd_nodes for r in routes)), tried
 
 
 def _refuse_noise(count: int, what: str, limit: int, threshold: float, given: bool) -> None:
@@ -513,7 +514,7 @@ def run_pipeline(image: np.ndarray, options: VectorizeOptions, *,
     report = VectorizeReport(
         strokes=len(strokes), intersections=len(simple.crossings), y_junctions=len(simple.y_feet),
         dropped_components=dropped, gaps_bridged=len(bridges), high_degree_junctions=len(simple.unresolved),
-        retries=tried - 1,
+        retries=tried - 1, odd_nodes=ordering.odd_nodes,
         scale=scale, stroke_width=w / scale, threshold=float(ink.threshold), warnings=tuple(warnings),
         seconds=clock.seconds,
         cpu_seconds=clock.cpu_seconds)
