@@ -112,7 +112,8 @@ function draw() {
   }
   g.globalAlpha = 1;
   g.restore();
-  g.globalAlpha = curve;
+  // The curve half faded over a mask, so that the mask's edges read beside it.
+  g.globalAlpha = curve * (studio.mask && maskWanted() ? 0.5 : 1);
   retraces(g);
   const t = studio.line;
   const penAt = studio.pen * t.total;
