@@ -9,7 +9,7 @@ from typing import TYPE_CHECKING, NamedTuple
 import numpy as np
 
 from onestroke.errors import InputError
-from vectorize.binarize import downscaled_gray, ink_image, paper_gray
+from vectorize.binarize import downscaled_gray, ink_image, ink_threshold, paper_gray
 from vectorize.drawing import Drawing
 from vectorize.edits import Edits
 from vectorize.gaps import bridge_gaps, keep_largest_piece
@@ -333,11 +333,9 @@ def _refuse_noise(count: int, what: str, limit: int, threshold: float, given: bo
                          f"drawing; {hint}")
 
 
-def _axis(image: np.ndarray, options: VectorizeOptions, clock: _Clock, cache: StageCache | None = None):
-    """Binarize, outline and medial axis: the stages that threshold and blur change, and the
-    mode does not. Returns (ink, rings, graph before pruning)."""
-    # Every piece of ink is kept here; in single-line mode the pieces of a line broken by
-    # pen gaps are bridged later, and only then is the largest kept.
+def working_paper(image: np.ndarray, options: VectorizeOptions, cache: StageCache | None = None):
+    """(gray, scale) of `binarize.paper_gray` at the options' blur and size: the working image
+    the threshold cuts, from the cache when one is given (and stored there)."""
     def paper():
         if cache is None:
             return paper_gray(image, max_size=options.max_size, blur=options.blur)
@@ -345,7 +343,24 @@ def _axis(image: np.ndarray, options: VectorizeOptions, clock: _Clock, cache: St
         scaled = cache.stage("gray", (options.max_size,), lambda: downscaled_gray(image, max_size=options.max_size))
         return paper_gray(image, max_size=options.max_size, blur=options.blur, downscaled=scaled)
 
-    gray, scale = paper() if cache is None else cache.stage("paper", (options.blur, options.max_size), paper)
+    return paper() if cache is None else cache.stage("paper", (options.blur, options.max_size), paper)
+
+
+def threshold_mask(image: np.ndarray, options: VectorizeOptions, cache: StageCache | None = None):
+    """(mask, level): (H, W) bool of the working pixels darker than the threshold (the options'
+    or Li's level), what the threshold catches before specks, a frame and pinholes are
+    cleaned; the studio shows it while a threshold or blur slider moves."""
+    gray, _ = working_paper(image, options, cache)
+    level = ink_threshold(gray, options.threshold)
+    return gray < level, level
+
+
+def _axis(image: np.ndarray, options: VectorizeOptions, clock: _Clock, cache: StageCache | None = None):
+    """Binarize, outline and medial axis: the stages that threshold and blur change, and the
+    mode does not. Returns (ink, rings, graph before pruning)."""
+    # Every piece of ink is kept here; in single-line mode the pieces of a line broken by
+    # pen gaps are bridged later, and only then is the largest kept.
+    gray, scale = working_paper(image, options, cache)
     ink = ink_image(gray, scale, threshold=options.threshold)
     clock.lap("binarize")
     # The fitting's libraries (scipy.interpolate: FITPACK) load beside the next stages.
