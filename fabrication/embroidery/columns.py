@@ -55,7 +55,9 @@ class Rows:
     """Rows across one column, in sewing order. centre (N, 2) mm; normal (N, 2) unit, to
     the left of the direction of travel; left / right (N,) mm from the centre to each rail
     (pull compensation included); t (N,) the stroke's parameter (rows that run on past a
-    corner keep the corner's); s (N,) arc length mm along the stroke (likewise clamped)."""
+    corner keep the corner's); s (N,) arc length mm along the stroke (likewise clamped);
+    full (N, 2) mm: the left and right reach from the centre before the rows were cut back
+    under a later column (None: not cut), how far a cut end may run on under it."""
 
     centre: np.ndarray
     normal: np.ndarray
@@ -63,6 +65,7 @@ class Rows:
     right: np.ndarray
     t: np.ndarray
     s: np.ndarray
+    full: np.ndarray | None = None
 
     def __len__(self) -> int:
         return len(self.centre)
@@ -75,14 +78,30 @@ class Rows:
     def right_points(self) -> np.ndarray:
         return self.centre - self.normal * self.right[:, None]
 
+    @property
+    def reach(self) -> np.ndarray:
+        """(N, 2) the left and right reach before any cut (`full`, or left and right)."""
+        return self.full if self.full is not None else np.column_stack([self.left, self.right])
+
     def take(self, index) -> "Rows":
         return Rows(self.centre[index], self.normal[index], self.left[index], self.right[index], self.t[index],
-                    self.s[index])
+                    self.s[index], None if self.full is None else self.full[index])
+
+    def recentred(self, index: np.ndarray, mid: np.ndarray, left: np.ndarray, right: np.ndarray) -> "Rows":
+        """These rows with rows `index` cut: their centres moved by `mid` (mm along the
+        normal) and their reach now `left` / `right`; the reach before the cut is kept."""
+        centre, new_left, new_right, full = self.centre.copy(), self.left.copy(), self.right.copy(), self.reach.copy()
+        centre[index] += self.normal[index] * mid[:, None]
+        new_left[index], new_right[index] = left, right
+        full[index, 0] -= mid
+        full[index, 1] += mid
+        return Rows(centre, self.normal, new_left, new_right, self.t, self.s, full)
 
     @staticmethod
     def concat(parts: "list[Rows]") -> "Rows":
         fields = ("centre", "normal", "left", "right", "t", "s")
-        return Rows(*(np.concatenate([getattr(p, f) for p in parts]) for f in fields))
+        full = None if all(p.full is None for p in parts) else np.concatenate([p.reach for p in parts])
+        return Rows(*(np.concatenate([getattr(p, f) for p in parts]) for f in fields), full)
 
 
 @dataclass(frozen=True, eq=False)
@@ -263,7 +282,7 @@ def cut_rows(rows: Rows, cover, overlap: float) -> Rows:
     if not len(hit):
         return rows
     keep = np.ones(len(rows), dtype=bool)
-    centre, left, right = rows.centre.copy(), rows.left.copy(), rows.right.copy()
+    cut, mids, lefts, rights = [], [], [], []
     for i, free in zip(hit.tolist(), shapely.difference(lines[hit], cover)):
         parts = [g for g in getattr(free, "geoms", [free]) if not g.is_empty]
         piece = max(parts, key=lambda g: g.length) if parts else None
@@ -280,10 +299,13 @@ def cut_rows(rows: Rows, cover, overlap: float) -> Rows:
         if hi < rows.left[i] - 1e-6:
             hi = min(rows.left[i], hi + overlap)
         mid = 0.5 * (lo + hi)
-        centre[i] = rows.centre[i] + n * mid
-        left[i], right[i] = hi - mid, mid - lo
-    cut = Rows(centre, rows.normal, left, right, rows.t, rows.s)
-    return cut.take(np.flatnonzero(keep))
+        cut.append(i)
+        mids.append(mid)
+        lefts.append(hi - mid)
+        rights.append(mid - lo)
+    if cut:
+        rows = rows.recentred(np.array(cut), np.array(mids), np.array(lefts), np.array(rights))
+    return rows.take(np.flatnonzero(keep))
 
 
 def _joined(corners: list[Corner], half_at) -> tuple[list[Corner], list[tuple[float, float]]]:
@@ -423,16 +445,20 @@ def _cut_at_line(rows: Rows, corner: Corner, *, after: bool, margin: float, with
     near = np.abs(rows.s - corner.s) <= within
     fl, fr = np.where(near, fl, 1.0), np.where(near, fr, 1.0)
     keep = (fl > 1e-9) | (fr > 1e-9)
-    centre, left, right = rows.centre.copy(), rows.left.copy(), rows.right.copy()
-    for i in np.flatnonzero(keep & ((fl < 0) | (fr < 0))).tolist():
+    cut = np.flatnonzero(keep & ((fl < 0) | (fr < 0)))
+    mids, lefts, rights = [], [], []
+    for i in cut.tolist():
         # the row from its right point (offset -right) to its left (+left), cut where f = 0
-        a, b_ = -right[i], left[i]
+        a, b_ = -rows.right[i], rows.left[i]
         x = a + (b_ - a) * (0.0 - fr[i]) / (fl[i] - fr[i])
         lo, hi = (x, b_) if fr[i] < 0 else (a, x)
         mid = 0.5 * (lo + hi)
-        centre[i] = rows.centre[i] + rows.normal[i] * mid
-        left[i], right[i] = hi - mid, mid - lo
-    return Rows(centre, rows.normal, left, right, rows.t, rows.s).take(np.flatnonzero(keep))
+        mids.append(mid)
+        lefts.append(hi - mid)
+        rights.append(mid - lo)
+    if len(cut):
+        rows = rows.recentred(cut, np.array(mids), np.array(lefts), np.array(rights))
+    return rows.take(np.flatnonzero(keep))
 
 
 def _near(rows: Rows, corner: Corner, other: Rows) -> Rows:

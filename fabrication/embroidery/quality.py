@@ -152,8 +152,10 @@ def hole_places(plan, rows: np.ndarray) -> tuple[Place, ...]:
     return _places(points, counts, 2 * DENSITY_RADIUS)
 
 
-def where(places: tuple[Place, ...], most: int = 3) -> str:
-    """'at (x, y) mm (8), (x, y) mm (7) and 2 more places' for a warning."""
+def where(places: tuple[Place, ...], most: int = 12) -> str:
+    """Where a warning's problem lies: every place, 'at (x, y) mm (8), (x, y) mm (7)'; past
+    `most` places, how many and the first `most` of them: 'at 15 places, the first 12: ...'."""
     shown = ", ".join(f"{p} ({p.count})" for p in places[:most])
-    more = len(places) - most
-    return f"at {shown}" + (f" and {more} more place{'s' if more > 1 else ''}" if more > 0 else "")
+    if len(places) <= most:
+        return f"at {shown}"
+    return f"at {len(places)} places, the first {most}: {shown}"
