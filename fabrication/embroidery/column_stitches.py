@@ -25,6 +25,7 @@ import numpy as np
 from fabrication.embroidery.columns import Column, Rows
 from fabrication.embroidery.crowding import relieve_crowding
 from fabrication.embroidery.needles import BODY, SNAP_ALLOWANCE, UNDERLAY, NeedlePoints
+from fabrication.embroidery.quality import stroke_sides
 from fabrication.embroidery.running import RunningOptions, running_stitch
 from fabrication.embroidery.sampling import DenseCurve
 from vectorize.stroke import Stroke
@@ -73,7 +74,7 @@ def column_needles(stroke: Stroke, curve: DenseCurve, columns: list[Column], how
     walk = running_stitch(stroke, RunningOptions(stitch_length=how.underlay_stitch_length, tolerance=how.tolerance),
                           curve=curve, breaks=np.array(spans).ravel())
     walk_s = np.interp(walk.t, curve.t, curve.s)
-    parts, inward, sides = [], [], []
+    parts, inward = [], []
     for column, (lo, hi) in zip(columns, spans):
         inside = walk_s[(walk_s >= lo - 1e-9) & (walk_s <= hi + 1e-9)]
         s = inside if len(inside) >= 2 else np.array([lo, hi])
@@ -81,7 +82,6 @@ def column_needles(stroke: Stroke, curve: DenseCurve, columns: list[Column], how
             t = curve.t_at(s)
             parts.append(NeedlePoints.of(stroke.points_at(t), t, UNDERLAY))
             inward.append(np.zeros((len(s), 2)))
-            sides.append(np.zeros(len(s)))
             continue
         # A column shorter than SHORT_COLUMN (a corner's jog, a short stroke) has no room
         # for an underlay: its walks would only pile needle points on its start.
@@ -89,15 +89,14 @@ def column_needles(stroke: Stroke, curve: DenseCurve, columns: list[Column], how
             under = _UNDERLAY[kind](column, s, how)
             parts.append(under)
             inward.append(np.zeros((len(under), 2)))
-            sides.append(np.zeros(len(under)))
-        top, room, side = top_points(column.rows, how, rng)
+        top, room = top_points(column.rows, how, rng)
         parts.append(top)
         inward.append(room)
-        sides.append(side)
     merged = NeedlePoints.concat(parts)
     if not len(merged):
         return merged
-    points, keep = relieve_crowding(merged.points, merged.roles, np.concatenate(inward), np.concatenate(sides),
+    points, keep = relieve_crowding(merged.points, merged.roles, np.concatenate(inward),
+                                    lambda rows, at: stroke_sides(stroke, at, merged.t[rows]),
                                     max_gap=2.0 * how.underlay_stitch_length)
     merged = NeedlePoints(points, merged.t, merged.roles).take(keep)
     return _split_top(merged, how.max_stitch - 2 * SNAP_ALLOWANCE, rng if how.random_phase else None)
@@ -118,10 +117,10 @@ def _split_top(needles: NeedlePoints, max_length: float, rng: np.random.Generato
 
 
 def top_points(rows: Rows, how: ColumnStitching,
-               rng: np.random.Generator | None = None) -> tuple[NeedlePoints, np.ndarray, np.ndarray]:
+               rng: np.random.Generator | None = None) -> tuple[NeedlePoints, np.ndarray]:
     """Rail to rail across `rows`, alternating sides, with short stitches (module doc), not
-    yet split; with how far (N, 2) mm each point may still be inset (to MAX_INSET of its
-    row's width) and its side (N,) (+1 left, -1 right)."""
+    yet split; and how far (N, 2) mm each point may still move: inset towards its row's
+    centre (to MAX_INSET of its width), or on a cut end, on under the column over it."""
     n = len(rows)
     side = np.where(np.arange(n) % 2 == 0, 1.0, -1.0)
     width = rows.left + rows.right
@@ -156,7 +155,7 @@ def top_points(rows: Rows, how: ColumnStitching,
     full = np.where(side > 0, rows.reach[:, 0], rows.reach[:, 1])
     cut = full > reach + 1e-6
     room = np.where(cut, side * np.minimum(full - side * now, RUN_UNDER), room)
-    return NeedlePoints.of(points, rows.t, BODY), rows.normal * room[:, None], side
+    return NeedlePoints.of(points, rows.t, BODY), rows.normal * room[:, None]
 
 
 def _keep_holes_apart(points, rows: Rows, side, offset, step, width, min_gap) -> np.ndarray:

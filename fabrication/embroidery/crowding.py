@@ -20,7 +20,7 @@ from __future__ import annotations
 import numpy as np
 from scipy.spatial import cKDTree
 
-from fabrication.embroidery.needles import SNAP_ALLOWANCE, UNDERLAY
+from fabrication.embroidery.needles import BODY, SNAP_ALLOWANCE, UNDERLAY
 from fabrication.embroidery.quality import DENSITY_LIMIT, DENSITY_RADIUS, HOLE_GAP, HOLE_WINDOW, density_counts
 
 # Points are counted with this margin over the radius: snapping to the files' grid may
@@ -29,11 +29,13 @@ from fabrication.embroidery.quality import DENSITY_LIMIT, DENSITY_RADIUS, HOLE_G
 MARGIN = SNAP_ALLOWANCE
 # Inset steps tried, as shares of a point's room towards its row's centre.
 STEPS = (0.25, 0.5, 0.75, 1.0)
-# An inset needle keeps this far (mm) from the holes around it on its side of the line.
+# An inset needle keeps this far (mm) from the holes around it on its side of the line;
+# one closer than REENTER to a recent hole re-enters it (once snapped to the grid).
 CLEAR = HOLE_GAP + 2.0 * SNAP_ALLOWANCE
+REENTER = HOLE_GAP + SNAP_ALLOWANCE
 
 
-def relieve_crowding(points: np.ndarray, roles: np.ndarray, inward: np.ndarray, side: np.ndarray, *,
+def relieve_crowding(points: np.ndarray, roles: np.ndarray, inward: np.ndarray, sides, *,
                      max_gap: float, limit: int = DENSITY_LIMIT,
                      radius: float = DENSITY_RADIUS) -> tuple[np.ndarray, np.ndarray]:
     """(points (N, 2) mm, keep (N,) bool) with the crowding relieved (module doc).
@@ -41,16 +43,28 @@ def relieve_crowding(points: np.ndarray, roles: np.ndarray, inward: np.ndarray, 
     points (N, 2) mm in sewing order; roles (N,) (UNDERLAY points may be left out: not the
     first or last point, and only while the stitch that replaces their two stays within
     `max_gap` mm); inward (N, 2) mm: how far each point may move towards its
-    row's centre (zeros: it stays); side (N,): +1 / -1 the side of the line it is on (0:
-    on the line), for the clearance from its last and next holes on that side.
+    row's centre (zeros: it stays); sides: (rows (M,), points (M, 2)) -> (M,) the side of
+    the line each is on (+1 / -1, 0 on the line: `quality.stroke_sides`), for the clearance
+    from its last and next holes on that side.
+
+    Last, a needle that re-enters one of the last HOLE_WINDOW holes on its side (the
+    repeated holes of `quality`) is inset where that clears it, or left out.
     """
-    points = np.asarray(points, dtype=float)
+    points = np.asarray(points, dtype=float).copy()
     keep = np.ones(len(points), dtype=bool)
-    reach = radius + MARGIN
-    counts = density_counts(points, radius=reach)
-    if not len(points) or counts.max() <= limit:
+    if not len(points):
         return points, keep
-    points = points.copy()
+    side = np.asarray(sides(np.arange(len(points)), points))
+    _relieve_density(points, keep, roles, inward, side, sides, max_gap, limit, radius + MARGIN)
+    _clear_holes(points, keep, roles, inward, side, sides, max_gap)
+    return points, keep
+
+
+def _relieve_density(points, keep, roles, inward, side, sides, max_gap, limit, reach) -> None:
+    """In place: steps 1 and 2 of the module doc."""
+    counts = density_counts(points, radius=reach)
+    if counts.max() <= limit:
+        return
     tree = cKDTree(points)
     dense = np.flatnonzero(counts > limit)
     # The points that may change: within one radius of a dense point; their neighbours
@@ -102,7 +116,8 @@ def relieve_crowding(points: np.ndarray, roles: np.ndarray, inward: np.ndarray, 
         before = int(np.sum(np.maximum(count[alive] - limit, 0)))
         for share in STEPS:
             q = points[g] + inward[g] * share
-            if not _clear(points, keep, side, g, q):
+            q_side = int(sides(np.array([g]), q[None, :])[0])
+            if not _clear(points, keep, side, g, q, q_side):
                 continue
             new_near = _within(q[None, :], pts, reach)[0] & alive
             new_near[choice] = True
@@ -111,12 +126,43 @@ def relieve_crowding(points: np.ndarray, roles: np.ndarray, inward: np.ndarray, 
             excess = int(np.sum(np.maximum(new_count[alive] - limit, 0)))
             if excess < before and not np.any(alive & (new_count > limit) & ~o):
                 points[g] = q
+                side[g] = q_side
                 pts[choice] = q
                 count = new_count
                 near[choice, :] = new_near
                 near[:, choice] = new_near
                 break
-    return points, keep
+
+
+def _clear_holes(points, keep, roles, inward, side, sides, max_gap) -> None:
+    """In place: needles within HOLE_GAP (and a snap) of one of the last HOLE_WINDOW kept
+    ones on their side are inset clear of them, or left out (module doc)."""
+    n = len(points)
+    for row in _reentering(points, keep, side).tolist():
+        if not keep[row] or roles[row] not in (BODY, UNDERLAY) or row in (0, n - 1) or \
+                _clear(points, keep, side, row, points[row], int(side[row]), ahead=False, gap=REENTER):
+            continue
+        for share in STEPS if np.linalg.norm(inward[row]) > 1e-9 else ():
+            q = points[row] + inward[row] * share
+            q_side = int(sides(np.array([row]), q[None, :])[0])
+            if _clear(points, keep, side, row, q, q_side):
+                points[row], side[row] = q, q_side
+                break
+        else:
+            if roles[row] == BODY or _gap_ok(points, keep, row, roles, max_gap):
+                keep[row] = False
+
+
+def _reentering(points: np.ndarray, keep: np.ndarray, side: np.ndarray) -> np.ndarray:
+    """Rows whose needle comes within REENTER mm of one of the HOLE_WINDOW kept needle
+    points before it on its side; ascending."""
+    rows = np.flatnonzero(keep)
+    p, sd = points[rows], side[rows]
+    hit = np.zeros(len(rows), dtype=bool)
+    for lag in range(1, HOLE_WINDOW + 1):
+        close = np.linalg.norm(p[lag:] - p[:-lag], axis=1) < REENTER
+        hit[lag:] |= close & (sd[lag:] == sd[:-lag])
+    return rows[hit]
 
 
 def _within(a: np.ndarray, b: np.ndarray, reach: float) -> np.ndarray:
@@ -144,22 +190,23 @@ def _gap_ok(points: np.ndarray, keep: np.ndarray, row: int, roles: np.ndarray, m
     return float(np.hypot(*(points[hi] - points[lo]))) <= max_gap
 
 
-def _clear(points: np.ndarray, keep: np.ndarray, side: np.ndarray, row: int, q: np.ndarray) -> bool:
-    """Whether a needle at `q` for `row` keeps CLEAR of the last and next HOLE_WINDOW kept
-    needle points on its side of the line."""
+def _clear(points: np.ndarray, keep: np.ndarray, side: np.ndarray, row: int, q: np.ndarray, q_side: int, *,
+           ahead: bool = True, gap: float = 0.0) -> bool:
+    """Whether a needle at `q` (on side `q_side`) for `row` keeps `gap` (CLEAR when 0) mm
+    from the last and (`ahead`) next HOLE_WINDOW kept needle points on its side of the line."""
     others = []
     k = row - 1
     while k >= 0 and len(others) < HOLE_WINDOW:
         if keep[k]:
             others.append(k)
         k -= 1
-    k, ahead = row + 1, 0
-    while k < len(points) and ahead < HOLE_WINDOW:
+    k, later = row + 1, 0
+    while ahead and k < len(points) and later < HOLE_WINDOW:
         if keep[k]:
             others.append(k)
-            ahead += 1
+            later += 1
         k += 1
-    others = [k for k in others if side[k] == side[row] or side[row] == 0 or side[k] == 0]
+    others = [k for k in others if side[k] == q_side]
     if not others:
         return True
-    return bool(np.min(np.linalg.norm(points[others] - q, axis=1)) >= CLEAR)
+    return bool(np.min(np.linalg.norm(points[others] - q, axis=1)) >= (gap or CLEAR))

@@ -114,14 +114,20 @@ def needle_sides(plan, *, centre: float = 0.15) -> np.ndarray:
         return sides
     for k in np.unique(plan.strokes[plan.strokes >= 0]):
         rows = np.flatnonzero(plan.strokes == k)
-        t = np.clip(plan.params[rows] - k, 0.0, 1.0)
-        stroke = plan.sewn.strokes[int(k)]
-        offset = plan.points[rows] - stroke.points_at(t)
-        tangent = stroke.tangents_at(t)
-        cross = tangent[:, 0] * offset[:, 1] - tangent[:, 1] * offset[:, 0]
-        far = np.linalg.norm(offset, axis=1) > centre
-        sides[rows] = np.where(far, np.sign(cross), 0).astype(int)
+        sides[rows] = stroke_sides(plan.sewn.strokes[int(k)], plan.points[rows], plan.params[rows] - k,
+                                   centre=centre)
     return sides
+
+
+def stroke_sides(stroke, points: np.ndarray, t: np.ndarray, *, centre: float = 0.15) -> np.ndarray:
+    """(N,) int side of `stroke` of needle points `points` (N, 2) mm made at its parameters
+    `t` (N,): +1 left, -1 right, 0 within `centre` mm of the curve."""
+    t = np.clip(t, 0.0, 1.0)
+    offset = points - stroke.points_at(t)
+    tangent = stroke.tangents_at(t)
+    cross = tangent[:, 0] * offset[:, 1] - tangent[:, 1] * offset[:, 0]
+    far = np.linalg.norm(offset, axis=1) > centre
+    return np.where(far, np.sign(cross), 0).astype(int)
 
 
 def repeated_holes(plan, *, gap: float = HOLE_GAP, window: int = HOLE_WINDOW) -> np.ndarray:
