@@ -23,9 +23,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from fabrication.embroidery.columns import Column, Rows
-from fabrication.embroidery.crowding import relieve_crowding
+from fabrication.embroidery.crowding import relieve_crowding, straight_density
 from fabrication.embroidery.needles import BODY, SNAP_ALLOWANCE, UNDERLAY, NeedlePoints
-from fabrication.embroidery.quality import stroke_sides
+from fabrication.embroidery.quality import DENSITY_LIMIT, stroke_sides
 from fabrication.embroidery.running import RunningOptions, running_stitch
 from fabrication.embroidery.sampling import DenseCurve
 from vectorize.stroke import Stroke
@@ -95,14 +95,17 @@ def column_needles(stroke: Stroke, curve: DenseCurve, columns: list[Column], how
     merged = NeedlePoints.concat(parts)
     if not len(merged):
         return merged
-    points, keep = relieve_crowding(merged.points, merged.roles, np.concatenate(inward),
-                                    lambda rows, at: stroke_sides(stroke, at, merged.t[rows]),
-                                    max_gap=2.0 * how.underlay_stitch_length)
-    merged = NeedlePoints(points, merged.t, merged.roles).take(keep)
-    return _split_top(merged, how.max_stitch - 2 * SNAP_ALLOWANCE, rng if how.random_phase else None)
+    widths = np.concatenate([c.rows.left + c.rows.right for c in columns if len(c.rows)] or [np.zeros(1)])
+    # Where the spacing asked is itself too dense, it is warned about, not hidden.
+    if straight_density(how.spacing, float(np.median(widths))) <= DENSITY_LIMIT:
+        points, keep = relieve_crowding(merged.points, merged.roles, np.concatenate(inward),
+                                        lambda rows, at: stroke_sides(stroke, at, merged.t[rows]),
+                                        max_gap=2.0 * how.underlay_stitch_length)
+        merged = NeedlePoints(points, merged.t, merged.roles).take(keep)
+    return split_body(merged, how.max_stitch - 2 * SNAP_ALLOWANCE, rng if how.random_phase else None)
 
 
-def _split_top(needles: NeedlePoints, max_length: float, rng: np.random.Generator | None) -> NeedlePoints:
+def split_body(needles: NeedlePoints, max_length: float, rng: np.random.Generator | None = None) -> NeedlePoints:
     """`needles` with each run of top stitches split where longer than `max_length` mm."""
     body = np.concatenate([[False], needles.roles == BODY, [False]])
     edges = np.flatnonzero(np.diff(body.astype(int)))

@@ -60,6 +60,17 @@ def relieve_crowding(points: np.ndarray, roles: np.ndarray, inward: np.ndarray, 
     return points, keep
 
 
+def straight_density(spacing: float, width: float, radius: float = DENSITY_RADIUS) -> int:
+    """Needle points within `radius` mm of a rail point of a straight column `width` mm
+    wide sewn at `spacing` mm peak to peak (the same rail every `spacing`, the other rail
+    half a spacing along): what the asked spacing itself makes, before any bend. Where it
+    passes the limit, the spacing asked is too dense and is warned about, not relieved."""
+    k = np.arange(-int(radius / max(spacing, 1e-9)) - 1, int(radius / max(spacing, 1e-9)) + 2)
+    same = np.abs(k * spacing) <= radius + 1e-9
+    other = np.hypot((k + 0.5) * spacing, width) <= radius + 1e-9
+    return int(same.sum() + other.sum())
+
+
 def _relieve_density(points, keep, roles, inward, side, sides, max_gap, limit, reach) -> None:
     """In place: steps 1 and 2 of the module doc."""
     counts = density_counts(points, radius=reach)
