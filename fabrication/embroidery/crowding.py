@@ -21,7 +21,7 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from fabrication.embroidery.needles import BODY, SNAP_ALLOWANCE, UNDERLAY
-from fabrication.embroidery.quality import DENSITY_LIMIT, DENSITY_RADIUS, HOLE_GAP, HOLE_WINDOW, density_counts
+from fabrication.embroidery.quality import DENSITY_LIMIT, DENSITY_RADIUS, HOLE_GAP, HOLE_WINDOW
 
 # Points are counted with this margin over the radius: snapping to the files' grid may
 # bring two points closer by up to twice SNAP_ALLOWANCE; half of that is kept in reserve
@@ -54,10 +54,30 @@ def relieve_crowding(points: np.ndarray, roles: np.ndarray, inward: np.ndarray, 
     keep = np.ones(len(points), dtype=bool)
     if not len(points):
         return points, keep
-    side = np.asarray(sides(np.arange(len(points)), points))
+    side = _Sides(points, sides)
     _relieve_density(points, keep, roles, inward, side, sides, max_gap, limit, radius + MARGIN)
     _clear_holes(points, keep, roles, inward, side, sides, max_gap)
     return points, keep
+
+
+class _Sides:
+    """The side of the line of each point, found when first asked (most never are)."""
+
+    UNKNOWN = 9
+
+    def __init__(self, points: np.ndarray, sides) -> None:
+        self.points, self.sides = points, sides
+        self.known = np.full(len(points), self.UNKNOWN, dtype=int)
+
+    def __getitem__(self, rows):
+        wanted = np.atleast_1d(rows)
+        ask = np.unique(wanted[self.known[wanted] == self.UNKNOWN])
+        if len(ask):
+            self.known[ask] = np.asarray(self.sides(ask, self.points[ask]), dtype=int)
+        return self.known[rows]
+
+    def __setitem__(self, row: int, value: int) -> None:
+        self.known[row] = value
 
 
 def straight_density(spacing: float, width: float, radius: float = DENSITY_RADIUS) -> int:
@@ -73,11 +93,13 @@ def straight_density(spacing: float, width: float, radius: float = DENSITY_RADIU
 
 def _relieve_density(points, keep, roles, inward, side, sides, max_gap, limit, reach) -> None:
     """In place: steps 1 and 2 of the module doc."""
-    counts = density_counts(points, radius=reach)
-    if counts.max() <= limit:
+    # The limit + 1 nearest tell whether a point is dense (as `quality.needle_density`).
+    tree = cKDTree(points, balanced_tree=False, compact_nodes=False)
+    k = min(limit + 1, len(points))
+    distance, _ = tree.query(points, k=k, distance_upper_bound=reach + 1e-9)
+    dense = np.flatnonzero(np.isfinite(distance.reshape(len(points), -1)).sum(axis=1) > limit)
+    if not len(dense):
         return
-    tree = cKDTree(points)
-    dense = np.flatnonzero(counts > limit)
     # The points that may change: within one radius of a dense point; their neighbours
     # (within another radius) are counted with them.
     movable = np.unique(np.concatenate(tree.query_ball_point(points[dense], reach)))
@@ -168,12 +190,14 @@ def _reentering(points: np.ndarray, keep: np.ndarray, side: np.ndarray) -> np.nd
     """Rows whose needle comes within REENTER mm of one of the HOLE_WINDOW kept needle
     points before it on its side; ascending."""
     rows = np.flatnonzero(keep)
-    p, sd = points[rows], side[rows]
-    hit = np.zeros(len(rows), dtype=bool)
+    p = points[rows]
+    found = []
     for lag in range(1, HOLE_WINDOW + 1):
-        close = np.linalg.norm(p[lag:] - p[:-lag], axis=1) < REENTER
-        hit[lag:] |= close & (sd[lag:] == sd[:-lag])
-    return rows[hit]
+        close = np.flatnonzero(np.linalg.norm(p[lag:] - p[:-lag], axis=1) < REENTER)
+        if len(close):
+            later, earlier = rows[close + lag], rows[close]
+            found.append(later[side[later] == side[earlier]])
+    return np.unique(np.concatenate(found)) if found else np.zeros(0, dtype=np.int64)
 
 
 def _within(a: np.ndarray, b: np.ndarray, reach: float) -> np.ndarray:
