@@ -61,6 +61,18 @@ def describe_os_error(error: OSError) -> str:
     return f"{reason}: {name!s}" if name is not None else reason
 
 
+def _caused_by_ctrl_c(error: BaseException) -> bool:
+    """True if a KeyboardInterrupt is in `error`'s chain of causes (a Ctrl-C landing while
+    numpy defines a class comes out as "RuntimeError: Error calling __set_name__")."""
+    seen = set()
+    while error is not None and id(error) not in seen:
+        if isinstance(error, KeyboardInterrupt):
+            return True
+        seen.add(id(error))
+        error = error.__cause__ or error.__context__
+    return False
+
+
 class OnestrokeGroup(click.Group):
     """A click group that turns every error into a one-line message and an exit code."""
 
@@ -88,6 +100,9 @@ class OnestrokeGroup(click.Group):
         except RecursionError:
             self._fail("the input is nested too deeply to read", 2)
         except Exception as error:  # noqa: BLE001 - a bug still gets one line, and a way to report it
+            if _caused_by_ctrl_c(error):  # Python wraps an interrupt in a class body (an import) in RuntimeError
+                click.echo("interrupted", err=True)
+                sys.exit(130)
             self._fail(f"internal error ({type(error).__name__}: {error}); please report this with the "
                        "command line and input", 1)
 
