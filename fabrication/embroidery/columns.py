@@ -10,8 +10,10 @@ never sparser than asked; the inside crowds and gets short stitches).
 Corners (Ink/Stitch's stroke-to-satin joins them with the path's line join, mitred up to a
 mitre limit): a corner whose mitre stays within `mitre_limit` half widths of the corner point
 is mitred, the column before it running on to the mitre line and the one after starting
-there; a sharper one is split: the column before runs on by its half width (covering the
-corner's round outside) and the column after starts at the corner, whole. In both, the rows
+there; a sharper one is split: the column before ends at the corner and the column after
+starts with a round cap that runs in by its half width ahead of the corner, covering the
+corner's round outside (a round pen's tip) on top, so no remnant of the column before
+shows beyond the tip. In both, the rows
 of the column before that lie under the column after are cut back to `overlap` inside its
 edge: each place is covered once, with no gap between the two (no slit) and no second
 layer (no pile-up). A column cut away entirely (a spike drawn out and back) is sewn by the
@@ -189,7 +191,7 @@ def column_rows(stroke: Stroke, curve: DenseCurve, half_at, lo: float, hi: float
                 before: float = 0.0, after: float = 0.0, cap: bool = False) -> Rows:
     """Rows of the column covering arc lengths [lo, hi] mm of `stroke`, running on straight
     `before` mm ahead of lo and `after` mm past hi (along the end directions; `cap`: the
-    rows past hi narrow to a round cap).
+    rows ahead of lo narrow to a round cap).
 
     half_at: arc lengths (n,) -> half widths (n,) mm. Rows are spaced so that the longer
     rail has one every `spacing` / 2 (module doc), an odd number of gaps when there is room
@@ -218,9 +220,9 @@ def column_rows(stroke: Stroke, curve: DenseCurve, half_at, lo: float, hi: float
                 left=np.interp(at, fine, left), right=np.interp(at, fine, right), t=curve.t_at(at), s=at)
     parts = [rows]
     if before > 1e-9:
-        parts.insert(0, _run_on(rows.take([0]), -direction[0], before, step, ahead=False))
+        parts.insert(0, _run_on(rows.take([0]), -direction[0], before, step, ahead=False, round_cap=cap))
     if after > 1e-9:
-        parts.append(_run_on(rows.take([-1]), direction[-1], after, step, ahead=True, round_cap=cap))
+        parts.append(_run_on(rows.take([-1]), direction[-1], after, step, ahead=True))
     return Rows.concat(parts) if len(parts) > 1 else rows
 
 
@@ -346,9 +348,9 @@ def stroke_columns(stroke: Stroke, curve: DenseCurve, half_at, spacing: float, *
             runs[k + 1][0] = reach * h
             mitres[k] = corner
         else:
-            runs[k][1] = h  # a round cap over the corner's outside
+            runs[k + 1][0] = h  # a round cap over the corner's outside, sewn on top
     rows = [column_rows(stroke, curve, half_at, starts[k], cuts[k + 1], spacing, before=runs[k][0],
-                        after=runs[k][1], cap=k < len(corners) and k not in mitres)
+                        after=runs[k][1], cap=k > 0 and k - 1 not in mitres)
             for k in range(len(cuts) - 1)]
     # Each side of a mitre stops at the mitre line (the one before runs on under the one
     # after by `overlap`); then the column before every corner is cut back under the one
