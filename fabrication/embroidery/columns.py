@@ -373,7 +373,7 @@ def stroke_columns(stroke: Stroke, curve: DenseCurve, half_at, spacing: float, *
             later = [r for r in later if len(r) > 1]
             if later:
                 rows[i] = cut_rows(rows[i], shapely.union_all([_cover_area(r) for r in later]), overlap)
-    _thin_crowded(rows)
+    _thin_crowded(rows, spacing)
     columns = []
     for k, r in enumerate(rows):
         if starts[k] > cuts[k]:  # the jog before this column: walked along its centre
@@ -382,11 +382,13 @@ def stroke_columns(stroke: Stroke, curve: DenseCurve, half_at, spacing: float, *
     return columns
 
 
-def _thin_crowded(rows: list[Rows]) -> None:
+def _thin_crowded(rows: list[Rows], spacing: float) -> None:
     """In place: rows whose rail points crowd (more than CROWDED needle points of other rows
     within DENSITY_RADIUS mm: the inside of a tight bend, the ground where corners meet) are
-    left out, in sewing order, while they still crowd. Whole rows go, so the sides still
-    alternate; only the rows whose points crowd at first are visited."""
+    left out, in sewing order, while they still crowd, and only where the rows kept either
+    side of one lie within `spacing` mm of each other on both rails (the outside of the
+    bend stays covered: no slit there). Whole rows go, so the sides still alternate; only
+    the rows whose points crowd at first are visited."""
     sizes = [len(r) for r in rows]
     if sum(sizes) < 2:
         return
@@ -401,6 +403,7 @@ def _thin_crowded(rows: list[Rows]) -> None:
     if count.max(initial=0) <= 2 * CROWDED:
         return
     alive = np.ones(row_of.max() + 1, dtype=bool)
+    column_of = np.repeat(np.arange(len(sizes)), sizes)
     suspects = np.unique(row_of[count > 2 * CROWDED]).tolist()
     for row in suspects:
         mine = np.flatnonzero(row_of == row)
@@ -411,7 +414,7 @@ def _thin_crowded(rows: list[Rows]) -> None:
             if int(np.count_nonzero(alive[others] & (others != row))) > 2 * CROWDED:
                 crowded = True
                 break
-        if crowded:
+        if crowded and _gap_closed(ends, row_of, column_of, alive, row, spacing):
             alive[row] = False
     base = 0
     for j, n in enumerate(sizes):
@@ -420,6 +423,21 @@ def _thin_crowded(rows: list[Rows]) -> None:
             if len(keep) < n:
                 rows[j] = rows[j].take(keep)
             base += n
+
+
+def _gap_closed(ends: np.ndarray, row_of: np.ndarray, column_of: np.ndarray, alive: np.ndarray, row: int,
+                spacing: float) -> bool:
+    """Whether the rows kept before and after `row` in its column lie within `spacing` mm of
+    each other on both rails (`ends`: every row's left then right rail point, by `row_of`)."""
+    before, after = row - 1, row + 1
+    while before >= 0 and column_of[before] == column_of[row] and not alive[before]:
+        before -= 1
+    while after < len(alive) and column_of[after] == column_of[row] and not alive[after]:
+        after += 1
+    if before < 0 or after >= len(alive) or column_of[before] != column_of[row] or column_of[after] != column_of[row]:
+        return False  # a column's first and last rows stay
+    a, b = ends[row_of == before], ends[row_of == after]
+    return bool(np.max(np.linalg.norm(a - b, axis=1)) <= spacing + 1e-9)
 
 
 def _within(rows: Rows, point: np.ndarray, reach: float) -> Rows:

@@ -25,7 +25,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from fabrication.embroidery.column_stitches import split_body
+from fabrication.embroidery.column_stitches import ColumnStitching, column_needles, split_body
+from fabrication.embroidery.columns import CORNER_ANGLE, MITRE_LIMIT, OVERLAP, find_corners, stroke_columns
 from fabrication.embroidery.crowding import relieve_crowding, straight_density
 from fabrication.embroidery.needles import BODY, GRID, SNAP_ALLOWANCE, UNDERLAY, NeedlePoints
 from fabrication.embroidery.running import (DENSE_TOLERANCE, STITCH_LENGTH, TOLERANCE, RunningOptions,
@@ -65,7 +66,9 @@ class ZigzagOptions:
     short_stitch_distance / short_stitch_inset: inset every other inner point by this
     fraction of the reach where inner points come closer than that distance; min_gap: the
     closest two needle points may come on one rail (0.35 mm keeps them >= 0.2 mm apart
-    after snapping to the files' 0.1 mm grid); max_stitch: longer zigs are split."""
+    after snapping to the files' 0.1 mm grid); max_stitch: longer zigs are split;
+    corner_angle (degrees), mitre_limit (half widths), overlap (mm): corners, as satin's
+    (`fabrication.embroidery.columns`)."""
 
     width: float = ranged(2.0, STITCH_WIDTH)
     spacing: float = ranged(0.4, SPACING)
@@ -80,6 +83,9 @@ class ZigzagOptions:
     min_gap: float = 0.35
     max_stitch: float = ranged(12.1, ZIG_MAX_STITCH)
     tolerance: float = ranged(0.2, TOLERANCE)
+    corner_angle: float = ranged(45.0, CORNER_ANGLE)
+    mitre_limit: float = ranged(2.0, MITRE_LIMIT)
+    overlap: float = ranged(0.3, OVERLAP)
 
     def __post_init__(self) -> None:
         check_ranges(self)
@@ -154,8 +160,11 @@ def _inset_crowded(points: np.ndarray, centre: np.ndarray, min_gap: float, inner
 
 
 def zigzag_stitch(stroke: Stroke, options: ZigzagOptions = ZigzagOptions()) -> NeedlePoints:
-    """Zigzag along `stroke` (mm), preceded by a there-and-back centre walk when wide."""
+    """Zigzag along `stroke` (mm), preceded by a there-and-back centre walk when wide; a
+    stroke with corners is sewn as satin's columns are (module doc)."""
     curve = dense_curve(stroke, DENSE_TOLERANCE)
+    if find_corners(stroke, curve, np.full(len(curve.s), options.reach), options.corner_angle):
+        return _cornered(stroke, curve, options)
     length = curve.length
     steps = max(1, int(round(2.0 * length / options.spacing)))
     if steps % 2 == 0:
@@ -205,6 +214,26 @@ def zigzag_stitch(stroke: Stroke, options: ZigzagOptions = ZigzagOptions()) -> N
                                         max_gap=2.0 * options.underlay_stitch_length)
         zig = NeedlePoints(points, zig.t, zig.roles).take(keep)
     return split_body(zig, options.max_stitch - 2 * SNAP_ALLOWANCE)
+
+
+def _cornered(stroke: Stroke, curve, options: ZigzagOptions) -> NeedlePoints:
+    """Zigzag along a stroke with corners: the constant-width columns of satin's engine,
+    mitred or split at the corners (`fabrication.embroidery.columns`)."""
+    def half_at(s: np.ndarray) -> np.ndarray:
+        return np.full(len(s), options.reach)
+
+    columns = stroke_columns(stroke, curve, half_at, options.spacing, corner_angle=options.corner_angle,
+                             mitre_limit=options.mitre_limit, overlap=options.overlap)
+    kind = options.underlay_kind if curve.length > options.underlay_stitch_length else "none"
+    # The zigzag's underlay inset counts from the drawn edge, the columns' from the rail.
+    inset = options.reach - max(0.0, options.width / 2.0 - options.underlay_inset)
+    how = ColumnStitching(
+        spacing=options.spacing, short_stitch_distance=options.short_stitch_distance,
+        # the zigzag's inset is a share of its reach, the columns' of the row's width (twice it)
+        short_stitch_inset=options.short_stitch_inset / 2.0, min_gap=options.min_gap, max_stitch=options.max_stitch,
+        underlays=() if kind == "none" else (kind,), underlay_stitch_length=options.underlay_stitch_length,
+        edge_inset=inset, zigzag_inset=inset, underlay_spacing=options.underlay_spacing, tolerance=options.tolerance)
+    return column_needles(stroke, curve, columns, how)
 
 
 def _offset(stroke: Stroke, t: np.ndarray, offset: np.ndarray) -> np.ndarray:
