@@ -3,15 +3,19 @@
 A small JSON file in the output folder. An output is current when it exists, is not older
 than its input and the manifest records it with the same options key; a second run skips
 such outputs. An input that failed is remembered with its size and time, so that a rerun
-does not try an unchanged bad file again (unless asked to).
+does not try an unchanged bad file again (unless asked to); a failure that was not the
+input's (its worker process died) is not remembered. The figures of each input (strokes,
+stitches, times) are kept too, for the report rows of a rerun that skips it.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import os
 from pathlib import Path
 
+from fabrication.batch.report import FileStats
 from onestroke.atomic import atomic_write_text
 
 MANIFEST_NAME = "onestroke-batch-manifest.json"
@@ -29,11 +33,13 @@ class Manifest:
         self.path = Path(out_dir) / MANIFEST_NAME
         self.outputs: dict[str, dict] = {}
         self.failed: dict[str, dict] = {}
+        self.stats: dict[str, dict] = {}
         try:
             payload = json.loads(self.path.read_text(encoding="utf-8"))
             if payload.get("format") == "onestroke-batch-manifest":
                 self.outputs = dict(payload.get("outputs", {}))
                 self.failed = dict(payload.get("failed", {}))
+                self.stats = dict(payload.get("stats", {}))
         except (OSError, ValueError, AttributeError):
             pass  # no manifest yet, or an unreadable one: everything is made again
         self.root = Path(out_dir).resolve()
@@ -65,6 +71,18 @@ class Manifest:
         self.outputs[self._key(output)] = {"input": name, "key": key}
         self.failed.pop(name, None)
 
+    def remember(self, name: str, stats: FileStats) -> None:
+        """Keep the figures of `name`'s run (those it measured; earlier ones for the rest)."""
+        figures = {field: value for field, value in dataclasses.asdict(stats).items() if value not in (None, ())}
+        self.stats[name] = {**self.stats.get(name, {}), **figures}
+
+    def stats_of(self, name: str) -> FileStats | None:
+        """The figures of the run that made `name`'s outputs, if known."""
+        known = {field.name for field in dataclasses.fields(FileStats)}
+        figures = {k: tuple(v) if isinstance(v, list) else v for k, v in self.stats.get(name, {}).items()
+                   if k in known}
+        return FileStats(**figures) if figures else None
+
     def failure(self, source: Path, name: str, key: str, error: str) -> None:
         try:
             self.failed[name] = {"key": key, "stamp": list(_stamp(source)), "error": error}
@@ -73,5 +91,6 @@ class Manifest:
 
     def save(self) -> None:
         payload = {"format": "onestroke-batch-manifest", "version": 1,
-                   "outputs": dict(sorted(self.outputs.items())), "failed": dict(sorted(self.failed.items()))}
+                   "outputs": dict(sorted(self.outputs.items())), "failed": dict(sorted(self.failed.items())),
+                   "stats": dict(sorted(self.stats.items()))}
         atomic_write_text(self.path, json.dumps(payload, indent=1) + "\n")

@@ -10,6 +10,7 @@ import click
 from fabrication.cli.common import console, done, edits_option, step, warn
 from fabrication.cli.options import (Integer, Length, Number, drawing_input_options, input_argument,
                                      output_option, placement_options)
+from onestroke.atomic import all_or_nothing
 from onestroke.errors import InputError
 from onestroke.paths import check_distinct
 
@@ -142,12 +143,13 @@ def embroider(source: str, output: str, style: str, size: float | None, width: f
                                    classifier=classifier, edits=edits, progress=progress)
     with step("planning the stitches") as progress:
         result = embroider_drawing(drawing, job, progress=progress)
-    with step(f"writing {os.path.basename(output)}"):
-        write_embroidery(result.plan, output, pes_version=pes_version)
-    if preview_path is not None:
-        with step("drawing the preview"):
-            render_stitch_preview(result.plan, preview_path, hoop=the_hoop, stats=result.stats,
-                                  options=preview_options)
+    with all_or_nothing():  # the file and its preview appear together, or neither does
+        with step(f"writing {os.path.basename(output)}"):
+            write_embroidery(result.plan, output, pes_version=pes_version)
+        if preview_path is not None:
+            with step("drawing the preview"):
+                render_stitch_preview(result.plan, preview_path, hoop=the_hoop, stats=result.stats,
+                                      options=preview_options)
 
     for message in result.warnings:
         warn(message)

@@ -9,6 +9,7 @@ import click
 
 from fabrication.cli.common import console, done, edits_option, step, warn
 from fabrication.cli.options import drawing_input_options, input_argument, output_option
+from onestroke.atomic import all_or_nothing, check_folder
 from onestroke.errors import InputError
 from onestroke.paths import check_distinct
 
@@ -25,6 +26,8 @@ def vectorize(source: str, output: str, multi: bool, threshold: float | None, bl
     """Vectorize SOURCE into one ordered cubic Bézier curve (or several with --multi)."""
     if debug_dir is not None and os.path.exists(debug_dir) and not os.path.isdir(debug_dir):
         raise InputError(f"--debug {debug_dir!r} is a file; give a folder for the stage images")
+    if debug_dir is not None:
+        check_folder(debug_dir, what="--debug")
     stage_images = []
     if debug_dir:  # the overlay module is imported only when --debug asks for it
         from vectorize.debug_overlay import STAGE_IMAGES
@@ -43,13 +46,15 @@ def vectorize(source: str, output: str, multi: bool, threshold: float | None, bl
         result = vectorize_file(source, options, edits=replay, progress=progress)
     for message in result.report.warnings:
         warn(message)
-    write_drawing(result.drawing, output)
-    if debug_dir is not None:
-        from vectorize.debug_overlay import write_debug_images
+    written = []
+    with all_or_nothing():  # the drawing and its stage images appear together, or none does
+        write_drawing(result.drawing, output)
+        if debug_dir is not None:
+            from vectorize.debug_overlay import write_debug_images
 
-        written = write_debug_images(result, debug_dir)
-        if written:
-            console.print(f"debug: {len(written)} stage images in {debug_dir}")
+            written = write_debug_images(result, debug_dir)
+    if written:
+        console.print(f"debug: {len(written)} stage images in {debug_dir}")
     report = result.report
     done(f"{output}: {report.strokes} stroke{'s' * (report.strokes != 1)}, "
          f"{report.intersections} intersection{'s' * (report.intersections != 1)}, "
