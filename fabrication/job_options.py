@@ -1,8 +1,11 @@
 """Command-line option values (strings such as "2.5mm") to the library's job dataclasses.
 
 Shared by `onestroke embroider`, `onestroke laser`, `onestroke batch` and the studio, so that
-one set of option values gives one job and each of them writes the same bytes.
-Nothing here prints: warnings come back as one-line messages for the caller to show.
+one set of option values gives one job and each of them writes the same bytes. A value is
+parsed here and checked against the range its option type declares (`onestroke.ranges`),
+with the text as given in the message: the studio's page and the command line get the
+same line for the same bad value. Nothing here prints: warnings come back as one-line
+messages for the caller to show.
 """
 
 from __future__ import annotations
@@ -49,15 +52,45 @@ class LaserSettings:
     warnings: tuple[str, ...]
 
 
-def _placement(size: str | None, width: str | None, height: str | None, rotate: float):
-    from fabrication.placement import PlacementOptions
-    from onestroke.units import parse_positive_length
+def _checked(value, parse, limits):
+    """`value` (text such as "2.5mm", or a number in the library's unit) parsed by `parse`
+    and checked against `limits`; None stays None. The message shows text as the CLI's
+    types do: quoted where it carries a unit."""
+    if value is None:
+        return None
+    number = parse(value, what=limits.name)
+    if not isinstance(value, str):
+        return limits.check(number)
+    return limits.check(number, shown=value.strip() if parse in (_whole, _number) else repr(value))
 
-    return PlacementOptions(
-        size=parse_positive_length(size, what="--size") if size is not None else None,
-        width=parse_positive_length(width, what="--width") if width is not None else None,
-        height=parse_positive_length(height, what="--height") if height is not None else None,
-        rotate=rotate)
+
+def _whole(value, *, what: str):
+    """An integer option given as text or a number."""
+    if isinstance(value, bool) or (isinstance(value, float) and not value.is_integer()):
+        raise InputError(f"{what} {value!r} is not a whole number")
+    try:
+        return int(str(value).strip()) if isinstance(value, str) else int(value)
+    except (TypeError, ValueError, OverflowError):
+        raise InputError(f"{what} {value!r} is not a whole number") from None
+
+
+def _number(value, *, what: str):
+    """A plain number option given as text or a number."""
+    from onestroke.units import parse_number
+
+    return parse_number(value, what=what)
+
+
+def _placement(size, width, height, rotate):
+    from fabrication.placement import PlacementOptions
+    from onestroke.ranges import ranges_of
+    from onestroke.units import parse_length
+
+    sides = ranges_of(PlacementOptions)
+    return PlacementOptions(size=_checked(size, parse_length, sides["size"]),
+                            width=_checked(width, parse_length, sides["width"]),
+                            height=_checked(height, parse_length, sides["height"]),
+                            rotate=_checked(rotate, _number, sides["rotate"]))
 
 
 def embroidery_settings(*, output: str, style: str = "running", size: str | None = None,
@@ -77,53 +110,51 @@ def embroidery_settings(*, output: str, style: str = "running", size: str | None
     colour or a comma-separated list (one per stroke); None keeps the drawing's colours.
     `name`: the design name files store (None: the stem of `source`, the input file, else
     'onestroke'). `date`: YYYYMMDDhhmmss for JEF (None: the fixed default)."""
-    from fabrication.embroidery.export import PES_VERSIONS
+    from fabrication.embroidery.export import check_pes_version
     from fabrication.embroidery.locks import LockOptions
-    from fabrication.embroidery.pipeline import EmbroideryJob
-    from fabrication.embroidery.plan import PlanOptions, style_options
     from fabrication.embroidery.order import parse_start
-    from fabrication.embroidery.plan import FIXED_DATE
+    from fabrication.embroidery.pipeline import EmbroideryJob
+    from fabrication.embroidery.plan import FIXED_DATE, PlanOptions, style_class
     from fabrication.embroidery.thread import check_chart, parse_colors
     from machines.hoops import load_embroidery_profile
-    from onestroke.units import parse_length, parse_positive_length
+    from onestroke.ranges import ranges_of
+    from onestroke.units import parse_length
 
     profile = load_embroidery_profile()
     fmt = profile.format_for(output)
-    if pes_version is not None:
-        if fmt.extension != "pes":
-            raise InputError(f"--pes-version applies to .pes output only, not .{fmt.extension}")
-        if pes_version not in PES_VERSIONS:
-            raise InputError(f"--pes-version {pes_version} is not supported; use 1 or 6")
-    lengths = {name: parse_positive_length(value, what=flag)
-               for name, value, flag in (("stitch_length", stitch_length, "--stitch-length"),
-                                         ("tolerance", tolerance, "--tolerance"),
-                                         ("stitch_width", stitch_width, "--stitch-width"),
-                                         ("spacing", spacing, "--spacing"),
-                                         ("arrow_size", arrow_size, "--arrow-size")) if value is not None}
-    if pull_comp is not None:
-        lengths["pull_comp"] = parse_length(pull_comp, what="--pull-comp")
-    if repeats is not None:
-        lengths["repeats"] = repeats
-    if underlay is not None:
-        lengths["underlay"] = underlay
-    style_values = {_STYLE_FIELDS[k][0]: v for k, v in lengths.items()}
-    stitch_options = style_options(style, **style_values)
-    warnings = [f"{_STYLE_FIELDS[k][1]} has no effect with --style {style}" for k in lengths
-                if _STYLE_FIELDS[k][0] not in type(stitch_options).__dataclass_fields__]
+    pes_version = check_pes_version(pes_version, fmt.extension)
+    given = {"stitch_length": stitch_length, "tolerance": tolerance, "stitch_width": stitch_width,
+             "spacing": spacing, "arrow_size": arrow_size, "pull_comp": pull_comp, "repeats": repeats,
+             "underlay": underlay}
+    cls = style_class(style)
+    style_ranges = ranges_of(cls)
+    style_values, warnings = {}, []
+    for key, value in given.items():
+        field, flag = _STYLE_FIELDS[key]
+        if value is None:
+            continue
+        if field not in cls.__dataclass_fields__:
+            warnings.append(f"{flag} has no effect with --style {style}")
+        elif key == "underlay":
+            style_values[field] = value  # a name: the style's options check it
+        else:
+            style_values[field] = _checked(value, _whole if key == "repeats" else parse_length,
+                                           style_ranges[field])
+    stitch_options = cls(**style_values)
     if not any(v is not None for v in (size, width, height)):
         size = "90mm"
     placement = _placement(size, width, height, rotate)
-    limit = min(parse_positive_length(max_stitch, what="--max-stitch"), fmt.max_stitch, profile.max_stitch)
+    rules = ranges_of(PlanOptions)
+    limit = min(_checked(max_stitch, parse_length, rules["max_stitch"]), fmt.max_stitch, profile.max_stitch)
     plan_options = PlanOptions(style=stitch_options, lock=LockOptions(form=lock_form),
-                               min_stitch=parse_positive_length(min_stitch, what="--min-stitch"),
+                               min_stitch=_checked(min_stitch, parse_length, rules["min_stitch"]),
                                max_stitch=limit,
-                               trim_distance=parse_length(trim_distance, what="--trim-distance"),
-                               min_stroke=parse_length(min_stroke, what="--min-stroke"),
+                               trim_distance=_checked(trim_distance, parse_length, rules["trim_distance"]),
+                               min_stroke=_checked(min_stroke, parse_length, rules["min_stroke"]),
                                colors=parse_colors(color) if color is not None else (),
                                thread_chart=check_chart(thread_chart) if thread_chart else None,
                                start=parse_start(start) if start is not None else None)
-    if spm is not None and not spm > 0:
-        raise InputError(f"--spm {spm:g} must be greater than zero")
+    spm = _checked(spm, _number, ranges_of(EmbroideryJob)["stitches_per_minute"])
     job = EmbroideryJob(placement=placement, hoop=profile.hoop(hoop), fit=fit, plan=plan_options,
                         stitches_per_minute=spm or profile.stitches_per_minute,
                         trim_seconds=profile.trim_seconds, date=date or FIXED_DATE,
@@ -148,20 +179,15 @@ def laser_settings(*, size: str | None = None, width: str | None = None, height:
     """The toolpath and G-code options of `onestroke laser`'s option values; `InputError`
     naming the flag for a bad value. `profile`: an already loaded profile, used instead of
     reading `profile_path` (the studio's profiles loaded from the page)."""
-    from fabrication.laser.gcode_write import GcodeOptions
-    from fabrication.laser.toolpath import ToolpathOptions
+    from fabrication.laser.gcode_write import FEED, PASSES, POWER, GcodeOptions
+    from fabrication.laser.toolpath import TOLERANCE, ToolpathOptions
     from machines.laser_profile import load_laser_profile
-    from onestroke.units import parse_fraction, parse_positive_length, parse_speed
+    from onestroke.units import parse_fraction, parse_length, parse_speed
 
-    feed_mm = parse_speed(feed, what="--feed")
-    if not feed_mm > 0:
-        raise InputError(f"--feed {feed!r} must be greater than 0 mm/min")
-    power_fraction = parse_fraction(power, what="--power")
-    if power_fraction <= 0:
-        raise InputError(f"--power {power!r} must be above 0% (and at most 100%)")
-    tol = parse_positive_length(tolerance, what="--tolerance")
-    if passes < 1:
-        raise InputError(f"--passes {passes} must be at least 1")
+    feed_mm = _checked(feed, parse_speed, FEED)
+    power_fraction = _checked(power, parse_fraction, POWER)
+    tol = _checked(tolerance, parse_length, TOLERANCE)
+    passes = _checked(passes, _whole, PASSES)
     placement = _placement(size, width, height, rotate)
     if profile is None:
         profile = load_laser_profile(profile_path)

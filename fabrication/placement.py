@@ -11,32 +11,34 @@ from dataclasses import dataclass
 import numpy as np
 
 from onestroke.errors import InputError
+from onestroke.ranges import Range, check_ranges, ranged
 from vectorize.drawing import Drawing
+
+# A design side from 0.1 mm (one needle or laser step) to 10 m (past any bed or hoop).
+SIDE = Range(0.1, 10_000.0, unit="mm", name="--size")
+ROTATE = Range(-360.0, 360.0, unit="degrees", name="--rotate")
+DPI = Range(0.0, None, name="dpi", low_open=True)
 
 
 @dataclass(frozen=True, kw_only=True)
 class PlacementOptions:
     """Target size of the design in mm. Give at most one of `size`, `width`, `height`.
 
-    size: longest side; width / height: that side; none: keep the drawing's own size
-    (pixels read at `dpi`). rotate: degrees, counter-clockwise as seen on screen.
+    size: longest side; width / height: that side (0.1 mm-10 m); none: keep the drawing's
+    own size (pixels read at `dpi`). rotate: degrees, counter-clockwise as seen on screen.
     """
 
-    size: float | None = None
-    width: float | None = None
-    height: float | None = None
-    rotate: float = 0.0
-    dpi: float = 96.0
+    size: float | None = ranged(None, SIDE)
+    width: float | None = ranged(None, SIDE.named("--width"))
+    height: float | None = ranged(None, SIDE.named("--height"))
+    rotate: float = ranged(0.0, ROTATE)
+    dpi: float = ranged(96.0, DPI)
 
     def __post_init__(self) -> None:
-        given = [(n, v) for n, v in (("size", self.size), ("width", self.width), ("height", self.height)) if v is not None]
+        check_ranges(self)
+        given = [n for n, v in (("size", self.size), ("width", self.width), ("height", self.height)) if v is not None]
         if len(given) > 1:
-            raise InputError(f"give only one of --size, --width, --height (got {', '.join(n for n, _ in given)})")
-        for name, value in given:
-            if not value > 0:
-                raise InputError(f"{name} {value:g} mm must be greater than zero")
-        if not self.dpi > 0:
-            raise InputError(f"dpi {self.dpi:g} must be greater than zero")
+            raise InputError(f"give only one of --size, --width, --height (got {', '.join(given)})")
 
 
 def place(drawing: Drawing, options: PlacementOptions = PlacementOptions()) -> Drawing:

@@ -12,8 +12,11 @@ from __future__ import annotations
 from collections.abc import Sequence
 
 from onestroke.errors import InputError
+from onestroke.ranges import Range
 
 DEFAULT_FRAME_FEED = 3000.0  # mm/min: slow enough to follow by eye
+# The trace's power, a fraction of max S shown in percent; 0 keeps the beam off.
+FRAME_POWER = Range(0.0, 1.0, unit="%", name="--frame-power", scale=100.0)
 
 
 def _num(value: float) -> str:

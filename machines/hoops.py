@@ -15,9 +15,13 @@ from functools import lru_cache
 from pathlib import Path
 
 from onestroke.errors import InputError
+from onestroke.ranges import Range
 from onestroke.units import parse_positive_length, parse_size_pair
 
 PROFILE_PATH = Path(__file__).with_name("profiles") / "embroidery.toml"
+# A machine's sewing speed, stitches per minute (home machines 350-1000, industrial ones
+# up to about 1500; 3000 leaves room).
+SPM = Range(100.0, 3000.0, name="--spm")
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -120,7 +124,7 @@ def _load(path: Path) -> EmbroideryProfile:
         for ext, spec in data.get("formats", {}).items()
     )
     return EmbroideryProfile(
-        stitches_per_minute=float(machine.get("stitches_per_minute", 600)),
+        stitches_per_minute=SPM.named("stitches_per_minute").check(float(machine.get("stitches_per_minute", 600))),
         trim_seconds=float(machine.get("trim_seconds", 10)),
         max_stitch=parse_positive_length(machine.get("max_stitch", "12.1mm"), what="max_stitch"),
         hoops=hoops, formats=formats,

@@ -6,7 +6,18 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from onestroke.errors import MachineError
+from onestroke.errors import InputError, MachineError
+
+# The serial rates GRBL boards use (GRBL 1.1's default: 115200).
+BAUD_RATES = (9600, 19200, 38400, 57600, 115200, 230400, 250000, 500000, 1000000)
+
+
+def check_baud(rate, *, name: str = "--baud", shown: str | None = None) -> int:
+    """`rate` if it is one of BAUD_RATES, else `InputError` naming `name`."""
+    if isinstance(rate, bool) or rate not in BAUD_RATES:
+        raise InputError(f"{name} {shown if shown is not None else rate} is not a serial rate GRBL uses; use one "
+                         f"of {', '.join(map(str, BAUD_RATES))} (GRBL 1.1 default: 115200)")
+    return int(rate)
 
 
 # Appended to every job: its `ok` only comes once the planner has drained, so the end of

@@ -15,6 +15,17 @@ _NUMBER = r"([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)"
 _LENGTH = re.compile(rf"^\s*{_NUMBER}\s*([a-zA-Z]*)\s*$")
 _SPEED = re.compile(rf"^\s*{_NUMBER}\s*(?:([a-zA-Z]+)\s*/\s*(min|s))?\s*$")
 _PERCENT = re.compile(rf"^\s*{_NUMBER}\s*(%?)\s*$")
+_PLAIN = re.compile(rf"^\s*{_NUMBER}\s*$")
+
+
+def parse_number(text: str | float, *, what: str = "value") -> float:
+    """A plain number ("12.5", "-3", "1e3") or a number as is; not checked for range."""
+    if isinstance(text, (int, float)) and not isinstance(text, bool):
+        return float(text)
+    match = _PLAIN.match(str(text))
+    if not match:
+        raise InputError(f"{what} {text!r} is not a number")
+    return float(match.group(1))
 
 
 def parse_length(text: str | float, *, default_unit: str = "mm", what: str = "length") -> float:

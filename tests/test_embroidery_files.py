@@ -162,7 +162,7 @@ def test_long_zigzag_stitches_are_split_into_real_stitches_for_every_format(tmp_
     line = Drawing((Stroke.from_polyline(np.array([[-20.0, 0.0], [20.0, 5.0]])),), 40, 5, "mm")
     for ext in FORMATS:
         fmt = format_for_path(f"x.{ext}")
-        plan = plan_embroidery(line, PlanOptions(style=style_options("zigzag", width=30.0),
+        plan = plan_embroidery(line, PlanOptions(style=style_options("zigzag", width=12.0, pull_compensation=2.0),
                                                  max_stitch=min(12.1, fmt.max_stitch)))
         write_embroidery(plan, tmp_path / f"wide.{ext}")
         back = read_embroidery(tmp_path / f"wide.{ext}").plan

@@ -45,7 +45,7 @@ def test_zero_length_stroke_among_others_is_dropped():
     assert tp.dropped == 1 and len(tp.paths) == 1
 
 
-@pytest.mark.parametrize("size", [0.05, 1.0, 399.9])
+@pytest.mark.parametrize("size", [0.1, 1.0, 399.9])  # from the smallest --size on
 def test_tiny_and_bed_sized_designs(size):
     tp = _plan(_drawing([[0, 0], [100, 40], [30, 90]]), placement=PlacementOptions(size=size))
     lines = gcode_lines(tp, PROFILE, GcodeOptions())

@@ -97,7 +97,7 @@ def test_studio_refuses_a_folder_a_non_image_and_bad_ports(tmp_path):
     busy.listen()
     taken = busy.getsockname()[1]
     cases = [([str(tmp_path)], "is a directory, not an image"), ([str(tmp_path / "notes.png")], "is not an image"),
-             ([loops, "--port", "abc"], "is not a valid integer"), ([loops, "--port", "70000"], "between 0 and 65535")]
+             ([loops, "--port", "abc"], "is not a whole number"), ([loops, "--port", "70000"], "from 0 to 65535")]
     try:
         for args, message in cases:
             run = CliRunner().invoke(main, ["studio", *args, "--no-browser"])

@@ -36,12 +36,15 @@ import math
 from dataclasses import dataclass, field, replace
 
 from onestroke.errors import InputError
+from onestroke.ranges import Range, check_ranges, ranged
+from vectorize.options import BLUR, THRESHOLD
 
 FORMAT = "onestroke-edits"
 PAIRINGS = ("crossing", "touching", "third")
 KINDS = ("pairing", "passes", "split", "merge", "reverse", "start", "twice", "once", "unbridge")
 # Default match radius in output px: a click lands within a few pixels of a marker.
 TOLERANCE = 8.0
+MATCH_RADIUS = Range(0.0, None, unit="px", name="edit tolerance", low_open=True)
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -102,20 +105,15 @@ class Edits:
     """Settings that override the vectorizer's options (None: keep the option) and the
     ordered list of corrections; `tolerance` is the match radius in output px."""
 
-    threshold: float | None = None
-    blur: float | None = None
+    threshold: float | None = ranged(None, THRESHOLD)
+    blur: float | None = ranged(None, BLUR)
     multi: bool | None = None
-    tolerance: float = TOLERANCE
+    tolerance: float = ranged(TOLERANCE, MATCH_RADIUS)
     items: tuple[Edit, ...] = field(default_factory=tuple)
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "items", tuple(self.items))
-        if self.threshold is not None and not 0.0 < self.threshold < 1.0:
-            raise InputError(f"threshold {self.threshold!r} must lie strictly between 0 and 1")
-        if self.blur is not None and not self.blur >= 0:
-            raise InputError(f"blur sigma {self.blur!r} must be >= 0")
-        if not self.tolerance > 0:
-            raise InputError(f"edit tolerance {self.tolerance!r} must be greater than 0 px")
+        check_ranges(self)
 
     def of(self, *kinds: str) -> tuple[Edit, ...]:
         """The corrections of these kinds, in order."""

@@ -9,7 +9,15 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 from onestroke.errors import InputError
+from onestroke.ranges import Range, check_ranges, ranged
 from vectorize.drawing import Drawing
+
+# Ranges of the options a user sets (edits files and the studio's sliders use them too).
+# The gray level is a fraction of paper white (paper = 1 after shading correction).
+THRESHOLD = Range(0.0, 1.0, name="--threshold", low_open=True, high_open=True)
+# A Gaussian sigma on the working image (longest side about 1000-2000 px).
+BLUR = Range(0.0, 25.0, unit="px", name="--blur")
+MAX_SIZE = Range(64, None, unit="px", name="max_size", integer=True)
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -17,8 +25,8 @@ class VectorizeOptions:
     """Options of the vectorizer.
 
     multi: multi-stroke mode (paper 4.5) instead of one single line.
-    threshold: gray level in [0, 1] below which a pixel is ink (None: Li's method).
-    blur: Gaussian sigma in px applied before thresholding (0: none).
+    threshold: gray level in (0, 1) below which a pixel is ink (None: Li's method).
+    blur: Gaussian sigma in px applied before thresholding (0: none), 0-25 px.
     classifier: "cnn" (shipped model), "geometric" (tangent continuity), or any object with
         the `vectorize.intersections.IntersectionClassifier` method `classify`.
     max_size: longest side of the working image in px; larger inputs are downscaled.
@@ -26,24 +34,19 @@ class VectorizeOptions:
     """
 
     multi: bool = False
-    threshold: float | None = None
-    blur: float = 0.0
+    threshold: float | None = ranged(None, THRESHOLD)
+    blur: float = ranged(0.0, BLUR)
     classifier: object = "cnn"
-    max_size: int = 1000
+    max_size: int = ranged(1000, MAX_SIZE)
     seed: int = 0
     keep_stages: bool = False
 
     def __post_init__(self) -> None:
-        if self.threshold is not None and not 0.0 < self.threshold < 1.0:
-            raise InputError(f"threshold {self.threshold!r} must lie strictly between 0 and 1")
-        if self.blur < 0:
-            raise InputError(f"blur sigma {self.blur!r} must be >= 0")
+        check_ranges(self)
         if isinstance(self.classifier, str) and self.classifier not in ("cnn", "geometric"):
             raise InputError(f"unknown classifier {self.classifier!r}; use 'cnn' or 'geometric'")
         if not isinstance(self.classifier, str) and not callable(getattr(self.classifier, "classify", None)):
             raise InputError(f"classifier {self.classifier!r} has no classify method")
-        if self.max_size < 64:
-            raise InputError(f"max_size {self.max_size!r} must be at least 64 px")
 
 
 @dataclass(frozen=True)

@@ -23,6 +23,10 @@ from fabrication.batch.report import BatchSummary, FileRecord, ReportRoom, repor
 from fabrication.batch.work import BatchJob, FileResult, process_file
 from onestroke.atomic import all_or_nothing, atomic_write_bytes, make_folder
 from onestroke.errors import OnestrokeError, OutputError
+from onestroke.ranges import Range
+
+# Worker processes of one batch (a pool of more than a thousand is a mistake, not a plan).
+JOBS = Range(1, 1024, name="--jobs", integer=True)
 
 # Seconds between manifest saves while results come in (and always at the end).
 SAVE_EVERY = 2.0

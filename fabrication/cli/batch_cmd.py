@@ -10,6 +10,7 @@ from fabrication.cli.common import console, done, warn
 from fabrication.cli.embroider_cmd import embroider, source_date
 from fabrication.job_options import embroidery_settings, laser_settings
 from fabrication.cli.laser_cmd import laser
+from fabrication.batch.runner import JOBS
 from fabrication.cli.options import Integer, drawing_input_options, placement_options
 from onestroke.atomic import check_folder
 from onestroke.errors import EXIT_INTERRUPTED, InputError, Interrupted
@@ -103,7 +104,7 @@ def _quiet_dask_logs() -> None:
               help="Folder for the outputs (the input tree is mirrored in it), the report and the manifest.")
 @click.option("--to", "to", default="svg", show_default=True,
               help="Outputs per drawing, comma-separated: svg, json, pes, dst, jef, exp, vp3, gcode, nc.")
-@click.option("--jobs", "-j", type=Integer(1, 1024), default=None, help="Worker processes [default: all cores].")
+@click.option("--jobs", "-j", type=Integer(JOBS), default=None, help="Worker processes [default: all cores].")
 @click.option("--scheduler", default=None,
               help="Run on a Dask distributed cluster at this address (tcp://HOST:PORT); needs onestroke[dask].")
 @click.option("--retry-failed", is_flag=True, help="Try again inputs that failed in an earlier run, unchanged.")

@@ -10,6 +10,13 @@ import click
 from fabrication.cli.common import console, done, edits_option, step, warn
 from fabrication.cli.options import (Integer, Length, Number, drawing_input_options, input_argument,
                                      output_option, placement_options)
+from fabrication.embroidery.arrows import ARROW_SIZE
+from fabrication.embroidery.plan import MAX_STITCH, MIN_STITCH, MIN_STROKE, TRIM_DISTANCE
+from fabrication.embroidery.preview import PREVIEW_WIDTH
+from fabrication.embroidery.running import STITCH_LENGTH, TOLERANCE
+from fabrication.embroidery.triple import REPEATS
+from fabrication.embroidery.zigzag import PULL_COMPENSATION, SPACING, STITCH_WIDTH
+from machines.hoops import SPM
 from onestroke.atomic import all_or_nothing
 from onestroke.errors import InputError
 from onestroke.paths import check_distinct
@@ -40,32 +47,33 @@ def source_date() -> str:
 @click.option("--hoop", default="100x100", show_default=True,
               help="Hoop: 100x100 (4x4), 130x180 (5x7), 150x250, 160x260 (6x10), 200x200, or WxH in mm.")
 @click.option("--fit", is_flag=True, help="Scale the design down to fit the hoop instead of refusing it.")
-@click.option("--stitch-length", type=Length(0.1, 12.7), default=None,
-              help="Running/triple stitch and the arrows' centre walk, 0.1-12.7 mm and at least --min-stitch "
+@click.option("--stitch-length", type=Length(STITCH_LENGTH), default=None,
+              help=f"Running/triple stitch and the arrows' centre walk, {STITCH_LENGTH.span()} and at least "
+                   "--min-stitch "
                    "[default: 2.5mm].")
-@click.option("--tolerance", type=Length(0.1, 5.0), default=None,
-              help="Largest chord-to-curve distance, 0.1-5 mm [default: 0.2mm].")
-@click.option("--stitch-width", "--zigzag-width", "stitch_width", type=Length(0.1, 12.0), default=None,
-              help="Zigzag width rail to rail [2mm] or arrow spread [2.5mm]; 0.1-12 mm.")
-@click.option("--spacing", type=Length(0.1, 50.0), default=None,
-              help="Zigzag peak-to-peak spacing [0.4mm] or arrow spacing [5mm]; 0.1-50 mm.")
-@click.option("--pull-comp", type=Length(0.0, 2.0), default=None,
-              help="Zigzag pull compensation added to the width, 0-2 mm [default: 0.2mm].")
-@click.option("--repeats", type=Integer(1, 5), default=None,
-              help="Triple stitch: back-and-forth passes, 1-5 [default: 1].")
-@click.option("--arrow-size", type=Length(0.1, 20.0), default=None,
-              help="Arrows: arm length along the curve, 0.1-20 mm [default: 2mm].")
+@click.option("--tolerance", type=Length(TOLERANCE), default=None,
+              help=f"Largest chord-to-curve distance, {TOLERANCE.span()} [default: 0.2mm].")
+@click.option("--stitch-width", "--zigzag-width", "stitch_width", type=Length(STITCH_WIDTH), default=None,
+              help=f"Zigzag width rail to rail [2mm] or arrow spread [2.5mm]; {STITCH_WIDTH.span()}.")
+@click.option("--spacing", type=Length(SPACING), default=None,
+              help=f"Zigzag peak-to-peak spacing [0.4mm] or arrow spacing [5mm]; {SPACING.span()}.")
+@click.option("--pull-comp", type=Length(PULL_COMPENSATION), default=None,
+              help=f"Zigzag pull compensation added to the width, {PULL_COMPENSATION.span()} [default: 0.2mm].")
+@click.option("--repeats", type=Integer(REPEATS), default=None,
+              help=f"Triple stitch: back-and-forth passes, {REPEATS.span()} [default: 1].")
+@click.option("--arrow-size", type=Length(ARROW_SIZE), default=None,
+              help=f"Arrows: arm length along the curve, {ARROW_SIZE.span()} [default: 2mm].")
 @click.option("--underlay", type=click.Choice(["center", "edge", "zigzag", "none"]), default=None,
               help="Zigzag underlay [default: center when wider than 1.5mm].")
-@click.option("--min-stroke", type=Length(0.0, 100.0), default="1mm", show_default=True,
+@click.option("--min-stroke", type=Length(MIN_STROKE), default="1mm", show_default=True,
               help="Shorter strokes join a neighbour within --trim-distance by travel stitches, or are "
-                   "left out with a warning; 0-100 mm.")
-@click.option("--min-stitch", type=Length(0.1, 3.0), default="0.3mm", show_default=True,
-              help="Shorter stitches are merged away (locks excepted); 0.1-3 mm.")
-@click.option("--max-stitch", type=Length(1.0, 12.7), default="12.1mm", show_default=True,
-              help="Longest needle-down stitch per axis, 1-12.7 mm (never above the format's limit).")
-@click.option("--trim-distance", type=Length(0.0, 1000.0), default="3mm", show_default=True,
-              help="Strokes further apart are joined by lock, trim and jump; 0-1000 mm.")
+                   f"left out with a warning; {MIN_STROKE.span()}.")
+@click.option("--min-stitch", type=Length(MIN_STITCH), default="0.3mm", show_default=True,
+              help=f"Shorter stitches are merged away (locks excepted); {MIN_STITCH.span()}.")
+@click.option("--max-stitch", type=Length(MAX_STITCH), default="12.1mm", show_default=True,
+              help=f"Longest needle-down stitch per axis, {MAX_STITCH.span()} (never above the format's limit).")
+@click.option("--trim-distance", type=Length(TRIM_DISTANCE), default="3mm", show_default=True,
+              help=f"Strokes further apart are joined by lock, trim and jump; {TRIM_DISTANCE.span()}.")
 @click.option("--lock", "lock_form", type=click.Choice(["half", "back_forth"]), default="half",
               show_default=True, help="Lock/tack form.")
 @click.option("--color", "--colour", "color", default=None,
@@ -77,14 +85,14 @@ def source_date() -> str:
               help="Design name stored in .pes/.dst [default: the input file's stem].")
 @click.option("--start", default=None,
               help="Where sewing starts: X,Y in mm from the design centre (y down), or 'reverse'.")
-@click.option("--pes-version", type=Integer(1, 6), default=None,
+@click.option("--pes-version", type=Integer(), default=None,
               help="PES version: 6 (default; keeps RGB colours) or 1 (Brother's 64-colour palette).")
-@click.option("--spm", type=Number(100, 3000), default=None,
-              help="Machine speed in stitches per minute, 100-3000 [default: 600].")
+@click.option("--spm", type=Number(SPM), default=None,
+              help=f"Machine speed in stitches per minute, {SPM.span()} [default: 600].")
 @output_option(".png", ".svg", flags=("--preview",), dest="preview_path", required=False,
                help="Also write a preview image (.png or .svg).")
-@click.option("--preview-width", type=Integer(64, 8000), default=1000, show_default=True,
-              help="Preview width in px, 64-8000.")
+@click.option("--preview-width", type=Integer(PREVIEW_WIDTH), default=1000, show_default=True,
+              help=f"Preview width, {PREVIEW_WIDTH.span()}.")
 @click.option("--preview-style", type=click.Choice(["realistic", "diagnostic"]), default="realistic",
               show_default=True,
               help="realistic: thread on fabric; diagnostic: needle points, jumps, trims, order, hoop.")
@@ -111,9 +119,6 @@ def embroider(source: str, output: str, style: str, size: float | None, width: f
     # Every option is checked before anything is read or written.
     check_distinct(inputs=[("input", source), ("--edits file", edits)],
                    outputs=[("output", output), ("--preview", preview_path)])
-    if stitch_length is not None and stitch_length < min_stitch:
-        raise InputError(f"--stitch-length {stitch_length:g} mm is shorter than --min-stitch {min_stitch:g} mm, "
-                         "so every stitch would be merged away; lengthen it or lower --min-stitch")
     settings = embroidery_settings(
         output=output, style=style, size=size, width=width, height=height, rotate=rotate, hoop=hoop, fit=fit,
         stitch_length=stitch_length, tolerance=tolerance, stitch_width=stitch_width, spacing=spacing,

@@ -11,13 +11,12 @@ import click
 from fabrication.cli.common import console, done, edits_option, step, warn
 from fabrication.cli.options import (Integer, Length, Percent, Speed, drawing_input_options, input_argument,
                                      machine_options, output_option, placement_options)
+from fabrication.laser.gcode_write import FEED, PASSES, POWER
+from fabrication.laser.raster_time import INTERVAL, RASTER_FEED
+from fabrication.laser.toolpath import TOLERANCE
+from machines.framing import FRAME_POWER
 from onestroke.atomic import all_or_nothing, check_writable
 from onestroke.paths import check_distinct
-
-# Documented ranges: a feed under 1 mm/min would be written as F0, which GRBL refuses; each
-# pass repeats the whole program, so passes bound the file size.
-MIN_FEED, MAX_FEED = 1.0, 100_000.0
-MAX_PASSES = 100
 
 
 def frame_path_for(output: str) -> str:
@@ -32,27 +31,27 @@ def frame_path_for(output: str) -> str:
 @placement_options()
 @click.option("--origin", type=click.Choice(["lower-left", "center"]), default="lower-left", show_default=True,
               help="lower-left: design's lower-left corner at machine (0,0); center: design centred on the bed.")
-@click.option("--feed", type=Speed(MIN_FEED, MAX_FEED), default="1500mm/min", show_default=True,
-              help=f"Burn speed, e.g. 1500mm/min, 25mm/s; {MIN_FEED:g}-{MAX_FEED:g} mm/min.")
-@click.option("--power", type=Percent(0.0, 100.0, low_open=True), default="60%", show_default=True,
-              help="Laser power, above 0% to 100% of the profile's max S ($30).")
-@click.option("--passes", type=Integer(1, MAX_PASSES), default=1, show_default=True,
-              help=f"Times the job is burned, 1-{MAX_PASSES}.")
-@click.option("--tolerance", type=Length(0.005, 1.0), default="0.02mm", show_default=True,
-              help="Largest distance of the burned path from the drawing, 0.005-1 mm.")
+@click.option("--feed", type=Speed(FEED), default="1500mm/min", show_default=True,
+              help=f"Burn speed, e.g. 1500mm/min, 25mm/s; {FEED.span()}.")
+@click.option("--power", type=Percent(POWER), default="60%", show_default=True,
+              help=f"Laser power, {POWER.span()} of the profile's max S ($30).")
+@click.option("--passes", type=Integer(PASSES), default=1, show_default=True,
+              help=f"Times the job is burned, {PASSES.span()}.")
+@click.option("--tolerance", type=Length(TOLERANCE), default="0.02mm", show_default=True,
+              help=f"Largest distance of the burned path from the drawing, {TOLERANCE.span()}.")
 @click.option("--arcs", is_flag=True, help="Emit G2/G3 arcs fitted within the tolerance (fewer lines).")
 @click.option("--keep-order", is_flag=True, help="Burn strokes in drawing order and direction (no travel optimisation).")
 @click.option("--air-assist/--no-air-assist", default=None, help="Switch air assist (M8) on; default: the profile's.")
 @click.option("--return-home", is_flag=True, help="End the job with G0 X0 Y0.")
 @click.option("--frame", is_flag=True, help="Also write OUT.frame.gcode tracing the bounding box.")
-@click.option("--frame-power", type=Percent(0.0, 100.0), default="0%", show_default=True,
-              help="Power of the framing trace, 0-100%; 0% keeps the laser off.")
+@click.option("--frame-power", type=Percent(FRAME_POWER), default="0%", show_default=True,
+              help=f"Power of the framing trace, {FRAME_POWER.span()}; 0% keeps the laser off.")
 @output_option(".png", ".svg", flags=("--preview",), dest="preview_path", required=False,
                help="Write a preview image of the job (.png or .svg).")
-@click.option("--raster-interval", type=Length(0.001, 10.0), default="0.1mm", show_default=True,
-              help="Line interval of the raster engraving the time is compared with, up to 10 mm (and at most "
-                   "a few hundred million raster pixels).")
-@click.option("--raster-feed", type=Speed(MIN_FEED, MAX_FEED), default=None,
+@click.option("--raster-interval", type=Length(INTERVAL), default="0.1mm", show_default=True,
+              help=f"Line interval of the raster engraving the time is compared with, {INTERVAL.span()} (and "
+                   "at most a few hundred million raster pixels).")
+@click.option("--raster-feed", type=Speed(RASTER_FEED), default=None,
               help="Scan speed of that raster engraving; default: --feed (the same burn per mm).")
 @drawing_input_options(prefix="Raster input: ")
 @machine_options(port_help="After writing, stream the job to this serial port (sim:// for a dry run).")

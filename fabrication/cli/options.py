@@ -11,7 +11,6 @@ which `onestroke.units` and `job_options` read back unchanged.
 
 from __future__ import annotations
 
-import math
 import os
 from collections.abc import Callable
 
@@ -20,11 +19,7 @@ import click
 from onestroke import units
 from onestroke.errors import InputError
 
-# Documented ranges (the README's option table repeats them).
-MAX_DESIGN_MM = 10_000.0   # --size/--width/--height: a 10 m design is past any bed or hoop
-MIN_DESIGN_MM = 0.1
-MAX_BLUR_PX = 25.0         # Gaussian sigma on the working image (longest side about 1000-2000 px)
-BAUD_RATES = (9600, 19200, 38400, 57600, 115200, 230400, 250000, 500000, 1000000)
+from onestroke.ranges import Range, ranges_of
 
 
 def _flag(param: click.Parameter | None) -> str:
@@ -36,62 +31,38 @@ def _flag(param: click.Parameter | None) -> str:
     return max(param.opts, key=len)
 
 
-def _range_text(low: float | None, high: float | None, low_open: bool, high_open: bool, unit: str) -> str:
-    def show(v: float) -> str:
-        return f"{v:g}{unit}"
-    if low is not None and high is not None:
-        return f"{'above' if low_open else 'from'} {show(low)} {'to below' if high_open else 'to'} {show(high)}"
-    if low is not None:
-        return f"{'above' if low_open else 'at least'} {show(low)}"
-    return f"{'below' if high_open else 'at most'} {show(high)}"
-
-
-def check_range(value: float, *, what: str, text=None, low: float | None = None, high: float | None = None,
-                low_open: bool = False, high_open: bool = False, unit: str = "", quote: bool = True) -> float:
-    """`value` if finite and within [low, high] (open ends as asked), else `InputError`.
-    `text`: what the user typed, shown in the message (quoted if `quote`)."""
-    shown = repr(value if text is None else text) if quote else str(value if text is None else text).strip()
-    if not math.isfinite(value):
-        raise InputError(f"{what} {shown} is not a finite number")
-    too_low = low is not None and (value <= low if low_open else value < low)
-    too_high = high is not None and (value >= high if high_open else value > high)
-    if too_low or too_high:
-        raise InputError(f"{what} {shown} must be {_range_text(low, high, low_open, high_open, unit)}")
-    return value
-
-
 class _Ranged(click.ParamType):
-    """Base of the numeric types: parse, then check the documented range."""
+    """Base of the numeric types: parse, then check against the option's declared `Range`
+    (`onestroke.ranges`), named by the flag it is given as."""
 
-    unit = ""
     quote = True  # lengths, speeds, percentages: show the typed text with its unit in quotes
 
-    def __init__(self, low: float | None = None, high: float | None = None, *, low_open: bool = False,
-                 high_open: bool = False) -> None:
-        self.low, self.high, self.low_open, self.high_open = low, high, low_open, high_open
+    def __init__(self, limits: Range | None = None) -> None:
+        self.limits = limits if limits is not None else Range()
 
     def parse(self, text, what: str) -> float:
+        """The number in the Range's unit."""
         raise NotImplementedError
+
+    def returned(self, number: float):
+        """What the command receives (the Range's unit unless a type says otherwise)."""
+        return number
 
     def convert(self, value, param, ctx):
         what = _flag(param)
         number = self.parse(value, what)
-        return check_range(number, what=what, text=value, low=self.low, high=self.high, low_open=self.low_open,
-                           high_open=self.high_open, unit=self.unit, quote=self.quote)
+        shown = repr(value) if self.quote else str(value).strip()
+        return self.returned(self.limits.named(what).check(number, shown=shown))
 
     def get_metavar(self, param, ctx=None) -> str:
         return self.name.upper()
 
 
 class Number(_Ranged):
-    """A plain finite float (degrees, px, a fraction) within a documented range."""
+    """A plain finite float (degrees, px, a fraction) within its declared range."""
 
     name = "number"
     quote = False
-
-    def __init__(self, low=None, high=None, *, unit: str = "", **kwargs) -> None:
-        super().__init__(low, high, **kwargs)
-        self.unit = unit
 
     def parse(self, text, what: str) -> float:
         try:
@@ -101,26 +72,22 @@ class Number(_Ranged):
 
 
 class Integer(_Ranged):
-    """An integer within a documented range."""
+    """An integer within its declared range."""
 
     name = "integer"
     quote = False
 
-    def parse(self, text, what: str) -> float:
+    def parse(self, text, what: str) -> int:
         try:
             return int(str(text).strip())
         except ValueError:
             raise InputError(f"{what} {text!r} is not a whole number") from None
-
-    def convert(self, value, param, ctx):
-        return int(super().convert(value, param, ctx))
 
 
 class Length(_Ranged):
     """A length with a unit ("2.5mm", "3in", "9cm"; a bare number is mm), returned in mm."""
 
     name = "length"
-    unit = " mm"
 
     def parse(self, text, what: str) -> float:
         return units.parse_length(text, what=what)
@@ -130,21 +97,23 @@ class Speed(_Ranged):
     """A speed ("1500mm/min", "25mm/s"; a bare number is mm/min), returned in mm/min."""
 
     name = "speed"
-    unit = " mm/min"
 
     def parse(self, text, what: str) -> float:
         return units.parse_speed(text, what=what)
 
 
 class Percent(_Ranged):
-    """A percentage ("60%"; a bare number is percent), returned in percent (0-100), which
+    """A percentage ("60%"; a bare number is percent) checked as the fraction its Range
+    declares (scale 100), returned in percent (0-100), which
     `onestroke.units.parse_fraction` reads back as the same value."""
 
     name = "percent"
-    unit = "%"
 
     def parse(self, text, what: str) -> float:
-        return units.parse_fraction(text, what=what) * 100.0
+        return units.parse_fraction(text, what=what)
+
+    def returned(self, number: float) -> float:
+        return number * 100.0
 
 
 class InputFile(click.ParamType):
@@ -207,16 +176,14 @@ class Port(click.ParamType):
 
 
 class BaudRate(Integer):
-    """One of the serial rates GRBL boards use."""
+    """One of the serial rates GRBL boards use (`machines.stream_types.BAUD_RATES`)."""
 
     name = "baud"
 
     def convert(self, value, param, ctx):
-        rate = super().convert(value, param, ctx)
-        if rate not in BAUD_RATES:
-            raise InputError(f"{_flag(param)} {value} is not a serial rate GRBL uses; use one of "
-                             f"{', '.join(map(str, BAUD_RATES))} (GRBL 1.1 default: 115200)")
-        return rate
+        from machines.stream_types import check_baud
+
+        return check_baud(super().convert(value, param, ctx), name=_flag(param), shown=str(value))
 
 
 # -- decorators ---------------------------------------------------------------------------------
@@ -246,17 +213,19 @@ def drawing_input_options(function: Callable | None = None, *, prefix: str = "")
     `classifier`, as `common.read_drawing` takes them. `prefix` (e.g. "Raster input: ")
     starts each help text on commands that also read SVG.
     """
+    from vectorize.options import BLUR, THRESHOLD
+
     def text(words: str) -> str:
         return prefix + words if prefix else words[0].upper() + words[1:]
 
     decorators = [
         click.option("--multi", is_flag=True, help=text("multi-stroke drawing: keep every ink piece, "
                                                         "several strokes.")),
-        click.option("--threshold", type=Number(0.0, 1.0, low_open=True, high_open=True), default=None,
-                     help=text("ink threshold, a gray level in (0, 1) with paper = 1 after shading "
+        click.option("--threshold", type=Number(THRESHOLD), default=None,
+                     help=text(f"ink threshold, a gray level ({THRESHOLD.span()}) with paper = 1 after shading "
                                "correction; default: Li's method.")),
-        click.option("--blur", type=Number(0.0, MAX_BLUR_PX, unit=" px"), default=0.0, show_default=True,
-                     help=text(f"Gaussian blur sigma in px (0-{MAX_BLUR_PX:g}) before thresholding; helps "
+        click.option("--blur", type=Number(BLUR), default=0.0, show_default=True,
+                     help=text(f"Gaussian blur sigma ({BLUR.span()}) before thresholding; helps "
                                "pencil scans and noisy photos.")),
         click.option("--classifier", type=click.Choice(["cnn", "geometric"]), default="cnn", show_default=True,
                      help=text("how crossings are told from touchings.")),
@@ -273,16 +242,19 @@ def placement_options(default_size: str | None = None) -> Callable:
     The command receives `size`, `width`, `height` (mm or None) and `rotate`, as
     `job_options` takes them; `default_size` is only named in the help (the job applies it).
     """
-    side = Length(MIN_DESIGN_MM, MAX_DESIGN_MM)
+    from fabrication.placement import ROTATE, PlacementOptions
+
+    sides = ranges_of(PlacementOptions)
     shown = f" [default: {default_size}]" if default_size else ""
     return lambda function: _apply(function, [
-        click.option("--size", type=side, default=None,
-                     help=f"Longest side of the design, e.g. 90mm, 3.5in ({MIN_DESIGN_MM:g} mm to "
-                          f"{MAX_DESIGN_MM / 1000:g} m){shown}."),
-        click.option("--width", type=side, default=None, help="Width of the design instead of --size."),
-        click.option("--height", type=side, default=None, help="Height of the design instead of --size."),
-        click.option("--rotate", type=Number(-360.0, 360.0, unit=" degrees"), default=0.0, show_default=True,
-                     help="Degrees counter-clockwise, -360 to 360."),
+        click.option("--size", type=Length(sides["size"]), default=None,
+                     help=f"Longest side of the design, e.g. 90mm, 3.5in ({sides['size'].span()}){shown}."),
+        click.option("--width", type=Length(sides["width"]), default=None,
+                     help="Width of the design instead of --size."),
+        click.option("--height", type=Length(sides["height"]), default=None,
+                     help="Height of the design instead of --size."),
+        click.option("--rotate", type=Number(ROTATE), default=0.0, show_default=True,
+                     help=f"Degrees counter-clockwise, {ROTATE.span()}."),
     ])
 
 

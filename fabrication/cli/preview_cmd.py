@@ -12,6 +12,8 @@ import click
 
 from fabrication.cli.common import console, done, step, warn
 from fabrication.cli.options import Integer, Number, input_argument, output_option
+from fabrication.embroidery.preview import PREVIEW_WIDTH
+from machines.hoops import SPM
 from onestroke.errors import InputError
 from onestroke.paths import check_distinct
 
@@ -25,11 +27,11 @@ DRAWING_SUFFIXES = (".svg", ".json")
 @click.command()
 @input_argument()
 @output_option(".png", ".svg", ".html", ".htm", help="Preview to write: an image (.png, .svg) or a player page (.html).")
-@click.option("--width", "width_px", type=Integer(64, 8000), default=1000, show_default=True,
-              help="Image width in px, 64-8000 (embroidery and drawings).")
+@click.option("--width", "width_px", type=Integer(PREVIEW_WIDTH), default=1000, show_default=True,
+              help=f"Image width, {PREVIEW_WIDTH.span()} (embroidery and drawings).")
 @click.option("--hoop", default=None, help="Embroidery: draw this hoop, e.g. 100x100 or 5x7.")
-@click.option("--spm", type=Number(100, 3000), default=None,
-              help="Embroidery: stitches per minute for the time, 100-3000 [600].")
+@click.option("--spm", type=Number(SPM), default=None,
+              help=f"Embroidery: stitches per minute for the time, {SPM.span()} [600].")
 def preview(source: str, output: str, width_px: int, hoop: str | None, spm: float | None) -> None:
     """Draw SOURCE (.pes/.dst/.jef/.exp/.vp3/... , .gcode/.nc, or an .svg/.json drawing) as OUTPUT.
 

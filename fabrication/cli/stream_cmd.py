@@ -18,15 +18,18 @@ from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
 
 from fabrication.cli.common import console, done, warn
 from fabrication.cli.common import progress_every as plain_progress_every
-from fabrication.cli.options import BAUD_RATES, Integer, Number, input_argument, machine_options, output_option
+from fabrication.cli.options import Integer, Number, input_argument, machine_options, output_option
 from machines.framing import DEFAULT_FRAME_FEED, framing_lines
 from machines.gcode_program import Program, analyze_program, load_program, program_from_text
 from machines.job_time import estimate_program_time, format_duration
 from machines.job_check import check_job
 from machines.ports import open_port
+from machines.emulator import TIME_SCALE
 from machines.resume import resume_program
+from machines.stream_types import check_baud
 from machines.streamer import GrblStreamer, MachineInfo, StreamError, StreamProgress
 from onestroke.errors import InputError, MachineError
+from onestroke.ranges import Range
 
 
 
@@ -122,9 +125,7 @@ def run_stream(gcode_path, *, port: str, baud: int = 115200, check: bool = False
         program = resume_program(program, from_line)
         warn(f"resuming {path.name} at line {from_line}: lines before it are skipped; the head first moves "
              "there with the beam off - check that the workpiece has not moved")
-    if baud not in BAUD_RATES:
-        raise InputError(f"--baud {baud} is not a serial rate GRBL uses; use one of "
-                         f"{', '.join(map(str, BAUD_RATES))} (GRBL 1.1 default: 115200)")
+    check_baud(baud)
     laser_profile = None
     if profile is not None:
         from machines.laser_profile import load_laser_profile
@@ -221,7 +222,7 @@ def run_stream(gcode_path, *, port: str, baud: int = 115200, check: bool = False
               help="Attach without resetting the controller (refused while it runs a job); default: soft reset.")
 @click.option("--allow-settings", is_flag=True,
               help="Let '$' commands of the file through (e.g. $32=1); otherwise the pre-check refuses them.")
-@click.option("--from-line", type=Integer(1, 100_000_000), default=None,
+@click.option("--from-line", type=Integer(Range(1, 100_000_000)), default=None,
               help="Resume at this file line after a failure (the head moves there with the beam off).")
 def stream(gcode: str, port: str, baud: int, check: bool, frame: bool, profile_path: str | None,
            no_reset: bool, allow_settings: bool, from_line: int | None) -> None:
@@ -234,7 +235,7 @@ def stream(gcode: str, port: str, baud: int, check: bool, frame: bool, profile_p
 
 
 @click.command("emulator")
-@click.option("--speed", type=Number(0.0, 1000.0, low_open=True), default=1.0, show_default=True,
+@click.option("--speed", type=Number(TIME_SCALE), default=1.0, show_default=True,
               help="Time scale, above 0 to 1000 (1 = a real machine's pace).")
 @output_option(flags=("--log",), dest="log_path", required=False,
                help="On exit, write every line the emulator executed to this file.")

@@ -8,14 +8,19 @@ import time
 import click
 
 from fabrication.cli.common import console, done
+from fabrication.cli.options import Integer
 from onestroke.atomic import check_writable
 from onestroke.errors import InputError
 from onestroke.paths import check_distinct
+from onestroke.ranges import Range
+
+PORT = Range(0, 65535, name="--port", integer=True)
 
 
 @click.command()
 @click.argument("source", type=click.Path(path_type=str))
-@click.option("--port", type=int, default=0, show_default=True, help="Port on 127.0.0.1 (0: any free port).")
+@click.option("--port", type=Integer(PORT), default=0, show_default=True,
+              help=f"Port on 127.0.0.1, {PORT.span()} (0: any free port).")
 @click.option("--no-browser", is_flag=True, help="Print the page's address instead of opening a browser.")
 @click.option("--edits", "edits_path", default=None, type=click.Path(dir_okay=False, path_type=str),
               help="The edits file the page loads and saves [default: DRAWING.edits.json beside the drawing].")
@@ -31,8 +36,6 @@ def studio(source: str, port: int, no_browser: bool, edits_path: str | None, pro
     from fabrication.studio.server import StudioServer
     from fabrication.studio.session import StudioSession
 
-    if not 0 <= port <= 65535:
-        raise InputError(f"--port {port} must be between 0 and 65535")
     check_distinct(inputs=[("input", source), ("--profile", profile_path)], outputs=[("--edits file", edits_path)])
     session = StudioSession(source, edits_path=edits_path, profile=profile_path, classifier=classifier,
                             precompute=True)

@@ -17,13 +17,20 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from fabrication.embroidery.needles import BODY, MOTIF, NeedlePoints
-from fabrication.embroidery.running import (DENSE_TOLERANCE, TOLERANCE_RESERVE, RunningOptions,
-                                            refine_to_tolerance, stitch_lengths_along)
+from fabrication.embroidery.needles import BODY, GRID, MOTIF, NeedlePoints
+from fabrication.embroidery.running import (CORNER_ANGLE, DENSE_TOLERANCE, STITCH_LENGTH, TOLERANCE,
+                                            TOLERANCE_RESERVE, RunningOptions, refine_to_tolerance,
+                                            stitch_lengths_along)
 from fabrication.embroidery.sampling import dense_curve
+from fabrication.embroidery.zigzag import SPACING, STITCH_WIDTH
 from onestroke.errors import InputError
+from onestroke.ranges import Range, check_ranges, ranged
 from vectorize.stroke import Stroke
 
+
+# Arm length along the curve; and the smallest motif, as a fraction of full size.
+ARROW_SIZE = Range(GRID, 20.0, unit="mm", name="--arrow-size")
+MIN_SCALE = Range(0.0, 1.0, name="arrow min_scale", low_open=True)
 
 @dataclass(frozen=True, kw_only=True)
 class ArrowOptions:
@@ -34,26 +41,21 @@ class ArrowOptions:
     tight_radius x size; shift: distance along the curve between the three holes at a
     tip, mm."""
 
-    size: float = 2.0
-    width: float = 2.5
-    spacing: float = 5.0
-    stitch_length: float = 2.5
-    tolerance: float = 0.2
-    corner_angle: float = 45.0
-    min_scale: float = 0.4
+    size: float = ranged(2.0, ARROW_SIZE)
+    width: float = ranged(2.5, STITCH_WIDTH)
+    spacing: float = ranged(5.0, SPACING)
+    stitch_length: float = ranged(2.5, STITCH_LENGTH)
+    tolerance: float = ranged(0.2, TOLERANCE)
+    corner_angle: float = ranged(45.0, CORNER_ANGLE)
+    min_scale: float = ranged(0.4, MIN_SCALE)
     tight_radius: float = 1.5
     shift: float = 0.35
 
     def __post_init__(self) -> None:
-        for name in ("size", "width", "spacing"):
-            if not getattr(self, name) > 0:
-                raise InputError(f"arrow {name} {getattr(self, name):g} mm must be greater than zero")
+        check_ranges(self)
         if not self.spacing > self.size:
-            raise InputError(f"arrow spacing {self.spacing:g} mm must exceed the arrow size "
-                             f"{self.size:g} mm, or the motifs overlap")
-        if not 0 < self.min_scale <= 1:
-            raise InputError(f"arrow min_scale {self.min_scale:g} must lie in (0, 1]")
-        self.running  # validates the centre walk
+            raise InputError(f"--spacing {self.spacing:g} mm must exceed --arrow-size {self.size:g} mm, "
+                             "or the motifs overlap")
 
     @property
     def running(self) -> RunningOptions:

@@ -36,6 +36,17 @@ _JEF_HOOP_OFFSET = 0x20  # int32 after the offsets, 0x14, the date, 2 pad bytes 
 PES_VERSIONS = (1, 6)
 
 
+def check_pes_version(version, extension: str) -> int | None:
+    """`version` (None: the default, 6) when it suits a file of `extension` ("pes", ...)."""
+    if version is None:
+        return None
+    if extension != "pes":
+        raise InputError(f"--pes-version applies to .pes output only, not .{extension}")
+    if isinstance(version, bool) or version not in PES_VERSIONS:
+        raise InputError(f"--pes-version {version} is not supported; use 1 or 6")
+    return int(version)
+
+
 def plan_units(plan: StitchPlan) -> np.ndarray:
     """Plan points as integer 0.1 mm units (N, 2); exact for a plan on the 0.1 mm grid."""
     return np.rint(plan.points * 10.0).astype(np.int64)
@@ -128,11 +139,7 @@ def check_plan_fits_format(plan: StitchPlan, fmt: EmbroideryFormat) -> None:
 
 def embroidery_bytes(plan: StitchPlan, fmt: EmbroideryFormat, *, pes_version: int | None = None) -> bytes:
     """The file content of `plan` in format `fmt`."""
-    if pes_version is not None:
-        if fmt.extension != "pes":
-            raise InputError(f"a PES version applies to .pes files only, not .{fmt.extension}")
-        if pes_version not in PES_VERSIONS:
-            raise InputError(f"PES version {pes_version!r} is not supported; use 1 or 6")
+    check_pes_version(pes_version, fmt.extension)
     settings = {**writer_settings(plan, fmt, pes_version=pes_version), "encode": False}
     check_plan_fits_format(plan, fmt)
     if plan.color_changes + 1 > fmt.max_colors:

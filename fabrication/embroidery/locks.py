@@ -13,6 +13,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from onestroke.errors import InputError
+from onestroke.ranges import Range, check_ranges, ranged
 from vectorize.graph import arc_lengths
 
 # Positions of the lock's needle points, as fractions of the lock length back from the
@@ -23,18 +24,19 @@ LOCK_FORMS: dict[str, tuple[float, ...]] = {
 }
 
 
+LOCK_LENGTH = Range(0.0, None, unit="mm", name="lock length", low_open=True)
+
 @dataclass(frozen=True, kw_only=True)
 class LockOptions:
     """form: a key of LOCK_FORMS; length: how far back along the path a lock reaches, mm."""
 
     form: str = "half"
-    length: float = 1.5
+    length: float = ranged(1.5, LOCK_LENGTH)
 
     def __post_init__(self) -> None:
+        check_ranges(self)
         if self.form not in LOCK_FORMS:
             raise InputError(f"unknown lock form {self.form!r}; use one of {', '.join(LOCK_FORMS)}")
-        if not self.length > 0:
-            raise InputError(f"lock length {self.length:g} mm must be greater than zero")
 
 
 def walk_back(path: np.ndarray, distances: np.ndarray) -> np.ndarray:

@@ -13,6 +13,11 @@ import numpy as np
 BODY, TACK, LOCK, UNDERLAY, TRAVEL, MOTIF = range(6)
 ROLE_NAMES = ("body", "tack", "lock", "underlay", "travel", "motif")
 
+# The files' coordinate step (pyembroidery's units), mm: no length under it can be sewn;
+# and the longest stitch any format stores, mm (DST's records hold 12.1 mm: longer ones are
+# split there).
+GRID, LONGEST_STITCH = 0.1, 12.7
+
 # Half the diagonal of one 0.1 mm grid cell: how far snapping to pyembroidery's units can
 # move a needle point. Generators keep this much of every geometric tolerance in reserve
 # so that the guarantees hold for the points actually written.

@@ -19,10 +19,13 @@ from fabrication.embroidery.plan import FIXED_DATE, PlanOptions, StitchPlan, pla
 from fabrication.embroidery.stats import EmbroideryStats, embroidery_stats
 from fabrication.embroidery.zigzag import ZigzagOptions
 from fabrication.placement import PlacementOptions, place
-from machines.hoops import Hoop, hoop_named
+from machines.hoops import SPM, Hoop, hoop_named
 from onestroke.errors import InputError
+from onestroke.ranges import Range, check_ranges, ranged
 from vectorize.drawing import Drawing
 
+
+TRIM_SECONDS = Range(0.0, None, unit="s", name="trim time")
 
 @dataclass(frozen=True, kw_only=True)
 class EmbroideryJob:
@@ -36,18 +39,15 @@ class EmbroideryJob:
     hoop: Hoop = field(default_factory=lambda: hoop_named("100x100"))
     fit: bool = False
     plan: PlanOptions = field(default_factory=PlanOptions)
-    stitches_per_minute: float = 600.0
-    trim_seconds: float = 10.0
+    stitches_per_minute: float = ranged(600.0, SPM)
+    trim_seconds: float = ranged(10.0, TRIM_SECONDS)
     name: str = "onestroke"
     date: str = FIXED_DATE
 
     def __post_init__(self) -> None:
+        check_ranges(self)
         if not re.fullmatch(r"\d{14}", str(self.date)):
             raise InputError(f"date {self.date!r} must be YYYYMMDDhhmmss")
-        if not self.stitches_per_minute > 0:
-            raise InputError(f"stitches per minute {self.stitches_per_minute:g} must be greater than zero")
-        if not self.trim_seconds >= 0:
-            raise InputError(f"trim time {self.trim_seconds:g} s must be >= 0")
 
 
 @dataclass(frozen=True, eq=False)

@@ -22,15 +22,16 @@ import numpy as np
 
 from fabrication.embroidery.arrows import ArrowOptions, arrow_stitch
 from fabrication.embroidery.locks import LockOptions, lock_points, tack_points
-from fabrication.embroidery.needles import (BODY, LOCK, MOTIF, TACK, TRAVEL, UNDERLAY,
-                                            NeedlePoints)
+from fabrication.embroidery.needles import (BODY, GRID, LOCK, LONGEST_STITCH, MOTIF, TACK, TRAVEL,
+                                            UNDERLAY, NeedlePoints)
 from fabrication.embroidery.order import Start, check_start, sewing_order
-from fabrication.embroidery.running import RunningOptions, running_stitch
+from fabrication.embroidery.running import STITCH_LENGTH, RunningOptions, running_stitch
 from fabrication.embroidery.thread import RGB, Thread, check_chart
 from fabrication.embroidery.triple import TripleOptions, triple_stitch
 from fabrication.embroidery.zigzag import ZigzagOptions, zigzag_stitch
 from onestroke.errors import FabricationError, InputError
 from onestroke.progress import ProgressCallback, Stage
+from onestroke.ranges import Range, check_ranges, ranged
 from vectorize.drawing import Drawing
 from vectorize.stroke import Stroke
 
@@ -59,17 +60,30 @@ _GENERATORS: dict[type, Callable[[Stroke, object, float], NeedlePoints]] = {
     ArrowOptions: lambda stroke, o, offset: arrow_stitch(stroke, o, offset=offset),
 }
 
+# Design-wide rules, mm (a stitch under one grid step is no stitch in the files).
+MIN_STITCH = Range(GRID, 3.0, unit="mm", name="--min-stitch")
+MAX_STITCH = Range(1.0, LONGEST_STITCH, unit="mm", name="--max-stitch")
+TRIM_DISTANCE = Range(0.0, 1000.0, unit="mm", name="--trim-distance")
+MIN_STROKE = Range(0.0, 100.0, unit="mm", name="--min-stroke")
+GRID_STEP = Range(0.0, None, unit="mm", name="grid", low_open=True)
+
 # Needle points the min-stitch rule may drop: body points, never tacks or locks.
 _DROPPABLE = np.zeros(8, dtype=bool)
 _DROPPABLE[[BODY, UNDERLAY, MOTIF, TRAVEL]] = True
 
 
-def style_options(name: str, **values) -> StyleOptions:
-    """Options of the style `name` ('running', 'triple', 'zigzag', 'arrows'); `values` that
-    are None are left at the style's default."""
+def style_class(name: str) -> type:
+    """The options class of the style `name` ('running', 'triple', 'zigzag', 'arrows')."""
     cls = STYLES.get(str(name).lower())
     if cls is None:
         raise InputError(f"unknown stitch style {name!r}; use one of {', '.join(STYLES)}")
+    return cls
+
+
+def style_options(name: str, **values) -> StyleOptions:
+    """Options of the style `name` ('running', 'triple', 'zigzag', 'arrows'); `values` that
+    are None are left at the style's default."""
+    cls = style_class(name)
     fields = cls.__dataclass_fields__
     return cls(**{k: v for k, v in values.items() if v is not None and k in fields})
 
@@ -97,34 +111,29 @@ class PlanOptions:
 
     style: StyleOptions = field(default_factory=RunningOptions)
     lock: LockOptions = field(default_factory=LockOptions)
-    min_stitch: float = 0.3
-    max_stitch: float = 12.1
-    trim_distance: float = 3.0
-    min_stroke: float = 1.0
+    min_stitch: float = ranged(0.3, MIN_STITCH)
+    max_stitch: float = ranged(12.1, MAX_STITCH)
+    trim_distance: float = ranged(3.0, TRIM_DISTANCE)
+    min_stroke: float = ranged(1.0, MIN_STROKE)
     color: RGB = (0, 0, 0)
     colors: tuple[RGB, ...] = ()
     thread_chart: str | None = None
     start: Start = None
-    grid: float = 0.1
+    grid: float = ranged(GRID, GRID_STEP)
 
     def __post_init__(self) -> None:
+        check_ranges(self)
         if type(self.style) not in _GENERATORS:
             raise InputError(f"unknown stitch style options {type(self.style).__name__}")
         if not self.min_stitch >= self.grid:
-            raise InputError(f"minimum stitch {self.min_stitch:g} mm must be at least {self.grid:g} mm")
-        if not self.max_stitch >= 1.0:
-            raise InputError(f"maximum stitch {self.max_stitch:g} mm must be at least 1 mm")
+            raise InputError(f"--min-stitch {self.min_stitch:g} mm must be at least the grid {self.grid:g} mm")
         if not self.max_stitch > 2 * self.min_stitch:
-            raise InputError(f"maximum stitch {self.max_stitch:g} mm must exceed twice the minimum "
+            raise InputError(f"--max-stitch {self.max_stitch:g} mm must exceed twice --min-stitch "
                              f"{self.min_stitch:g} mm")
-        if not self.trim_distance >= 0:
-            raise InputError(f"trim distance {self.trim_distance:g} mm must be >= 0")
-        if not 0 <= self.min_stroke <= 100:
-            raise InputError(f"minimum stroke {self.min_stroke:g} mm must lie in [0, 100] mm")
         walk = getattr(self.style, "stitch_length", None)
         if walk is not None and walk < self.min_stitch:
-            raise InputError(f"stitch length {walk:g} mm is shorter than the minimum stitch "
-                             f"{self.min_stitch:g} mm; every stitch would be merged away")
+            raise InputError(f"--stitch-length {walk:g} mm is shorter than --min-stitch {self.min_stitch:g} mm, "
+                             "so every stitch would be merged away; lengthen it or lower --min-stitch")
         for rgb in (self.color, *self.colors):
             Thread(color=rgb)  # validates
         if self.thread_chart is not None:
@@ -267,7 +276,8 @@ def _chain_points(drawing: Drawing, chain: list[int], options: PlanOptions, offs
         if stroke.length >= options.min_stroke:
             body = generate(stroke, options.style, offset)
         else:
-            walk = running_stitch(stroke, RunningOptions(stitch_length=max(options.min_stroke, 0.5)))
+            length = min(max(options.min_stroke, 0.5), STITCH_LENGTH.high)  # one stitch, or the longest
+            walk = running_stitch(stroke, RunningOptions(stitch_length=length))
             body = NeedlePoints.of(walk.points, walk.t, TRAVEL)
         offset += stroke.length
         parts.append(body)

@@ -21,6 +21,7 @@ from fabrication.embroidery.plan import JUMP, STITCH, TRIM, StitchPlan
 from fabrication.embroidery.stats import EmbroideryStats
 from machines.hoops import Hoop
 from onestroke.errors import InputError
+from onestroke.ranges import Range, check_ranges, ranged
 from vectorize.drawing import Drawing
 from vectorize.graph import arc_lengths
 
@@ -33,6 +34,8 @@ JUMP_COLOR = (110, 110, 110)
 TRIM_COLOR = (220, 30, 30)
 HOOP_COLOR = (90, 90, 90)
 PREVIEW_STYLES = ("realistic", "diagnostic")
+PREVIEW_WIDTH = Range(64, 8000, unit="px", name="--preview-width", integer=True)
+MARGIN = Range(0.0, None, unit="mm", name="preview margin")
 # Realistic style: a 40 wt thread lies about 0.4 mm wide; light comes from the top left.
 REAL_THREAD_WIDTH = 0.4
 FABRIC_COLOR = (233, 226, 211)  # unbleached cotton
@@ -46,18 +49,15 @@ class PreviewOptions:
     stats box (diagnostic style); style: 'realistic' or 'diagnostic'; hoop: draw the
     hoop outline when one is given (the diagnostic style always does)."""
 
-    width: int = 1000
-    margin: float = 4.0
+    width: int = ranged(1000, PREVIEW_WIDTH)
+    margin: float = ranged(4.0, MARGIN)
     needles: bool = True
     stats: bool = True
     style: str = "realistic"
     hoop: bool = False
 
     def __post_init__(self) -> None:
-        if not (isinstance(self.width, int) and 64 <= self.width <= 8000):
-            raise InputError(f"preview width {self.width!r} px must be an integer from 64 to 8000")
-        if not self.margin >= 0:
-            raise InputError(f"preview margin {self.margin:g} mm must be >= 0")
+        check_ranges(self)
         if self.style not in PREVIEW_STYLES:
             raise InputError(f"preview style {self.style!r} is not one of {', '.join(PREVIEW_STYLES)}")
 

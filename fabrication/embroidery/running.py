@@ -12,10 +12,16 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from fabrication.embroidery.needles import BODY, SNAP_ALLOWANCE, NeedlePoints
+from fabrication.embroidery.needles import BODY, GRID, LONGEST_STITCH, SNAP_ALLOWANCE, NeedlePoints
 from fabrication.embroidery.sampling import DenseCurve, dense_curve
-from onestroke.errors import InputError
+from onestroke.ranges import Range, check_ranges, ranged
 from vectorize.stroke import Stroke
+
+# The stitch a walk aims at, from one step of the files' grid to the longest stitch stored.
+STITCH_LENGTH = Range(GRID, LONGEST_STITCH, unit="mm", name="--stitch-length")
+# Largest chord-to-curve distance: under one grid step the files cannot follow it.
+TOLERANCE = Range(GRID, 5.0, unit="mm", name="--tolerance")
+CORNER_ANGLE = Range(0.0, 180.0, unit="degrees", name="corner angle", low_open=True, high_open=True)
 
 # Dense sampling tolerance (mm): small against every stitch tolerance we accept. The curve
 # strays at most this far from the dense polyline on which chord errors are measured, so
@@ -29,18 +35,12 @@ class RunningOptions:
     """stitch_length: target stitch in mm; tolerance: largest chord-to-curve distance in mm;
     corner_angle: turns sharper than this (degrees) always get a needle point."""
 
-    stitch_length: float = 2.5
-    tolerance: float = 0.2
-    corner_angle: float = 45.0
+    stitch_length: float = ranged(2.5, STITCH_LENGTH)
+    tolerance: float = ranged(0.2, TOLERANCE)
+    corner_angle: float = ranged(45.0, CORNER_ANGLE)
 
     def __post_init__(self) -> None:
-        if not self.stitch_length > 0:
-            raise InputError(f"stitch length {self.stitch_length:g} mm must be greater than zero")
-        if not self.tolerance >= 0.1:
-            raise InputError(f"chord tolerance {self.tolerance:g} mm must be at least 0.1 mm "
-                             "(the files store 0.1 mm steps)")
-        if not 0 < self.corner_angle < 180:
-            raise InputError(f"corner angle {self.corner_angle:g} must lie between 0 and 180 degrees")
+        check_ranges(self)
 
 
 def chord_deviation(curve: DenseCurve, s_stitch: np.ndarray, points: np.ndarray) -> np.ndarray:

@@ -18,10 +18,14 @@ from dataclasses import dataclass
 import numpy as np
 
 from fabrication.embroidery.needles import BODY, NeedlePoints
-from fabrication.embroidery.running import DENSE_TOLERANCE, RunningOptions, running_stitch
+from fabrication.embroidery.running import (CORNER_ANGLE, DENSE_TOLERANCE, STITCH_LENGTH, TOLERANCE,
+                                            RunningOptions, running_stitch)
 from fabrication.embroidery.sampling import dense_curve
-from onestroke.errors import InputError
+from onestroke.ranges import Range, check_ranges, ranged
 from vectorize.stroke import Stroke
+
+REPEATS = Range(1, 5, name="--repeats", integer=True)
+SHIFT = Range(0.2, 2.0, unit="mm", name="triple-stitch shift")
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -29,18 +33,14 @@ class TripleOptions:
     """Running-stitch placement (mm, degrees) plus `repeats` back-and-forth passes and
     `shift`: how far (mm, along the curve) the holes of the passes lie from each other."""
 
-    stitch_length: float = 2.5
-    tolerance: float = 0.2
-    corner_angle: float = 45.0
-    repeats: int = 1
-    shift: float = 0.35
+    stitch_length: float = ranged(2.5, STITCH_LENGTH)
+    tolerance: float = ranged(0.2, TOLERANCE)
+    corner_angle: float = ranged(45.0, CORNER_ANGLE)
+    repeats: int = ranged(1, REPEATS)
+    shift: float = ranged(0.35, SHIFT)
 
     def __post_init__(self) -> None:
-        if not (isinstance(self.repeats, int) and 1 <= self.repeats <= 5):
-            raise InputError(f"triple-stitch repeats {self.repeats!r} must be an integer from 1 to 5")
-        if not 0.2 <= self.shift <= 2.0:
-            raise InputError(f"triple-stitch shift {self.shift:g} mm must lie in [0.2, 2] mm")
-        self.running  # validates the running-stitch part
+        check_ranges(self)
 
     @property
     def running(self) -> RunningOptions:

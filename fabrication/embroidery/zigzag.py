@@ -25,11 +25,23 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from fabrication.embroidery.needles import BODY, SNAP_ALLOWANCE, UNDERLAY, NeedlePoints
-from fabrication.embroidery.running import DENSE_TOLERANCE, RunningOptions, running_stitch
+from fabrication.embroidery.needles import BODY, GRID, SNAP_ALLOWANCE, UNDERLAY, NeedlePoints
+from fabrication.embroidery.running import (DENSE_TOLERANCE, STITCH_LENGTH, TOLERANCE, RunningOptions,
+                                            running_stitch)
 from fabrication.embroidery.sampling import dense_curve
 from onestroke.errors import InputError
+from onestroke.ranges import Range, check_ranges, ranged
 from vectorize.stroke import Stroke
+
+# Rail to rail, and the arrows' spread (`arrows.ArrowOptions.width`): one --stitch-width.
+STITCH_WIDTH = Range(GRID, 12.0, unit="mm", name="--stitch-width")
+# Peak to peak along the curve, and the arrows' tip to tip: one --spacing.
+SPACING = Range(GRID, 50.0, unit="mm", name="--spacing")
+PULL_COMPENSATION = Range(0.0, 2.0, unit="mm", name="--pull-comp")
+UNDERLAY_INSET = Range(0.0, None, unit="mm", name="underlay inset")
+UNDERLAY_SPACING = Range(0.5, None, unit="mm", name="underlay spacing")
+SHORT_STITCH_INSET = Range(0.0, 1.0, name="short-stitch inset", high_open=True)
+ZIG_MAX_STITCH = Range(1.0, None, unit="mm", name="zigzag max stitch", low_open=True)
 
 # The inside reach stays below this fraction of the curve radius, so inner points never
 # pass the centre of curvature (they would sew loops and run backwards).
@@ -50,32 +62,22 @@ class ZigzagOptions:
     closest two needle points may come on one rail (0.35 mm keeps them >= 0.2 mm apart
     after snapping to the files' 0.1 mm grid); max_stitch: longer zigs are split."""
 
-    width: float = 2.0
-    spacing: float = 0.4
-    pull_compensation: float = 0.2
+    width: float = ranged(2.0, STITCH_WIDTH)
+    spacing: float = ranged(0.4, SPACING)
+    pull_compensation: float = ranged(0.2, PULL_COMPENSATION)
     underlay: bool | str | None = None
     underlay_min_width: float = 1.5
-    underlay_stitch_length: float = 2.0
-    underlay_inset: float = 0.4
-    underlay_spacing: float = 3.0
+    underlay_stitch_length: float = ranged(2.0, STITCH_LENGTH.named("underlay stitch length"))
+    underlay_inset: float = ranged(0.4, UNDERLAY_INSET)
+    underlay_spacing: float = ranged(3.0, UNDERLAY_SPACING)
     short_stitch_distance: float = 0.35
-    short_stitch_inset: float = 0.3
+    short_stitch_inset: float = ranged(0.3, SHORT_STITCH_INSET)
     min_gap: float = 0.35
-    max_stitch: float = 12.1
-    tolerance: float = 0.2
+    max_stitch: float = ranged(12.1, ZIG_MAX_STITCH)
+    tolerance: float = ranged(0.2, TOLERANCE)
 
     def __post_init__(self) -> None:
-        if not self.width > 0:
-            raise InputError(f"zigzag width {self.width:g} mm must be greater than zero")
-        if not self.spacing >= 0.1:
-            raise InputError(f"zigzag spacing {self.spacing:g} mm must be at least 0.1 mm")
-        if not self.pull_compensation >= 0:
-            raise InputError(f"pull compensation {self.pull_compensation:g} mm must be >= 0")
-        if not 0 <= self.short_stitch_inset < 1:
-            raise InputError(f"short-stitch inset {self.short_stitch_inset:g} must lie in [0, 1)")
-        if not self.max_stitch > 1.0:
-            raise InputError(f"max stitch {self.max_stitch:g} mm must be over 1 mm")
-        RunningOptions(stitch_length=self.underlay_stitch_length, tolerance=self.tolerance)
+        check_ranges(self)
         if isinstance(self.underlay, str):
             key = self.underlay.strip().lower().replace("centre", "center")
             if key not in UNDERLAYS:
@@ -83,10 +85,6 @@ class ZigzagOptions:
             object.__setattr__(self, "underlay", key)
         elif self.underlay is not None and not isinstance(self.underlay, bool):
             raise InputError(f"underlay {self.underlay!r} is not one of {', '.join(UNDERLAYS)}")
-        if not self.underlay_inset >= 0:
-            raise InputError(f"underlay inset {self.underlay_inset:g} mm must be >= 0")
-        if not self.underlay_spacing >= 0.5:
-            raise InputError(f"underlay spacing {self.underlay_spacing:g} mm must be at least 0.5 mm")
 
     @property
     def reach(self) -> float:

@@ -21,7 +21,14 @@ from fabrication.laser.toolpath import BurnPath, Toolpath
 from machines.laser_profile import LaserProfile
 from onestroke.atomic import atomic_write_text
 from onestroke.progress import ProgressCallback, Stage
-from onestroke.errors import InputError
+from onestroke.ranges import Range, check_ranges, ranged
+
+# Burn speed: under 1 mm/min the file would say F0, which GRBL refuses.
+FEED = Range(1.0, 100_000.0, unit="mm/min", name="--feed")
+# A fraction of the profile's max S ($30), shown in percent.
+POWER = Range(0.0, 1.0, unit="%", name="--power", low_open=True, scale=100.0)
+# Each pass repeats the whole program: passes bound the file's size and the job's time.
+PASSES = Range(1, 100, name="--passes", integer=True)
 
 MAX_LINE = 80  # GRBL's line buffer; longer lines get error:11
 
@@ -34,20 +41,15 @@ class GcodeOptions:
     profile's setting. dynamic: M4 (True, even burn through corners) or M3 constant power.
     """
 
-    feed: float = 1500.0
-    power: float = 0.6
-    passes: int = 1
+    feed: float = ranged(1500.0, FEED)
+    power: float = ranged(0.6, POWER)
+    passes: int = ranged(1, PASSES)
     return_home: bool = False
     air_assist: bool | None = None
     dynamic: bool = True
 
     def __post_init__(self) -> None:
-        if not (isinstance(self.feed, (int, float)) and self.feed > 0 and np.isfinite(self.feed)):
-            raise InputError(f"feed {self.feed!r} mm/min must be greater than 0")
-        if not (0.0 < self.power <= 1.0):
-            raise InputError(f"power {self.power * 100:g}% must be above 0% and at most 100%")
-        if isinstance(self.passes, bool) or not isinstance(self.passes, int) or self.passes < 1:
-            raise InputError(f"passes {self.passes!r} must be a whole number >= 1")
+        check_ranges(self)
 
 
 def comment_line(text: str) -> str:

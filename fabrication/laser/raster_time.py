@@ -14,12 +14,17 @@ from dataclasses import dataclass
 import numpy as np
 from PIL import Image, ImageDraw
 
+from fabrication.laser.gcode_write import FEED
 from fabrication.laser.toolpath import Toolpath
 from machines.grbl_settings import kinematics_from_profile
 from machines.laser_profile import LaserProfile
 from machines.planner_model import plan_times
 from onestroke.errors import InputError
+from onestroke.ranges import Range
 
+# Row spacing of the compared raster engraving, mm; MAX_PIXELS bounds it from below per job.
+INTERVAL = Range(0.001, 10.0, unit="mm", name="--raster-interval")
+RASTER_FEED = FEED.named("--raster-feed")
 MAX_PIXELS = 40_000_000
 
 
@@ -41,10 +46,8 @@ def raster_time(toolpath: Toolpath, profile: LaserProfile, *, interval: float = 
     line_width: burned line width in mm (default: one interval, the finest line a raster
     of that interval can show).
     """
-    if not interval > 0:
-        raise InputError(f"raster line interval {interval!r} mm must be greater than 0")
-    if not feed > 0:
-        raise InputError(f"raster feed {feed!r} mm/min must be greater than 0")
+    INTERVAL.check(interval)
+    RASTER_FEED.check(feed)
     width_mm = interval if line_width is None else line_width
     xmin, ymin, xmax, ymax = toolpath.bounds
     pad = width_mm

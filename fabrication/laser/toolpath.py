@@ -24,10 +24,14 @@ from fabrication.placement import PlacementOptions, place
 from machines.laser_profile import LaserProfile
 from onestroke.errors import InputError
 from onestroke.progress import ProgressCallback, counted
+from onestroke.ranges import Range, check_ranges, ranged
 from vectorize.drawing import Drawing
 from vectorize.stroke import Stroke
 
 ORIGINS = ("lower-left", "center")
+# Largest distance of the burned path from the drawing: at least 5 G-code quanta (the
+# rounding budget must leave room), at most 1 mm (coarser is no longer the drawing).
+TOLERANCE = Range(0.005, 1.0, unit="mm", name="--tolerance")
 QUANTUM = 0.001  # mm: G-code numbers carry 3 decimals
 _ROUNDING_BUDGET = 0.001  # covers sqrt(2) * QUANTUM / 2 with margin
 
@@ -44,15 +48,14 @@ class ToolpathOptions:
 
     placement: PlacementOptions = PlacementOptions()
     origin: str = "lower-left"
-    tolerance: float = 0.02
+    tolerance: float = ranged(0.02, TOLERANCE)
     arcs: bool = False
     optimize: bool = True
 
     def __post_init__(self) -> None:
+        check_ranges(self)
         if self.origin not in ORIGINS:
             raise InputError(f"origin {self.origin!r} is not one of {', '.join(ORIGINS)}")
-        if not (self.tolerance >= 0.005):
-            raise InputError(f"tolerance {self.tolerance!r} mm must be at least 0.005 mm")
 
 
 @dataclass(frozen=True)

@@ -320,11 +320,6 @@ class StudioSession:
             values["profile_path"] = str(source)
         else:
             values["profile"] = source
-        if "passes" in values:
-            try:
-                values["passes"] = int(str(values["passes"]))
-            except ValueError:
-                raise InputError(f"--passes {values['passes']!r} is not a whole number") from None
         settings = laser_settings(**values)
         drawing = self.vectorize(edits).drawing
         program = laser_program(drawing, settings.profile, settings.toolpath, settings.gcode,
