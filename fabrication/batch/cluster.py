@@ -14,7 +14,7 @@ import contextlib
 import socket
 from collections.abc import Iterator
 
-from fabrication.batch.inputs import BatchItem
+from fabrication.batch.inputs import BatchItem, Todo
 from fabrication.batch.work import BatchJob, FileResult, process_file, warm_up
 from onestroke.errors import FabricationError, InputError
 
@@ -27,9 +27,6 @@ WORKER_SECONDS = 30.0
 # Files handed to the cluster ahead of the results, per worker: keeps workers busy
 # without holding every input's bytes in memory at once.
 DASK_AHEAD = 4
-
-Todo = list[tuple[BatchItem, tuple[str, ...]]]
-
 
 class SchedulerLost(FabricationError):
     """The connection to the Dask scheduler broke while drawings were being made."""

@@ -22,15 +22,12 @@ from collections.abc import Iterator
 from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
 from concurrent.futures.process import BrokenProcessPool
 
-from fabrication.batch.inputs import BatchItem
+from fabrication.batch.inputs import BatchItem, Todo
 from fabrication.batch.work import BatchJob, FileResult, process_file, warm_up
 
 # Times a drawing is tried again after its worker process died while making it.
 RETRIES = 1
 RETRIED = "its worker process died while making it (killed, or out of memory); made again in a fresh one"
-
-Todo = list[tuple[BatchItem, tuple[str, ...]]]
-
 
 @contextlib.contextmanager
 def _interrupts_ignored() -> Iterator[None]:

@@ -17,7 +17,7 @@ import time
 from collections.abc import Callable, Iterator
 from pathlib import Path
 
-from fabrication.batch.inputs import BatchItem
+from fabrication.batch.inputs import BatchItem, Todo
 from fabrication.batch.manifest import Manifest
 from fabrication.batch.report import BatchSummary, FileRecord, ReportRoom, report_paths, write_report
 from fabrication.batch.work import BatchJob, FileResult, process_file
@@ -33,9 +33,6 @@ SAVE_EVERY = 2.0
 # Write errors of the output folder as a whole: every next drawing would fail the same way,
 # so the batch stops (a name too long, a folder in an output's place fail that drawing only).
 STOPS_THE_BATCH = (errno.ENOSPC, errno.EDQUOT, errno.EROFS, errno.EIO, errno.EACCES, errno.EPERM)
-
-Todo = list[tuple[BatchItem, tuple[str, ...]]]
-
 
 def _in_process(todo: Todo, job: BatchJob) -> Iterator[tuple[BatchItem, FileResult]]:
     for item, needed in todo:
