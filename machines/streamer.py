@@ -312,7 +312,7 @@ class GrblStreamer(StreamConnect, StreamStops):
             if self._alarm_locked:
                 raise stop("the machine went into ALARM at the end of the job")
         except KeyboardInterrupt as signal:  # Ctrl-C; SIGTERM and SIGHUP come as onestroke.errors.Interrupted
-            raise stop(f"stopped by {signal or 'Ctrl-C'}", cls=StreamInterrupted, since=time.monotonic()) from None
+            raise stop(f"stopped by {str(signal) or 'Ctrl-C'}", cls=StreamInterrupted, since=time.monotonic()) from None
         except MachineError as error:
             if isinstance(error, StreamError):
                 raise

@@ -119,15 +119,18 @@ def warm_up(job: BatchJob, *, ignore_interrupt: bool = True, parent: int | None 
         die_with_parent(parent)
     if ignore_interrupt:
         signal.signal(signal.SIGINT, signal.SIG_IGN)
-    import fabrication.embroidery.export  # noqa: F401  (pyembroidery and the stitch planner)
-    import fabrication.embroidery.pipeline  # noqa: F401
-    import fabrication.laser.program  # noqa: F401
-    import vectorize.vectorizer  # noqa: F401
+    try:
+        import fabrication.embroidery.export  # noqa: F401  (pyembroidery and the stitch planner)
+        import fabrication.embroidery.pipeline  # noqa: F401
+        import fabrication.laser.program  # noqa: F401
+        import vectorize.vectorizer  # noqa: F401
 
-    if job.vectorize.classifier == "cnn":
-        from vectorize.cnn_classifier import CnnClassifier
+        if job.vectorize.classifier == "cnn":
+            from vectorize.cnn_classifier import CnnClassifier
 
-        CnnClassifier().session  # noqa: B018  (creates the cached onnxruntime session)
+            CnnClassifier().session  # noqa: B018  (creates the cached onnxruntime session)
+    except Exception:  # noqa: BLE001 - only a head start: each drawing's own run reports the error
+        pass
 
 
 def process_file(name: str, job: BatchJob, *, path: str | None = None, data: bytes | None = None,
