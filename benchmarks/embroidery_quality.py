@@ -1,12 +1,17 @@
 """Embroidery quality, measured on files written and read back with pyembroidery.
 
-Run from the repository root: python benchmarks/embroidery_quality.py
-Prints the numbers the acceptance criteria of issue 4 ask for (worst cases over the
-test designs, every style and format).
+Run from the repository root: python benchmarks/embroidery_quality.py [--only density]
+Prints the numbers the acceptance criteria of issues 4 and 27 ask for: worst cases over
+the test designs, every style and format; then, on every benchmark drawing (the bundled
+examples, the test designs, a three-colour SVG, short strokes) and every style, the
+density with every needle point counted and the repeated holes, measured by
+`fabrication.embroidery.quality` (the same functions as the stats' warnings), and whether
+a warning names each place over the limit.
 """
 
 from __future__ import annotations
 
+import argparse
 import sys
 import tempfile
 from pathlib import Path
@@ -17,7 +22,7 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 sys.path.insert(0, str(ROOT / "tests"))
 
-from embroidery_fixtures import FORMATS, STYLE_NAMES, design, lock_figure_ok, spiral, stroke_rows  # noqa: E402
+from embroidery_fixtures import FORMATS, STYLE_NAMES, THREE_COLOURS, design, lock_figure_ok, spiral, stroke_rows  # noqa: E402
 from fabrication.embroidery.export import write_embroidery  # noqa: E402
 from fabrication.embroidery.needles import BODY, LOCK, TACK, UNDERLAY  # noqa: E402
 from fabrication.embroidery.plan import STITCH, PlanOptions, plan_embroidery, style_options  # noqa: E402
@@ -35,8 +40,91 @@ def seg_dist(p, a, b):
     return np.linalg.norm(p - (a + u[:, None] * ab), axis=1)
 
 
+EXAMPLES = ("closed-drawing.png", "hershey-HersheySans1-ampersand.png", "hershey-HersheySans1-eight.png",
+            "loop-drawing.png", "loops.png", "shallow-crossing-drawing.png", "spike-drawing.png",
+            "touch-drawing.png", "embroidery/wave.svg")
+def _short_strokes() -> Drawing:
+    """1.2 mm strokes (just above --min-stroke) at six angles, 6 mm apart, and a long line."""
+    strokes = []
+    for k, angle in enumerate(range(0, 180, 30)):
+        u = np.array([np.cos(np.radians(angle)), np.sin(np.radians(angle))])
+        start = np.array([6.0 * k, 0.0])
+        strokes.append(Stroke.from_polyline(np.array([start, start + 1.2 * u])))
+    strokes.append(Stroke.from_polyline(np.array([[0.0, 10.0], [30.0, 10.0]])))
+    return Drawing(tuple(strokes), 32, 12, "mm")
+
+
+def benchmark_drawings(folder: str) -> dict[str, tuple[Drawing, float | None]]:
+    """Name -> (drawing, size in mm or None to sew it at its own size in mm)."""
+    from vectorize import VectorizeOptions, vectorize_file
+
+    drawings = {name: (vectorize_file(str(ROOT / "examples" / name), VectorizeOptions()).drawing, 90.0)
+                for name in EXAMPLES}
+    svg = Path(folder) / "rgb3.svg"
+    svg.write_text(THREE_COLOURS)  # tests/test_embroidery_threads.py's drawing
+    drawings["rgb3.svg"] = (vectorize_file(str(svg), VectorizeOptions()).drawing, 90.0)
+    drawings["test design"] = (design(), None)
+    drawings["tight spiral"] = (Drawing((spiral(0, 0, 2.0, 9.0, 3.0, n=48),), 20, 20, "mm"), None)
+    drawings["hairpin 0.8 mm"] = (Drawing((Stroke.from_polyline(np.array([[0, 0], [20, 0], [20, 0.8],
+                                                                           [0, 0.8]])),), 20, 1, "mm"), None)
+    drawings["1.2 mm strokes"] = (_short_strokes(), None)
+    return drawings
+
+
+def density_and_holes(folder: str) -> None:
+    """Every benchmark drawing x every style through the whole job (`embroider`): density
+    with every needle point counted, repeated holes, and whether the warnings name them."""
+    from fabrication.embroidery.pipeline import EmbroideryJob, embroider
+    from fabrication.embroidery.quality import DENSITY_LIMIT, needle_density, repeated_holes
+    from fabrication.placement import PlacementOptions
+
+    hoop = hoop_named("200x200")
+    print(f"\n{'drawing':36} {'style':8} {'needles':>7} {'density':>7} {'holes':>5} {'ties lighter':>12} "
+          f"{'box off':>7} {'curve-centred off':>17}  warned")
+    worst, holes_total, unwarned, offsets, curve_offsets = 0, 0, 0, [], []
+    for name, (drawing, size) in benchmark_drawings(folder).items():
+        for style in STYLE_NAMES:
+            placement = PlacementOptions(size=size) if size else PlacementOptions(size=max(drawing.width, drawing.height))
+            job = EmbroideryJob(placement=placement, hoop=hoop, plan=PlanOptions(style=style_options(style)))
+            result = embroider(drawing, job)
+            plan = result.plan
+            density = needle_density(plan.points[plan.kinds == STITCH])
+            holes = len(repeated_holes(plan))
+            assert density.maximum == result.stats.max_density  # one measure, the stats' own
+            named = all(str(p) in " ".join(result.warnings) for p in density.places)
+            hole_named = holes == 0 or any("re-enter a hole" in w for w in result.warnings)
+            warned = ("-" if density.maximum <= DENSITY_LIMIT and not holes else
+                      "yes" if named and hole_named else "NO")
+            unwarned += warned == "NO"
+            worst, holes_total = max(worst, density.maximum), holes_total + holes
+            x0, y0, x1, y1 = plan.bounds()
+            off = float(np.hypot((x0 + x1) / 2, (y0 + y1) / 2))
+            # What the old centring (the curve's box) left: the same plan, not moved.
+            raw = plan_embroidery(result.drawing, PlanOptions(style=style_options(style)))
+            # result.drawing moved with the stitches; the curve's own box centre is the old frame.
+            cx0, cy0, cx1, cy1 = result.drawing.bounds()
+            rx0, ry0, rx1, ry1 = raw.bounds()
+            curve_off = float(np.hypot((rx0 + rx1) / 2 - (cx0 + cx1) / 2, (ry0 + ry1) / 2 - (cy0 + cy1) / 2))
+            offsets.append(off)
+            curve_offsets.append(curve_off)
+            print(f"{name:36} {style:8} {len(plan.points[plan.kinds == STITCH]):7d} {density.maximum:7d} "
+                  f"{holes:5d} {len(plan.lighter):12d} {off:7.3f} {curve_off:17.3f}  {warned}")
+    print(f"worst density, every needle point counted: {worst} within 0.5 mm (limit {DENSITY_LIMIT}); "
+          f"repeated holes in all: {holes_total}; places over the limit or with holes and no warning "
+          f"naming them: {unwarned}")
+    print(f"stitches' box centre from (0, 0): max {max(offsets):.3f} mm (curve-centred, as before: max "
+          f"{max(curve_offsets):.3f} mm)")
+
+
 def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--only", choices=["density"], default=None,
+                        help="only the density and repeated holes of every benchmark drawing")
+    args = parser.parse_args()
     folder = tempfile.mkdtemp()
+    density_and_holes(folder)
+    if args.only:
+        return
     hoop = hoop_named("100x100")
     drawing = design()
     worst_err = worst_axis = 0.0
@@ -108,7 +196,7 @@ def main() -> None:
             np.fill_diagonal(d, np.inf)
             gaps.append(float(d.min()))
     print(f"zigzag: closest two needle points on inner curves  {min(gaps):.3f} mm  (radius 1.5-5 mm, width 2-3 mm)")
-    stats = embroidery_stats(plan_embroidery(drawing, PlanOptions(style=style_options("zigzag"))))
+    stats = embroidery_stats(plan_embroidery(drawing, PlanOptions(style=style_options("zigzag"))), column=True)
     print("zigzag design stats: " + "; ".join(line.split(None, 1)[0] + " " + line.split(None, 1)[1].strip()
                                               for line in stats.lines()))
 

@@ -85,7 +85,8 @@ def merge_scaling() -> None:
     """Short-stitch merging on rows that nearly all merge (what a 0.0001 mm stitch length
     used to make): the time must grow in proportion to the rows, not their square."""
     from fabrication.embroidery.needles import BODY, LOCK
-    from fabrication.embroidery.plan import STITCH, _merge_short
+    from fabrication.embroidery.grid import merge_short as _merge_short
+    from fabrication.embroidery.needles import STITCH
 
     print(f"\n{'rows':>9} {'merge s':>8} {'us/row':>7}   (every stitch 0.1 grid unit, minimum 3 units)")
     for n in (10_000, 100_000, 1_000_000):

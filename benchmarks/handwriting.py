@@ -132,8 +132,10 @@ def _wobble(rng: np.random.Generator, s: np.ndarray, amplitude: float) -> np.nda
     return out * amplitude / max(np.linalg.norm(out, axis=1).max(), 1e-9)
 
 
-def _mouse_trace(rng: np.random.Generator, stroke: Stroke, cusp_lengths: np.ndarray, width: float) -> np.ndarray:
-    """The stroke as a mouse or tablet records it (module doc): jittered samples, px."""
+def _mouse_trace(rng: np.random.Generator, stroke: Stroke, cusp_lengths: np.ndarray, width: float,
+                 wobble: float = 0.4) -> np.ndarray:
+    """The stroke as a mouse or tablet records it (module doc): jittered samples, px; the slow
+    wobble is at most `wobble` widths."""
     s, steps = [0.0], 0
     speed = rng.uniform(3.0, 7.0)
     while s[-1] < stroke.length:
@@ -141,10 +143,46 @@ def _mouse_trace(rng: np.random.Generator, stroke: Stroke, cusp_lengths: np.ndar
         speed = float(np.clip(speed + rng.normal(0.0, 0.5), 3.0, 7.0))
         s.append(s[-1] + speed)
     s = np.unique(np.clip(np.concatenate([s, cusp_lengths, [stroke.length]]), 0.0, stroke.length))
-    pts = stroke.points_at_lengths(s) + _wobble(rng, s, 0.4 * width)
+    pts = stroke.points_at_lengths(s) + _wobble(rng, s, wobble * width)
     pts = np.round(pts + rng.normal(0.0, 0.3, pts.shape))
     keep = np.r_[True, np.any(np.diff(pts, axis=0) != 0, axis=1)]
     return pts[keep]
+
+
+def on_the_page(runs: list[np.ndarray], slant: float, turn: float, room: float,
+                max_scale: float) -> tuple[list[np.ndarray], float]:
+    """Runs in x-height units (y up) slanted (x += slant * y), flipped (y down on the page),
+    turned by `turn` radians, scaled to fit `room` px (at most `max_scale` px per x-height)
+    and centred on the canvas: (runs px, px per x-height)."""
+    c, s_ = np.cos(turn), np.sin(turn)
+    shape = np.array([[c, -s_], [s_, c]]) @ np.array([[1.0, slant], [0.0, -1.0]])
+    pts = np.concatenate(runs) @ shape.T
+    lo, hi = pts.min(axis=0), pts.max(axis=0)
+    scale = min(room / (hi - lo).max(), max_scale)
+    offset = np.array([CANVAS / 2, CANVAS / 2]) - scale * (lo + hi) / 2
+    return [r @ (scale * shape).T + offset for r in runs], float(scale)
+
+
+def retraced_runs(runs: list[np.ndarray]) -> list[int]:
+    """Indices of the runs that go back exactly over the run before them (a retraced stem)."""
+    return [k for k in range(1, len(runs)) if len(runs[k]) == 2 and len(runs[k - 1]) == 2
+            and np.array_equal(runs[k - 1][::-1], runs[k])]
+
+
+def traced_crossings(trace: np.ndarray, stroke: Stroke, clean: Stroke, clean_poly: np.ndarray,
+                     retraced_zones: list, width: float) -> tuple[np.ndarray, tuple, tuple]:
+    """The crossings of a traced word ((n, 2) px), their events and the don't-care zones: the
+    retraced stems' zones given, narrow cusps, passes within one width without a crossing, and
+    loops too small to hold paper. Crossings of the jittered passes of a retraced stem or a
+    cusp are not crossings of the word."""
+    inter = polyline_intersections([trace], [False])
+    dont_care = list(retraced_zones) + _sharp_turns(clean_poly, False, width)
+    dont_care += merged_without_crossing(clean, False, width, polyline_intersections([clean_poly], [False]).crossings)
+    dont_care += tiny_loop_crossings(stroke, False, width, inter.crossings)
+    real = ~dont_care_mask(inter.crossings, dont_care, max(MATCH_DISTANCE, width))
+    crossings, angles = inter.crossings[real], inter.crossing_angles[real]
+    events = tuple(Event("crossing", p, float(a)) for p, a in zip(crossings, angles))
+    return crossings.reshape(-1, 2), events, tuple(dont_care)
 
 
 def handwriting_drawing(seed: int, index: int) -> GroundTruth:
@@ -154,35 +192,19 @@ def handwriting_drawing(seed: int, index: int) -> GroundTruth:
     width = float(np.round(rng.uniform(3.0, 8.0) * 4) / 4)
     runs = word_runs(word)
     slant = rng.uniform(0.1, 0.35)
-    turn = np.radians(rng.uniform(-5.0, 5.0))
-    c, s_ = np.cos(turn), np.sin(turn)
-    # slant (x += slant * y), flip y (down on the page), rotate a little
-    shape = np.array([[c, -s_], [s_, c]]) @ np.array([[1.0, slant], [0.0, -1.0]])
-    pts = np.concatenate(runs) @ shape.T
-    lo, hi = pts.min(axis=0), pts.max(axis=0)
-    room = CANVAS - 2 * (MARGIN + width + 10)
-    scale = min(room / (hi - lo).max(), 170.0)
-    offset = np.array([CANVAS / 2, CANVAS / 2]) - scale * (lo + hi) / 2
-    runs = [r @ (scale * shape).T + offset for r in runs]
+    runs, scale = on_the_page(runs, slant, np.radians(rng.uniform(-5.0, 5.0)), CANVAS - 2 * (MARGIN + width + 10), 170.0)
     clean, clean_poly, ends = _runs_stroke(runs)
     run_lengths = np.cumsum([0.0] + [float(np.linalg.norm(np.diff(clean_poly[a:b + 1], axis=0), axis=1).sum())
                                      for a, b in zip([0] + ends[:-1], ends)])
     trace = _mouse_trace(rng, clean, run_lengths[1:-1] * clean.length / run_lengths[-1], width)
     stroke = Stroke.from_polyline(trace)
     fair = fair_meta(clean_poly, ambiguous=bool(ambiguous_junctions(clean_poly)), scale=stroke.length / clean.length)
-    inter = polyline_intersections([trace], [False])
-    retraced = [shapely.LineString(r) for k, r in enumerate(runs[1:], 1)
-                if len(r) == 2 and len(runs[k - 1]) == 2 and np.array_equal(runs[k - 1][::-1], r)]
-    dont_care = [g.buffer(width) for g in retraced] + _sharp_turns(clean_poly, False, width)
-    dont_care += merged_without_crossing(clean, False, width, polyline_intersections([clean_poly], [False]).crossings)
-    dont_care += tiny_loop_crossings(stroke, False, width, inter.crossings)
-    # crossings of the jittered passes of a retraced stem or a cusp are not crossings of the word
-    real = ~dont_care_mask(inter.crossings, dont_care, max(MATCH_DISTANCE, width))
-    crossings, angles = inter.crossings[real], inter.crossing_angles[real]
-    events = tuple(Event("crossing", p, float(a)) for p, a in zip(crossings, angles))
+    retraced = [shapely.LineString(runs[k]) for k in retraced_runs(runs)]
+    crossings, events, dont_care = traced_crossings(trace, stroke, clean, clean_poly,
+                                                    [g.buffer(width) for g in retraced], width)
     drawing = Drawing((stroke,), CANVAS, CANVAS, unit="px", stroke_width=width)
     return GroundTruth(name=f"hand-{word}-{seed}-{index}", kind="handwriting", drawing=drawing, closed=False,
-                       intersections=crossings.reshape(-1, 2), events=events, dont_care=tuple(dont_care),
+                       intersections=crossings, events=events, dont_care=dont_care,
                        meta={"seed": seed, "index": index, "word": word, "width": width, "x_height": scale,
                              "retraces": len(retraced), **fair, "clean_length": clean.length})
 

@@ -23,7 +23,6 @@ docs/benchmark.md says exactly how each is measured.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from functools import lru_cache
 
 import numpy as np
 import shapely
@@ -39,7 +38,6 @@ EXCURSION_SLACK = 1.0  # px added to half the width: the acceptance bound of the
 CENTRE_SPACING = 0.25  # px between ground-truth centre-line samples (distance error < 0.01 px)
 OUTPUT_SPACING = 0.5  # px between output samples
 FAIR_LENGTH_SLACK = (0.01, 2.0)  # (share of the minimum length, stroke widths) an output may exceed it by
-MAX_ODD_NODES = 20  # the exact pairing below is exponential in the odd nodes
 RETRACE_SLACK = 1.0  # px a pen path may exceed its merged ink graph by and still count as drawn once
 
 
@@ -131,26 +129,20 @@ def ink_graph(polyline: np.ndarray) -> InkGraph:
     return InkGraph(nodes, inverse.reshape(-1, 2), np.array([p.length for p in parts], dtype=float))
 
 
-def _pairing_cost(dist: np.ndarray, free: int) -> float:
-    """Minimum total distance pairing all nodes, `free` of them allowed to stay unpaired
-    (exact, by dynamic programming over subsets)."""
+def _pairing_cost(dist: np.ndarray) -> float:
+    """Minimum total distance (px) pairing all nodes, two of them allowed to stay unpaired
+    (the pen's ends): a minimum-weight perfect matching (networkx's blossom) on the nodes and
+    two free vertices joined to every node and to each other at no cost. Weights in integer
+    thousandths of a px, where blossom is exact."""
+    import networkx as nx
+
     k = len(dist)
-
-    @lru_cache(maxsize=None)
-    def best(mask: int, left: int) -> float:
-        if mask == 0:
-            return 0.0
-        i = (mask & -mask).bit_length() - 1
-        rest = mask & ~(1 << i)
-        cost = best(rest, left - 1) if left > 0 else np.inf
-        j_bits = rest
-        while j_bits:
-            j = (j_bits & -j_bits).bit_length() - 1
-            j_bits &= j_bits - 1
-            cost = min(cost, dist[i, j] + best(rest & ~(1 << j), left))
-        return cost
-
-    return float(best((1 << k) - 1, free))
+    graph = nx.Graph()
+    graph.add_weighted_edges_from((i, j, int(round(dist[i, j] * 1000))) for i in range(k) for j in range(i + 1, k)
+                                  if np.isfinite(dist[i, j]))
+    graph.add_weighted_edges_from((i, free, 0) for i in range(k) for free in ("free a", "free b"))
+    graph.add_edge("free a", "free b", weight=0)
+    return sum(float(dist[u, v]) for u, v in nx.min_weight_matching(graph) if isinstance(u, int) and isinstance(v, int))
 
 
 def min_traversal_length(graph: InkGraph) -> float:
@@ -161,8 +153,6 @@ def min_traversal_length(graph: InkGraph) -> float:
     odd = np.flatnonzero(graph.degrees % 2 == 1)
     if len(odd) <= 2:
         return total
-    if len(odd) > MAX_ODD_NODES:
-        raise ValueError(f"{len(odd)} odd junctions: too many for the exact pairing")
     n = len(graph.nodes)
     a, b = graph.edges[:, 0], graph.edges[:, 1]
     keep = a != b
@@ -175,7 +165,7 @@ def min_traversal_length(graph: InkGraph) -> float:
     dense[rows, cols] = w  # later (shorter) entries win
     matrix = coo_matrix(np.where(np.isfinite(dense), dense, 0.0))
     dist = dijkstra(matrix, directed=False, indices=odd)[:, odd]
-    return total + _pairing_cost(dist, 2)
+    return total + _pairing_cost(dist)
 
 
 REVERSAL_DEGREES = 140.0  # the pen turns back by more than this at a retrace's tip
@@ -262,9 +252,9 @@ def fair_meta(polyline: np.ndarray, *, ambiguous: bool = False, scale: float = 1
     i.e. the length it draws twice), "fair" (True when `ambiguous` or the path retraces more
     than `RETRACE_SLACK`: then which stretch is drawn twice, or whether the pen started at a
     free end, cannot be read from the ink), "fair_why" ("ambiguous", "retrace" or "") and,
-    when fair, "min_length" (the minimum traversal, px, times `scale`: a handwriting word's
-    graph is taken before jitter and scaled to the jittered length). A graph with more than
-    `MAX_ODD_NODES` odd junctions is not fair (no exact minimum). near_width (px, a glyph's
+    "odd_nodes" (odd-degree junctions of the graph), "route_min" (the minimum traversal, px, times `scale`: a handwriting word's graph is taken
+    before jitter and scaled to the jittered length) and, when fair, the same as "min_length"
+    (the fair-retrace rule's bar). near_width (px, a glyph's
     line width): also count a near retrace (`near_retraces`: out and back closer than the line
     is wide) as a retrace, on the path `snap_near_retraces` makes (fair_why "near-retrace").
     """
@@ -279,12 +269,11 @@ def fair_meta(polyline: np.ndarray, *, ambiguous: bool = False, scale: float = 1
             near = float(arc_lengths(snapped)[-1] - near_graph.lengths.sum())
             if near > retraced + RETRACE_SLACK:
                 graph, retraced, why = near_graph, near, "near-retrace"
-    meta: dict = {"retraced_length": retraced, "fair": False, "fair_why": ""}
+    route_min = min_traversal_length(graph) * scale
+    meta: dict = {"retraced_length": retraced, "fair": False, "fair_why": "", "route_min": route_min,
+                  "odd_nodes": int(np.count_nonzero(graph.degrees % 2))}
     if why:
-        try:
-            meta.update(fair=True, fair_why=why, min_length=min_traversal_length(graph) * scale)
-        except ValueError:
-            pass
+        meta.update(fair=True, fair_why=why, min_length=route_min)
     return meta
 
 

@@ -74,8 +74,9 @@ def scaled(gt: GroundTruth, factor: float) -> GroundTruth:
     if "width_profile" in meta:
         knots, widths = meta["width_profile"]
         meta["width_profile"] = (knots, np.asarray(widths) * factor)
-    if "min_length" in meta:
-        meta["min_length"] = meta["min_length"] * factor
+    for key in ("min_length", "route_min"):
+        if key in meta:
+            meta[key] = meta[key] * factor
     zones = tuple(shapely.affinity.scale(z, factor, factor, origin=(0, 0)) if isinstance(z, shapely.Geometry)
                   else np.asarray(z) * factor for z in gt.dont_care)
     return replace(gt, name=f"{gt.name}-x{factor:g}", drawing=drawing, intersections=gt.intersections * factor,

@@ -99,8 +99,9 @@ def photographed(gt: GroundTruth, rng: np.random.Generator) -> GroundTruth:
 
     meta = {**gt.meta, "condition": "photo", "width_profile": profile, "source": gt.name,
             "homography": h.tolist()}
-    if "min_length" in meta:
-        meta["min_length"] = meta["min_length"] * stroke.length / gt.stroke.length
+    for key in ("min_length", "route_min"):
+        if key in meta:
+            meta[key] = meta[key] * stroke.length / gt.stroke.length
     drawing = Drawing((stroke,), gt.drawing.width, gt.drawing.height, unit=gt.drawing.unit,
                       stroke_width=float(np.max(profile[1])))
     return replace(gt, name=f"photo-{gt.name}", kind="photo", drawing=drawing,

@@ -14,7 +14,9 @@ are read by path. `run` imports `vectorize` from the given source tree (a git wo
 the version to check) and writes the SHA-256 of each output's SVG (or the error message):
 every drawing single-line, seed-0 drawings also multi-stroke; each examples/ drawing at
 several threshold and blur values through one `StageCache` (as the studio does, so the
-cached path is checked too), and the same values fresh. `compare` lists what differs.
+cached path is checked too), and the same values fresh. The curves (the SVG without its
+`data-widths`) and the ink widths are hashed apart, as "KEY" and "KEY widths": versions
+before widths existed compare equal on their curves. `compare` lists what differs.
 """
 
 from __future__ import annotations
@@ -23,11 +25,15 @@ import argparse
 import hashlib
 import json
 import multiprocessing as mp
+import re
 import sys
 import time
 from pathlib import Path
 
 HERE = Path(__file__).resolve().parents[1]
+# The ink widths along a path (vectorize/svg_write.py): hashed apart from the curves, so that
+# the curves of versions before and after widths existed compare equal.
+WIDTHS = re.compile(r' data-widths="([^"]*)"')
 # (threshold, blur) of the examples' runs: Li's threshold and set ones, no blur and blur.
 SETTINGS = [(None, 0.0), (0.35, 0.0), (0.5, 0.0), (None, 0.75), (0.4, 0.75), (None, 1.5), (0.45, 2.0)]
 
@@ -84,7 +90,14 @@ def _one(task: tuple) -> tuple[str, str]:
                         results.append((f"{key} t={threshold} b={blur} multi={multi} {how}", drawing_to_svg(drawing)))
     except Exception as exc:  # noqa: BLE001 - a failure is an output to compare too
         return [(key, f"{type(exc).__name__}: {exc}")]
-    return [(k, hashlib.sha256(svg.encode()).hexdigest()) for k, svg in results]
+    out = []
+    for k, svg in results:
+        # The curves and the ink widths apart: a change of one shows as that one.
+        widths = " ".join(WIDTHS.findall(svg))
+        out.append((k, hashlib.sha256(WIDTHS.sub("", svg).encode()).hexdigest()))
+        if widths:
+            out.append((f"{k} widths", hashlib.sha256(widths.encode()).hexdigest()))
+    return out
 
 
 def run(folder: Path, tree: Path, out: Path, jobs: int) -> int:
@@ -111,10 +124,13 @@ def run(folder: Path, tree: Path, out: Path, jobs: int) -> int:
 def compare(a: Path, b: Path) -> int:
     first, second = json.loads(a.read_text()), json.loads(b.read_text())
     differ = sorted(k for k in first.keys() | second.keys() if first.get(k) != second.get(k))
-    errors = sum(1 for v in first.values() if len(v) != 64)
+    errors = sum(1 for k, v in first.items() if len(v) != 64 and not k.endswith(" widths"))
     for key in differ:
         print(f"DIFFERS {key}: {first.get(key)} != {second.get(key)}")
-    print(f"{len(first)} and {len(second)} outputs; {len(differ)} differ; {errors} are errors in both")
+    curves = [k for k in differ if not k.endswith(" widths")]
+    print(f"{len(first)} and {len(second)} hashes; {len(curves)} outputs differ (curves, SVG without "
+          f"data-widths), {len(differ) - len(curves)} ink-width profiles differ or are only on one side; "
+          f"{errors} are errors in both")
     return 1 if differ else 0
 
 

@@ -15,7 +15,9 @@ SingleLine glyphs), "triple" (three passes through a point), "handwriting" (jitt
 cursive words); "heldout" (not in "all"): glyphs, words and seeds no other set uses, under
 scan, JPEG, noise, pen-pressure, broken-line, half-resolution and pencil conditions
 (benchmarks/heldout.py); "kinds" (not in "all"): TSP art, brush kana, broad-nib capitals and
-phone photos of pen drawings (benchmarks/kinds.py). Classifier "auto" runs the CNN everywhere and the geometric rule on touch
+phone photos of pen drawings (benchmarks/kinds.py); "cursive" (not in "all"): long cursive words
+and short sentences as one line, with overshoot hooks, entry stubs and drifting stem loops
+(benchmarks/cursive.py). Classifier "auto" runs the CNN everywhere and the geometric rule on touch
 too. See docs/benchmark.md for the columns.
 
 Each drawing is vectorized in a fresh process forked from this one (the vectorizer's
@@ -56,6 +58,7 @@ from benchmarks.hershey import hershey_set  # noqa: E402
 from benchmarks.ink_metrics import ink_pieces, ink_scores, verdict  # noqa: E402
 from benchmarks.metrics import ORDER_THRESHOLD, evaluate, order_tolerance  # noqa: E402
 from benchmarks.relief import relief_set  # noqa: E402
+from benchmarks.route_figures import print_route_figures, route_row  # noqa: E402
 from benchmarks.render import render, render_truth, to_uint8  # noqa: E402
 
 DEFAULT_COUNTS = {"plain": 42, "touch": 40, "hershey": 40, "hershey-retrace": 40, "relief": 40, "triple": 40,
@@ -63,6 +66,7 @@ DEFAULT_COUNTS = {"plain": 42, "touch": 40, "hershey": 40, "hershey-retrace": 40
 SETS = tuple(DEFAULT_COUNTS)
 HELDOUT_COUNT = 93  # --set heldout (benchmarks/heldout.py): not part of "all", which are the sets tuned on
 KINDS_COUNT = 40  # --set kinds (benchmarks/kinds.py): not part of "all" either
+CURSIVE_COUNT = 40  # --set cursive (benchmarks/cursive.py): long lines, not part of "all"
 
 
 def build_set(name: str, count: int, seed: int) -> list:
@@ -85,6 +89,10 @@ def build_set(name: str, count: int, seed: int) -> list:
         from benchmarks.kinds import kinds_set
 
         return kinds_set(count, seed)
+    if name == "cursive":
+        from benchmarks.cursive import cursive_set
+
+        return cursive_set(count, seed)
     return generate_set(name, count, seed)
 TASKS: list = []  # (set name, GroundTruth), inherited by the forked workers
 PLOT_DIR: list = []  # [Path] when --plot is given
@@ -187,6 +195,7 @@ def _run_one(index: int, classifier: str, oracle: bool, conn) -> None:
                    ssim=scores.ssim, psnr=scores.psnr, length_ratio=scores.length_ratio,
                    gt_intersections=scores.gt_intersections, out_intersections=scores.out_intersections, matched=scores.matched,
                    order=scores.order, order_correct=scores.correct, **_ink_row(gt, output, scores),
+                   **route_row(gt, output, report),
                    warnings=" | ".join(report.warnings) if report is not None else "")
     except BaseException as exc:  # noqa: BLE001 - a failing drawing is a result, not a crash
         row["error"] = f"{type(exc).__name__}: {exc}".replace("\n", " ")[:300]
@@ -362,8 +371,9 @@ def _git_commit() -> str:
 
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[1], formatter_class=argparse.RawTextHelpFormatter)
-    ap.add_argument("--set", default="all", choices=[*SETS, "heldout", "kinds", "all"],
-                    help="all: every set but heldout and kinds (the drawings and conditions no set tunes on)")
+    ap.add_argument("--set", default="all", choices=[*SETS, "heldout", "kinds", "cursive", "all"],
+                    help="all: every set but heldout and kinds (the drawings and conditions no set tunes on) and "
+                         "cursive (long lines)")
     ap.add_argument("--classifier", default="auto", choices=["auto", "cnn", "geometric", "both"],
                     help="auto: cnn on plain/hershey, both on touch")
     ap.add_argument("--count", type=int, default=None, help="drawings per set (default: plain 42, touch 40, "
@@ -398,7 +408,7 @@ def main(argv: list[str] | None = None) -> int:
     sets = list(SETS) if args.set == "all" else [args.set]
     for name in sets:
         count = args.count if args.count is not None else DEFAULT_COUNTS.get(
-            name, KINDS_COUNT if name == "kinds" else HELDOUT_COUNT)
+            name, {"kinds": KINDS_COUNT, "cursive": CURSIVE_COUNT}.get(name, HELDOUT_COUNT))
         gts = build_set(name, count, args.seed)
         if args.name:
             gts = [gt for gt in gts if any(text in gt.name for text in args.name)]
@@ -467,6 +477,7 @@ def main(argv: list[str] | None = None) -> int:
     print_tables(rows)
     print_failures(rows)
     print_fair_only(rows)
+    print_route_figures(rows)
     errors = [r for r in rows if r.get("error")]
     if errors:
         print()
@@ -478,8 +489,8 @@ def main(argv: list[str] | None = None) -> int:
                 "psnr", "length_ratio", "gt_intersections", "out_intersections", "matched", "seconds",
                 "peak_mb", "condition", "order_correct", "fair", "fair_why", "one_piece", "excursion", "excursion_w",
                 "within", "headroom", "uncovered",
-                "cover_tolerance", "out_length", "min_length",
-                "error", "warnings"]
+                "cover_tolerance", "out_length", "min_length", "odd_nodes_gt", "odd_nodes", "route_min",
+                "route_ratio", "drawn_ratio", "error", "warnings"]
         args.csv.parent.mkdir(parents=True, exist_ok=True)
         with open(args.csv, "w", newline="") as fh:
             writer = csv.DictWriter(fh, fieldnames=keys, extrasaction="ignore")

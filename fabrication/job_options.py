@@ -65,11 +65,15 @@ def _checked(value, parse, limits):
 
 
 def _whole(value, *, what: str):
-    """An integer option given as text or a number."""
+    """An integer option given as text (the one number grammar: ASCII digits) or a number."""
+    from onestroke.units import parse_integer
+
+    if isinstance(value, str):
+        return parse_integer(value, what=what)
     if isinstance(value, bool) or (isinstance(value, float) and not value.is_integer()):
         raise InputError(f"{what} {value!r} is not a whole number")
     try:
-        return int(str(value).strip()) if isinstance(value, str) else int(value)
+        return int(value)
     except (TypeError, ValueError, OverflowError):
         raise InputError(f"{what} {value!r} is not a whole number") from None
 

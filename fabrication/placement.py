@@ -68,3 +68,24 @@ def place(drawing: Drawing, options: PlacementOptions = PlacementOptions()) -> D
     matrix = np.array([[scale, 0.0, -scale * cx], [0.0, scale, -scale * cy]])
     return rotated.transformed(matrix, width=max(w * scale, 1e-9), height=max(h * scale, 1e-9),
                                unit="mm", stroke_width=drawing.stroke_width * scale)
+
+
+def place_on_page(drawing: Drawing, options: PlacementOptions | None = None) -> Drawing:
+    """`drawing` in millimetres on a page of its physical size, for SVG documents read by
+    other tools (Ink/Stitch, laser senders, vpype); the origin is the page's top-left corner.
+
+    options None: the input's own page read at 96 dpi (a drawing in px is scaled, nothing
+    moves, so a caller can map the result back onto the input). Otherwise the drawing is
+    `place`d and its box starts half an ink width from the page's corner, so the drawn
+    line's round caps stay on the page (the page is the box plus that margin).
+    """
+    if options is None:
+        scale = 1.0 if drawing.unit == "mm" else 25.4 / PlacementOptions().dpi
+        return drawing.transformed(np.array([[scale, 0.0, 0.0], [0.0, scale, 0.0]]),
+                                   width=drawing.width * scale, height=drawing.height * scale, unit="mm",
+                                   stroke_width=drawing.stroke_width * scale)
+    placed = place(drawing, options)
+    margin = placed.stroke_width / 2
+    dx, dy = placed.width / 2 + margin, placed.height / 2 + margin
+    return placed.transformed(np.array([[1.0, 0.0, dx], [0.0, 1.0, dy]]), width=placed.width + 2 * margin,
+                              height=placed.height + 2 * margin, unit="mm", stroke_width=placed.stroke_width)

@@ -17,6 +17,7 @@ from machines.gcode_interpreter import GcodeError, MachineConfig
 from machines.grbl_protocol import MAX_LINE_CHARS, clean_line
 from machines.grbl_settings import INTEGER_SETTINGS
 from machines.planner_model import BlockBuilder, Kinematics
+from machines.system_commands import system_answer
 
 VERSION = "1.1h"
 BUILD_DATE = "20190825"
@@ -229,6 +230,9 @@ class EmulatorProtocol:
 
     def _system_command(self, text: str) -> None:
         busy = self.state.startswith(("Run", "Hold"))
+        answer = system_answer(text, self.settings, idle=not busy)  # GRBL's error codes, as the pre-check
+        if answer.code:
+            return self._reply(f"error:{answer.code}")
         if text == "$":
             self._reply("[HLP:$$ $# $G $I $N $x=val $Nx=line $J=line $SLP $C $X $H ~ ! ? ctrl-x]")
         elif text == "$$":

@@ -10,7 +10,7 @@ from __future__ import annotations
 import os
 import re
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -19,6 +19,7 @@ from machines.gcode_interpreter import GcodeError, GcodeInterpreter, GcodeState,
 from machines.grbl_codes import describe_error
 from machines.grbl_protocol import MAX_LINE_CHARS, clean_line
 from machines.planner_model import Kinematics, plan_times
+from machines.system_commands import system_answer
 from onestroke.errors import InputError
 from onestroke.progress import ProgressCallback, Stage
 from onestroke.textfile import read_text
@@ -81,6 +82,10 @@ def load_program(path: str | os.PathLike) -> Program:
     """Read a G-code file (UTF-8 text) into a `Program`; InputError if unreadable."""
     name = str(path)
     text = read_text(path, what="G-code file", expect="a .gcode/.nc file")
+    if text.lstrip("\ufeff \t\r\n").startswith("<"):  # G-code never starts with '<'; XML always does
+        kind = "an SVG drawing" if "<svg" in text[:4096].lower() else "XML (or HTML)"
+        raise InputError(f"G-code file {name!r} is {kind}, not G-code; make G-code from a drawing with "
+                         "'onestroke laser DRAWING -o JOB.gcode'")
     program = program_from_text(text, source=name)
     if not program.lines:
         raise InputError(f"G-code file {name!r} has no G-code lines")
@@ -143,7 +148,8 @@ class ProgramStats:
     for lines GRBL would refuse (or `$` commands when not allowed), in file order; codes
     the matching GRBL error codes (0 for a refused `$` command). dwell: (len(program),)
     seconds of G4 on each line. syncs: (len(program),) the line drains the planner (its
-    `ok` waits for the machine to stop).
+    `ok` waits for the machine to stop). settings_written: {$N: value} the job's own `$N=`
+    lines store (allowed `$` lines only), in effect for the lines after them.
     """
 
     extent: tuple[tuple[float, float], tuple[float, float]] | None
@@ -157,6 +163,7 @@ class ProgramStats:
     segments: Segments
     dwell: np.ndarray
     syncs: np.ndarray
+    settings_written: Mapping[int, float] = field(default_factory=dict)
 
     @property
     def total_seconds(self) -> float:
@@ -235,7 +242,10 @@ def analyze_program(program: Program, *, settings: Mapping[int, float] | None = 
     `start` (mm) and work offsets from `$#` ({"G54": (x, y, z), ..., "G92": ...}).
 
     allow_settings: False reports every `$` line as an error (a job should not change
-    the machine's settings); True skips them like any sender that passes them through.
+    the machine's settings); True checks each as GRBL 1.1h would (`system_commands`: its
+    error codes, `error:8` for a command that needs Idle streamed behind moves) and reports
+    the ones that change what the job means ($C, $SLP, $RST, $N, $J=) by name; a stored
+    setting holds for the lines after it, a homing cycle moves the head home.
     progress: an `onestroke.progress.ProgressCallback` (lines read).
     """
     settings = dict(settings or {})
@@ -263,6 +273,8 @@ def analyze_program(program: Program, *, settings: Mapping[int, float] | None = 
     other = np.flatnonzero([bool(r[5]) for r in rows]) if rows is not None else np.arange(len(texts))
     index = 0
     report = Stage(progress, "reading G-code", len(texts), "lines")
+    written: dict[int, float] = {}
+    idle = True  # GRBL Idle when the next line arrives: nothing queued since the last sync
     while index < len(texts):
         report.set(index)
         if rows is not None and not rows[index][5]:
@@ -271,16 +283,29 @@ def analyze_program(program: Program, *, settings: Mapping[int, float] | None = 
             if run is not None:
                 cols.add_run(run, index, file_line[index:index + run.n], pending_stop, interp.state.spindle)
                 max_s = max(max_s, float(run.s.max()))
-                pending_stop = False
+                pending_stop = idle = False
                 position = tuple(interp.state.position)
                 index += run.n
                 continue
         number, text = program.lines[index]
         index += 1
         if text.startswith("$"):
-            if not allow_settings:
-                errors.append((number, f"{text}: {SETTINGS_REFUSED}"))
-                codes.append(0)
+            answer = system_answer(text, settings, idle=idle) if allow_settings else None
+            if answer is None or answer.code or answer.refused:
+                # GRBL's own error where it names the fault; the refusal where the line would only
+                # be refused for arriving mid-job (error:8), or not at all
+                named = answer is not None and answer.refused and answer.code in (0, 8)
+                why = SETTINGS_REFUSED if answer is None else f"it {answer.refused}; remove it from the job" \
+                    if named else describe_error(answer.code)
+                errors.append((number, f"{text}: {why}"))
+                codes.append(answer.code if answer is not None and not named else 0)
+            elif answer.setting is not None:
+                settings[answer.setting[0]] = written[answer.setting[0]] = answer.setting[1]
+                interp.config = replace(interp.config, laser_mode=bool(settings.get(32, 1)),
+                                        arc_tolerance=settings.get(12, 0.002))
+            elif answer.homes:
+                interp.state.position = [0.0, 0.0, 0.0]
+                position, pending_stop = (0.0, 0.0, 0.0), True
             continue
         try:
             actions = interp.execute(text)
@@ -293,6 +318,7 @@ def analyze_program(program: Program, *, settings: Mapping[int, float] | None = 
         for action in actions:
             kind = action[0]
             if kind == "move":
+                idle = False
                 _, target, feed, rapid, mode, s = action
                 cols.seg.append((position, target, np.nan if feed is None else feed, rapid, pending_stop,
                                  move_index, index - 1, mode != "M5" and s > 0 and not rapid))
@@ -301,10 +327,11 @@ def analyze_program(program: Program, *, settings: Mapping[int, float] | None = 
                 max_s = max(max_s, s)
             elif kind in ("sync", "end", "pause"):
                 pending_stop = True
+                idle = kind != "pause"  # M0 leaves GRBL in a feed hold
                 syncs[index - 1] = True
             elif kind == "dwell":
                 dwell[index - 1] += float(action[1])
-                pending_stop = True
+                pending_stop = idle = True
             elif kind == "spindle":
                 max_s = max(max_s, action[2])
         if motion is not None:
@@ -321,4 +348,4 @@ def analyze_program(program: Program, *, settings: Mapping[int, float] | None = 
     points = np.vstack([np.asarray(start, dtype=float)[:2], ends[:, :2]])
     burn = np.vstack([starts[seg_burn, :2], ends[seg_burn, :2]])
     return ProgramStats(_box(points) if len(points) > 1 else None, _box(burn), max_s, bool(seg_burn.any()),
-                        np.cumsum(per_line), tuple(errors), tuple(codes), moves, segments, dwell, syncs)
+                        np.cumsum(per_line), tuple(errors), tuple(codes), moves, segments, dwell, syncs, written)

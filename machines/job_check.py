@@ -22,6 +22,7 @@ def check_job(stats: ProgramStats, settings: dict[int, float], *, profile=None) 
     homing, only the job's size is checked against the bed and its position is a warning.
     """
     problems: list[JobProblem] = []
+    settings = {**settings, **stats.settings_written}  # what the job's own $N= lines store holds
     laser_mode = settings.get(32)
     if stats.uses_laser and laser_mode is not None and not laser_mode:
         problems.append(JobProblem(True, "laser mode is off ($32=0): GRBL would keep the beam on during G0 "
@@ -47,7 +48,8 @@ def check_job(stats: ProgramStats, settings: dict[int, float], *, profile=None) 
     if stats.errors:
         line, text = stats.errors[0]
         more = f" (and {len(stats.errors) - 1} more)" if len(stats.errors) > 1 else ""
-        problems.append(JobProblem(True, f"line {line} would be refused by GRBL: {text}{more}"))
+        by = "is refused" if stats.codes[0] == 0 else "would be refused by GRBL"  # code 0: refused here
+        problems.append(JobProblem(True, f"line {line} {by}: {text}{more}"))
     if profile is not None:
         for number, name, value in ((130, "bed width", profile.bed_width), (131, "bed height", profile.bed_height),
                                     (30, "max power", profile.max_power)):

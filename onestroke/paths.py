@@ -41,3 +41,35 @@ def check_distinct(*, inputs: Iterable[tuple[str, str | os.PathLike | None]],
             raise InputError(f"{role} {str(path)!r} is the same file as the {seen[key]}; writing it would "
                              "destroy that, give another file name")
         seen[key] = role
+
+
+def _kind(mode: int) -> str | None:
+    """What a file that is not a regular file is, in a user's words; None for a regular file."""
+    import stat
+
+    kinds = ((stat.S_ISDIR, "a directory"), (stat.S_ISFIFO, "a named pipe (FIFO)"),
+             (stat.S_ISCHR, "a character device"), (stat.S_ISBLK, "a block device"), (stat.S_ISSOCK, "a socket"))
+    return next((name for test, name in kinds if test(mode)), None)
+
+
+def check_input_file(path: str | os.PathLike, *, what: str = "input file", expect: str = "a file") -> str:
+    """`path` as a string if it names a readable regular file, else `InputError` saying which
+    way it is not: missing, a broken symbolic link, a directory, a FIFO or device (reading
+    one would block or never end: /dev/zero), or unreadable."""
+    name = os.fspath(path)
+    try:
+        info = os.stat(name)
+    except FileNotFoundError:
+        if os.path.islink(name):
+            raise InputError(f"{what} {name!r} is a symbolic link to {os.readlink(name)!r}, which does not "
+                             "exist") from None
+        raise InputError(f"{what} {name!r} does not exist") from None
+    except OSError as error:
+        raise InputError(f"cannot read {what} {name!r}: {error.strerror}") from None
+    kind = _kind(info.st_mode)
+    if kind is not None:
+        target = f" (a link to {os.path.realpath(name)!r})" if os.path.islink(name) else ""
+        raise InputError(f"{what} {name!r}{target} is {kind}, not a regular file; give {expect}")
+    if not os.access(name, os.R_OK):
+        raise InputError(f"{what} {name!r} is not readable (permission denied)")
+    return name

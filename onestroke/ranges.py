@@ -109,7 +109,12 @@ class Range:
         value scaled, without unit."""
         if not isinstance(value, numbers.Real) or isinstance(value, bool):
             raise InputError(f"{self.name} {value!r} is not a number")
-        text = shown if shown is not None else (f"{value * self.scale:g}" if math.isfinite(value) else str(value))
+        if shown is not None:
+            text = shown
+        elif isinstance(value, numbers.Integral) and self.scale == 1:
+            text = str(int(value))
+        else:
+            text = f"{value * self.scale:g}" if math.isfinite(value) else str(value)
         if not math.isfinite(value):
             raise InputError(f"{self.name} {text} is not a finite number")
         if self.integer and not isinstance(value, numbers.Integral):

@@ -5,12 +5,13 @@ from __future__ import annotations
 import os
 
 from onestroke.errors import InputError
+from onestroke.paths import check_input_file
 
 
 def read_text(path: str | os.PathLike, *, what: str = "file", expect: str = "a text file") -> str:
     """The text of `path` (UTF-8, else Latin-1 when it is plainly text); InputError naming
     `what` when missing, a folder, or not text (NUL or control bytes)."""
-    name = str(path)
+    name = check_input_file(path, what=what, expect=expect)
     try:
         with open(path, "rb") as handle:
             data = handle.read()

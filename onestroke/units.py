@@ -11,21 +11,36 @@ import re
 from onestroke.errors import InputError
 
 MM_PER_UNIT = {"mm": 1.0, "cm": 10.0, "m": 1000.0, "in": 25.4, "pt": 25.4 / 72, "px": 25.4 / 96}
-_NUMBER = r"([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)"
-_LENGTH = re.compile(rf"^\s*{_NUMBER}\s*([a-zA-Z]*)\s*$")
-_SPEED = re.compile(rf"^\s*{_NUMBER}\s*(?:([a-zA-Z]+)\s*/\s*(min|s))?\s*$")
-_PERCENT = re.compile(rf"^\s*{_NUMBER}\s*(%?)\s*$")
-_PLAIN = re.compile(rf"^\s*{_NUMBER}\s*$")
+# The one number grammar of every value a user types (options, unit strings, sim:// values):
+# ASCII decimal digits, an optional sign, point and exponent. Not Python's float()/int(),
+# which also take "1_0", "nan", "infinity" and Arabic-Indic or full-width digits.
+_NUMBER = r"([-+]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][-+]?[0-9]+)?)"
+_INTEGER = re.compile(r"^[ \t]*([-+]?[0-9]+)[ \t]*$", re.ASCII)
+_PLAIN = re.compile(rf"^[ \t]*{_NUMBER}[ \t]*$", re.ASCII)
+_LENGTH = re.compile(rf"^\s*{_NUMBER}\s*([a-zA-Z]*)\s*$", re.ASCII)
+_SPEED = re.compile(rf"^\s*{_NUMBER}\s*(?:([a-zA-Z]+)\s*/\s*(min|s))?\s*$", re.ASCII)
+_PERCENT = re.compile(rf"^\s*{_NUMBER}\s*(%?)\s*$", re.ASCII)
 
 
 def parse_number(text: str | float, *, what: str = "value") -> float:
-    """A plain number ("12.5", "-3", "1e3") or a number as is; not checked for range."""
+    """A number written in ASCII decimal ("2.5", "-3", "1e-3"), as a float (possibly
+    infinite when the exponent overflows: range checks refuse it)."""
     if isinstance(text, (int, float)) and not isinstance(text, bool):
         return float(text)
     match = _PLAIN.match(str(text))
     if not match:
-        raise InputError(f"{what} {text!r} is not a number")
+        raise InputError(f"{what} {text!r} is not a number; write it with the digits 0-9, e.g. 2.5")
     return float(match.group(1))
+
+
+def parse_integer(text: str | int, *, what: str = "value") -> int:
+    """A whole number written in ASCII decimal ("3", "-1")."""
+    if isinstance(text, int) and not isinstance(text, bool):
+        return text
+    match = _INTEGER.match(str(text))
+    if not match:
+        raise InputError(f"{what} {text!r} is not a whole number; write it with the digits 0-9, e.g. 3")
+    return int(match.group(1))
 
 
 def parse_length(text: str | float, *, default_unit: str = "mm", what: str = "length") -> float:
@@ -91,7 +106,7 @@ def parse_size_pair(text: str, *, what: str = "size") -> tuple[float, float]:
     parts = re.split(r"\s*[xX×]\s*", str(text).strip())
     if len(parts) != 2:
         raise InputError(f"{what} {text!r} is not WxH; use e.g. '100x100' or '130x180mm'")
-    unit = re.sub(r"^[-+.\deE]+", "", parts[1]) or "mm"
+    unit = re.sub(r"^[-+.0-9eE]+", "", parts[1]) or "mm"
     first = parts[0] if re.search(r"[a-zA-Z]$", parts[0]) else parts[0] + unit
     w = parse_positive_length(first, what=what)
     h = parse_positive_length(parts[1] if re.search(r"[a-zA-Z]$", parts[1]) else parts[1] + "mm", what=what)

@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+import os
+import shutil
+import subprocess
 from pathlib import Path
 
 import numpy as np
@@ -14,6 +17,22 @@ CHROMIUM = "/usr/bin/chromium"
 CHROMIUM_ARGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-background-networking",
                  "--disable-component-update", "--disable-sync", "--no-first-run"]
 ARTIFACTS = Path(__file__).resolve().parents[1] / "test-artifacts"
+# Debian packages the tests drive, by a file each installs: Chromium for the browser tests,
+# Inkscape (and the lxml its extensions' inkex needs) for the Inkscape extension's tests.
+SYSTEM_PACKAGES = {CHROMIUM: "chromium", "/usr/bin/inkscape": "inkscape",
+                   "/usr/lib/python3/dist-packages/lxml": "python3-lxml"}
+
+
+def pytest_sessionstart(session) -> None:
+    """Install the missing system packages (as root, with apt-get), so that the README's test
+    command passes alone on a fresh Debian machine; elsewhere the tests that need them say so."""
+    missing = [package for path, package in SYSTEM_PACKAGES.items() if not Path(path).exists()]
+    if not missing or not hasattr(os, "geteuid") or os.geteuid() != 0 or not shutil.which("apt-get"):
+        return
+    env = {**os.environ, "DEBIAN_FRONTEND": "noninteractive"}
+    subprocess.run(["apt-get", "update", "-qq"], env=env, check=False)
+    subprocess.run(["apt-get", "install", "-y", "-qq", *missing], env=env, check=False,
+                   stdout=subprocess.DEVNULL)
 
 
 @pytest.fixture(scope="session")

@@ -4,10 +4,18 @@ from __future__ import annotations
 
 import numpy as np
 
-from fabrication.embroidery.needles import LOCK, TACK
-from fabrication.embroidery.plan import JUMP, STITCH, TRIM, StitchPlan
+from fabrication.embroidery.plan import STITCH, StitchPlan
 from vectorize.drawing import Drawing
 from vectorize.stroke import Stroke
+
+# Three colours; red twice, far apart, so one colour block holds two strokes.
+THREE_COLOURS = """<svg xmlns="http://www.w3.org/2000/svg" width="100" height="100" viewBox="0 0 100 100">
+<path d="M10 10 C 30 0 50 20 60 10" stroke="#c81e28" fill="none"/>
+<path d="M10 40 C 30 30 50 50 60 40" stroke="rgb(20,120,40)" fill="none"/>
+<g stroke="navy" fill="none"><path d="M10 70 C 30 60 50 80 60 70"/></g>
+<path d="M70 10 L 90 90" stroke="#c81e28" fill="none"/>
+</svg>
+"""
 
 STYLE_NAMES = ("running", "triple", "zigzag", "arrows")
 FORMATS = ("pes", "dst", "jef", "exp", "vp3")
@@ -75,52 +83,25 @@ def lock_figure_ok(points: np.ndarray) -> bool:
                 and steps.min() > 0)
 
 
-# -- what an embroiderer checks: piled-up holes -------------------------------------------
-PENETRATION_GAP = 0.2  # mm: a needle this close to a recent hole on its side re-pierces it
-PENETRATION_WINDOW = 4  # "the previous few" needle points
+# -- what an embroiderer checks: piled-up holes and density ---------------------------------
+# One implementation, the library's (`fabrication.embroidery.quality`): the stats' warnings,
+# the planner and benchmarks/embroidery_quality.py measure the same way.
 
 
-def needle_sides(plan: StitchPlan, *, centre: float = 0.15) -> np.ndarray:
-    """Side of the curve of each row: +1 left, -1 right, 0 on the curve (within `centre`
-    mm), from the sewn stroke at the row's parameter (rows without a stroke: 0)."""
-    sides = np.zeros(len(plan.points), dtype=int)
-    sewn = plan.sewn
-    for k in np.unique(plan.strokes[plan.strokes >= 0]):
-        rows = np.flatnonzero(plan.strokes == k)
-        t = np.clip(plan.params[rows] - k, 0.0, 1.0)
-        stroke = sewn.strokes[int(k)]
-        offset = plan.points[rows] - stroke.points_at(t)
-        tangent = stroke.tangents_at(t)
-        cross = tangent[:, 0] * offset[:, 1] - tangent[:, 1] * offset[:, 0]
-        far = np.linalg.norm(offset, axis=1) > centre
-        sides[rows] = np.where(far, np.sign(cross), 0).astype(int)
-    return sides
+def repeated_penetrations(plan: StitchPlan, **kwargs) -> int:
+    """How many needle points re-enter a recent hole (see `quality.repeated_holes`)."""
+    from fabrication.embroidery.quality import repeated_holes
 
-
-def repeated_penetrations(plan: StitchPlan, *, gap: float = PENETRATION_GAP,
-                          window: int = PENETRATION_WINDOW) -> int:
-    """Needle points outside tacks and locks that land within `gap` mm of one of the
-    previous `window` needle points on the same side of the curve (same run of thread)."""
-    sides = needle_sides(plan)
-    count = 0
-    for run in needle_runs(plan):
-        pts, side, role = plan.points[run], sides[run], plan.roles[run]
-        for lag in range(1, window + 1):
-            if len(run) <= lag:
-                break
-            close = np.linalg.norm(pts[lag:] - pts[:-lag], axis=1) < gap - 1e-9
-            same = side[lag:] == side[:-lag]
-            free = (role[lag:] != TACK) & (role[lag:] != LOCK)
-            count += int((close & same & free).sum())
-    return count
+    return len(repeated_holes(plan, **kwargs))
 
 
 def worst_density(plan: StitchPlan, radius: float = 0.5) -> int:
-    """Most needle points within `radius` mm of a needle point, both outside tacks and
-    locks (measured independently of `embroidery_stats`)."""
-    from scipy.spatial import cKDTree
-
-    needle = plan.kinds == STITCH
-    pts, roles = plan.points[needle], plan.roles[needle]
-    sewn = pts[(roles != TACK) & (roles != LOCK)]
-    return int(cKDTree(sewn).query_ball_point(sewn, radius, return_length=True).max())
+    """Most needle points within `radius` mm of a needle point, every needle point counted
+    (tacks and locks too): a brute-force count over all pairs, independent of the
+    k-d tree in `quality.needle_density` that the stats use."""
+    pts = plan.points[plan.kinds == STITCH]
+    worst = 0
+    for start in range(0, len(pts), 512):
+        d = np.linalg.norm(pts[start:start + 512, None] - pts[None], axis=2)
+        worst = max(worst, int((d <= radius + 1e-9).sum(axis=1).max()))
+    return worst

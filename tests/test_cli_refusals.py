@@ -102,7 +102,7 @@ TABLE = [
     ("5", ["embroider", "{in}/dir.pes", "-o", "{out}/a.pes"], 2, "is a directory"),
     ("5", ["preview", "{in}/dir.pes", "-o", "{out}/a.png"], 2, "is a directory"),
     ("5", ["vectorize", "{in}/d.svg", "-o", "/etc/hostname/x.svg"], 2, "is a file, not a folder"),
-    ("5", ["embroider", "{in}/d.svg", "-o", "{out}/a.pes", "--rotate", "nan"], 2, "--rotate nan is not a finite"),
+    ("5", ["embroider", "{in}/d.svg", "-o", "{out}/a.pes", "--rotate", "nan"], 2, "--rotate 'nan' is not a number"),
     ("5", ["embroider", "{in}/d.svg", "-o", "{out}/a.pes", "--hoop", "9" * 1000], 2, " ... "),
     ("5", ["vectorize", "{in}/noise.png", "-o", "{out}/a.svg", "--threshold", "0.4"], 2, "with that threshold"),
     ("5", ["preview", "{in}/garbage.pes", "-o", "{out}/a.png"], 2, "not a valid .pes file (damaged"),

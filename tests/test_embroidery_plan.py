@@ -61,7 +61,10 @@ def test_short_stitches_are_merged_away_outside_locks():
         assert lengths.min() > 0
         assert lengths[~np.isin(roles, (TACK, LOCK))].min() >= minimum - 1e-9
         rows = stroke_rows(plan)[0]
-        assert lock_figure_ok(plan.points[rows[:5]]) and lock_figure_ok(plan.points[rows[-5:]])
+        # The tack and lock keep their figure, unless made lighter on this crowded wobble.
+        lighter = {t.lock for t in plan.lighter}
+        assert False in lighter or lock_figure_ok(plan.points[rows[:5]])
+        assert True in lighter or lock_figure_ok(plan.points[rows[-5:]])
 
 
 def test_long_needle_down_moves_are_split_into_stitches_not_jumps():
@@ -144,6 +147,24 @@ def test_stats_count_time_thread_and_size():
     assert any(line.startswith("stitches") for line in stats.lines())
 
 
+def test_bobbin_thread_is_estimated_beside_the_top_thread():
+    """Running stitches: the bobbin lies under every stitch (as long as the top thread).
+    A zigzag column: a third of its body stitches, the whole of its walks and locks."""
+    line = Drawing((_line([0, 0], [40, 0]),), 40, 1, "mm")
+    running = plan_embroidery(line, PlanOptions())
+    stats = embroidery_stats(running)
+    assert stats.bobbin_length == pytest.approx(stats.thread_length)
+    assert "top" in stats.lines()[2] and "bobbin" in stats.lines()[2]
+    zigzag = plan_embroidery(line, PlanOptions(style=ZigzagOptions()))
+    column = embroidery_stats(zigzag, column=True)
+    a, b = zigzag.stitches()
+    length = np.hypot(*(b - a).T)
+    body = zigzag.roles[zigzag.stitch_mask] == BODY
+    assert column.bobbin_length == pytest.approx(length[body].sum() / 3 + length[~body].sum())
+    assert 0.3 * column.thread_length < column.bobbin_length < 0.5 * column.thread_length
+    assert "1/3" in column.bobbin_rule and "1/3" in column.lines()[2]
+
+
 def test_density_warning_above_six_needle_points_within_half_a_millimetre():
     def plan_of(points, roles=None):
         n = len(points)
@@ -157,9 +178,11 @@ def test_density_warning_above_six_needle_points_within_half_a_millimetre():
     stats = embroidery_stats(plan_of(seven))
     assert stats.too_dense and stats.max_density == 7 and stats.dense_points == 7
     assert "too dense" in stats.warnings[0]
-    # Tacks and locks are dense on purpose: they are left out of the count.
+    # Every needle point counts: tacks and locks are no exception.
     locked = embroidery_stats(plan_of(seven, [TACK, TACK, LOCK, LOCK, BODY, BODY, BODY, BODY]))
-    assert not locked.too_dense and locked.max_density == 3
+    assert locked.too_dense and locked.max_density == 7
+    # The warning names the place (mm) and what to change.
+    assert "at (0.0, 0.0) mm (7)" in stats.warnings[0] and "longer stitch" in stats.warnings[0]
     # A zigzag at 0.1 mm spacing is too dense; the default 0.4 mm on a straight line is not.
     line = Drawing((_line([0, 0], [20, 0]),), 20, 1, "mm")
     assert embroidery_stats(plan_embroidery(line, PlanOptions(style=ZigzagOptions(spacing=0.1)))).too_dense
@@ -261,5 +284,10 @@ def test_random_drawings_keep_every_rule(seed, style):
     assert lengths[~np.isin(roles, (TACK, LOCK))].min() >= 0.3 - 1e-9
     assert np.allclose(plan.points * 10, np.rint(plan.points * 10))
     trims = np.flatnonzero(plan.kinds == TRIM)
-    assert (plan.roles[trims - 1] == LOCK).all() and (plan.kinds[trims + 1] == JUMP).all()
-    assert plan.roles[np.flatnonzero(plan.kinds == STITCH)[-1]] == LOCK
+    assert (plan.kinds[trims + 1] == JUMP).all()
+    # A lock before every trim and at the end, unless left out where it would have
+    # crowded its place beyond the density limit.
+    left_out = {(round(t.x, 1), round(t.y, 1)) for t in plan.lighter if t.lock and t.level == 2}
+    ends = np.r_[trims - 1, np.flatnonzero(plan.kinds == STITCH)[-1]]
+    for end in ends[plan.roles[ends] != LOCK]:
+        assert tuple(np.round(plan.points[end], 1)) in left_out

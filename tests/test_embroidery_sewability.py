@@ -41,7 +41,7 @@ DRAWINGS = {
 
 @pytest.mark.parametrize("drawing", list(DRAWINGS))
 @pytest.mark.parametrize("style", STYLE_NAMES)
-def test_no_repeated_holes_and_no_dense_places_outside_locks(drawing, style):
+def test_no_repeated_holes_and_no_dense_places_every_needle_point_counted(drawing, style):
     plan = plan_embroidery(DRAWINGS[drawing](), PlanOptions(style=style_options(style)))
     assert repeated_penetrations(plan) == 0
     density = worst_density(plan)
@@ -117,3 +117,67 @@ def test_every_stroke_still_starts_with_a_tack_and_ends_with_a_lock():
     for run in needle_runs(plan):
         roles = plan.roles[run]
         assert roles[1] == TACK and roles[-1] == LOCK
+
+
+@pytest.mark.parametrize("style", STYLE_NAMES)
+@pytest.mark.parametrize("angle", [0.0, 37.0])
+def test_a_short_stroke_just_above_min_stroke_never_knots(style, angle):
+    """A 1.2 mm stroke (--min-stroke is 1 mm) used to get a full tack, its body and a full
+    lock: 8 needle points within 0.5 mm (running, arrows), 11 (triple), 8-13 (zigzag).
+    The tack and lock now give way where they would crowd it: every needle point
+    counted, at most 6 within 0.5 mm; the stroke is still sewn and still secured (a lock,
+    or a body that goes back over itself)."""
+    u = np.array([np.cos(np.radians(angle)), np.sin(np.radians(angle))])
+    drawing = Drawing((_line([0.0, 0.0], 1.2 * u), _line([20.0, 0.0], [40.0, 0.0])), 40, 2, "mm")
+    plan = plan_embroidery(drawing, PlanOptions(style=style_options(style)))
+    assert worst_density(plan) <= 6
+    assert embroidery_stats(plan).max_density == worst_density(plan)
+    short = np.flatnonzero((plan.kinds == STITCH) & (plan.strokes == 0))
+    assert len(short) >= 2 and not plan.dropped
+    roles = plan.roles[short]
+    # Secured: the thread passes over the stroke at least twice before the trim.
+    along = plan.points[short] @ u
+    assert (roles[-1] == LOCK) or np.sum(np.diff(along) < 0) >= 1
+    # The long stroke keeps its full tack and lock.
+    long_rows = np.flatnonzero((plan.kinds == STITCH) & (plan.strokes == 1))
+    assert (plan.roles[long_rows[1:5]] == TACK).all() and (plan.roles[long_rows[-4:]] == LOCK).all()
+    # What was made lighter is on record, at the short stroke. A zigzag this short has no
+    # underlay (it would re-enter its own first hole), and its tack and lock fit in full.
+    assert all(np.hypot(t.x, t.y) < 1.3 for t in plan.lighter)
+    assert bool(plan.lighter) == (style != "zigzag")
+    assert repeated_penetrations(plan) == 0
+
+
+def test_a_dropped_speck_is_measured_to_the_nearest_stitch_of_its_thread():
+    """The warning used to measure from the neighbouring strokes' ends only; it now gives
+    the distance to the nearest needle point of the speck's thread, and says why a speck
+    near the middle of a stroke is still left out."""
+    line = _line([0.0, 0.0], [30.0, 0.0])
+    beside = _line([15.0, 1.5], [15.4, 1.7])  # 1.5 mm from the line's middle, 15 mm from its ends
+    far = _line([10.0, 12.0], [10.4, 12.2])
+    other = _line([0.0, 25.0], [30.0, 25.0])
+    drawing = Drawing((line, beside, far, other), 30, 25, "mm")
+    plan = plan_embroidery(drawing, PlanOptions())
+    assert len(plan.dropped) == 2
+    needles = plan.points[plan.kinds == STITCH]
+    near_beside = np.linalg.norm(needles - beside.points_at(np.linspace(0, 1, 9))[:, None], axis=2).min()
+    near_far = np.linalg.norm(needles - far.points_at(np.linspace(0, 1, 9))[:, None], axis=2).min()
+    assert near_beside < 3.0 < near_far
+    first, second = plan.dropped
+    assert first.startswith("stroke 2 ") and f"nearest stitch of its thread, {near_beside:.1f} mm" in first
+    assert "sewn before and after it end more than --trim-distance 3 mm away" in first
+    assert second.startswith("stroke 3 ") and f"every stitch of its thread (the nearest is {near_far:.1f} mm" in second
+
+
+@pytest.mark.parametrize("style", ["running", "arrows"])
+def test_a_retraced_spike_is_sewn_back_in_fresh_holes(style):
+    """Out along a line and back along the same line (the vectorizer's retraced spikes):
+    equal stitches on the way back used to pierce the holes of the way out (2 on the spike
+    example drawing). Not yet triple stitch: its passes 0.35 mm either side of each hole
+    can still meet a hole of the way out on this spike (1 here, and a warning names it)."""
+    spike = Stroke.from_polyline(np.array([[0.0, 0.0], [8.0, 0.0], [13.0, 1.0], [8.0, 0.0], [8.0, 9.0]]))
+    plan = plan_embroidery(Drawing((spike,), 13, 9, "mm"), PlanOptions(style=style_options(style)))
+    assert repeated_penetrations(plan) == 0
+    assert worst_density(plan) <= 6
+    # The tip still gets its needle point.
+    assert np.linalg.norm(plan.points - [13.0, 1.0], axis=1).min() < 0.08

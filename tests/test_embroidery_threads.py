@@ -12,7 +12,7 @@ import pytest
 from click.testing import CliRunner
 from PIL import Image
 
-from embroidery_fixtures import FORMATS
+from embroidery_fixtures import FORMATS, THREE_COLOURS
 from fabrication.cli import main
 from fabrication.embroidery.export import jef_hoop_code
 from fabrication.embroidery.needles import UNDERLAY
@@ -23,14 +23,6 @@ from fabrication.embroidery.zigzag import ZigzagOptions, zigzag_stitch
 from vectorize.drawing import Drawing
 from vectorize.stroke import Stroke
 
-# Three colours; red twice, far apart, so one colour block holds two strokes.
-THREE_COLOURS = """<svg xmlns="http://www.w3.org/2000/svg" width="100" height="100" viewBox="0 0 100 100">
-<path d="M10 10 C 30 0 50 20 60 10" stroke="#c81e28" fill="none"/>
-<path d="M10 40 C 30 30 50 50 60 40" stroke="rgb(20,120,40)" fill="none"/>
-<g stroke="navy" fill="none"><path d="M10 70 C 30 60 50 80 60 70"/></g>
-<path d="M70 10 L 90 90" stroke="#c81e28" fill="none"/>
-</svg>
-"""
 COLOUR_FORMATS = ("pes", "jef", "vp3")  # the formats that store thread colours
 
 
@@ -70,6 +62,33 @@ def test_jef_hoop_code_follows_the_hoop(svg, tmp_path, hoop, code):
     _run("embroider", svg, "-o", out, "--size", "40mm", "--hoop", hoop)
     assert int.from_bytes(out.read_bytes()[0x20:0x24], "little") == code
     assert pyembroidery.read(str(out)).count_stitches() > 50  # still a valid file
+
+
+def _pes_hoop(data: bytes) -> tuple[int, tuple[int, int] | None]:
+    """The hoop indicator and (version 6) the hoop size in mm of a .pes file, read after
+    libpes' description of the header (not through our writer's code)."""
+    indicator = int.from_bytes(data[12:14], "little")
+    if data[:8] != b"#PES0060":
+        return indicator, None
+    at = 16  # the indicator, then two characters
+    for _ in range(5):  # design, category, author, keywords, comments
+        at += 1 + data[at]
+    at += 4  # optimize hoop change, design page is custom
+    return indicator, (int.from_bytes(data[at:at + 2], "little"), int.from_bytes(data[at + 2:at + 4], "little"))
+
+
+@pytest.mark.parametrize("hoop, indicator, size", [("4x4", 0, (100, 100)), ("5x7", 1, (130, 180)),
+                                                   ("200x200", 1, (200, 200)), ("6x10", 1, (160, 260)),
+                                                   ("90x80", 0, (90, 80))])
+def test_pes_header_hoop_follows_the_hoop(svg, tmp_path, hoop, indicator, size):
+    """pyembroidery writes a 130x180 indicator and a 100x100 mm hoop size whatever the hoop."""
+    for version in (6, 1):
+        out = tmp_path / f"d{version}.pes"
+        _run("embroider", svg, "-o", out, "--size", "40mm", "--hoop", hoop, "--pes-version", version)
+        assert _pes_hoop(out.read_bytes()) == (indicator, size if version == 6 else None)
+        back = pyembroidery.read(str(out))  # still a valid file, name and all
+        assert back.count_stitches() > 50
+        assert version == 1 or back.get_metadata("name") == "flowers"
 
 
 def test_design_name_is_stored_where_the_format_has_room(svg, tmp_path):

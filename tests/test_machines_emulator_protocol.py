@@ -13,7 +13,7 @@ def test_welcome_info_settings_and_modal_state(link):
     settings = grbl.send(b"$$\n", until=answered)
     assert "$30=1000" in settings and "$32=1" in settings and "$110=6000.000" in settings
     assert grbl.send(b"$G\n", until=answered)[0].startswith("[GC:G0 G54 G17 G21 G90 G94 M5")
-    assert grbl.send(b"$Q\n", until=answered) == ["error:3"]
+    assert grbl.send(b"$Q\n", until=answered) == ["error:2"]  # system.c: no setting number to read
 
 
 def test_errors_unsupported_too_long_feed_undefined(link):

@@ -68,7 +68,8 @@ def test_an_option_type_refuses_what_its_range_excludes(cls, name, limits):
     for value in _outside(limits):
         with pytest.raises(InputError) as refused:
             cls(**{name: value})
-        assert str(refused.value) == f"{limits.name} {value * limits.scale:g} must be {limits.text()}"
+        shown = str(value) if isinstance(value, int) else f"{value * limits.scale:g}"
+        assert str(refused.value) == f"{limits.name} {shown} must be {limits.text()}"
     for value, words in ((math.nan, "is not a finite number"), (math.inf, "is not a finite number"),
                          ("12", "is not a number"), (True, "is not a number")):
         with pytest.raises(InputError, match=re.escape(f"{limits.name} ") + ".*" + words):

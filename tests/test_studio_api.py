@@ -48,10 +48,14 @@ def test_guard_token_host_and_size(drawing):
         # The page's cookie carries the token from then on (the client keeps it).
         assert anonymous.get("/static/app.js").status_code == 200
         assert anonymous.get(f"/?token={TOKEN}", headers={"Host": "evil.example:8765"}).status_code == 403
+        # A change needs the token in its header: the cookie alone does not do.
+        assert anonymous.post("/api/state", json={}).status_code == 403
+        header = {"X-Studio-Token": TOKEN}
         big = b"x" * (MAX_BODY + 1)
-        assert anonymous.post("/api/state", content=big).status_code == 413
-        assert anonymous.post("/api/send", json={"port": "socket://10.0.0.1:23"}).status_code == 400
-        assert anonymous.post("/api/send", json={"port": "sim://?profile=/etc/passwd"}).status_code == 400
+        assert anonymous.post("/api/state", content=big, headers=header).status_code == 413
+        assert anonymous.post("/api/send", json={"port": "socket://10.0.0.1:23"}, headers=header).status_code == 400
+        assert anonymous.post("/api/send", json={"port": "sim://?profile=/etc/passwd"},
+                              headers=header).status_code == 400
 
 
 def test_state_pairing_edit_changes_the_order(client):

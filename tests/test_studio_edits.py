@@ -67,7 +67,7 @@ def test_passes_name_a_triple_points_branches_by_direction():
     ('{"format": "onestroke-edits", "version": 1, "edits": [{"kind": "passes", "at": [1, 2], "passes": [[1, 2]]}]}',
      "three or more pairs"),
     ('{"format": "onestroke-edits", "version": 1, "edits": [{"kind": "passes", "at": [1, 2], "passes": "x"}]}',
-     "pairs of directions"),
+     "passes: expected array or null"),
     ('{"format": "onestroke-edits", "version": 1, "edits": [{"kind": "split", "at": [1, 2], "passes": [[1, 2]]}]}',
      "takes no passes"),
 ])

@@ -12,7 +12,7 @@ from scipy.spatial import cKDTree
 
 from tests.conftest import render_polylines
 from vectorize import VectorizeOptions, vectorize_image
-from vectorize.route_inspection import EXACT_ODD_NODES, match_odd
+from vectorize.route_matching import PRUNE_FROM, match_odd
 
 OPTIONS = VectorizeOptions(classifier="geometric")
 WIDTH = 6.0
@@ -111,7 +111,7 @@ def test_exact_matching_is_optimal(seed):
 
 def test_large_matchings_are_complete():
     rng = np.random.default_rng(7)
-    m = EXACT_ODD_NODES + 6
+    m = PRUNE_FROM + 6
     points = rng.uniform(0, 100, (m, 2))
     dist = np.linalg.norm(points[:, None] - points[None], axis=2)
     pairs, ends = match_odd(dist, np.zeros(m))

@@ -7,7 +7,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from onestroke.errors import InputError
-from vectorize.stroke import Stroke, curve_bounds
+from vectorize.stroke import Stroke, curve_bounds, scaled_widths
 
 UNITS = ("px", "mm")
 
@@ -60,5 +60,6 @@ class Drawing:
             x, y = control[..., 0], control[..., 1]
             moved = np.stack([a * x + b * y + tx, c * x + d * y + ty], axis=-1)
             ends = np.cumsum([len(s.control) for s in self.strokes])[:-1]
-            strokes = tuple(Stroke(piece, s.color) for piece, s in zip(np.split(moved, ends), self.strokes))
+            strokes = tuple(Stroke(piece, s.color, scaled_widths(s.widths, matrix))
+                            for piece, s in zip(np.split(moved, ends), self.strokes))
         return replace(self, strokes=strokes, width=width, height=height, unit=unit, stroke_width=stroke_width)

@@ -135,43 +135,57 @@ class Edits:
         return json.dumps(self.to_dict(), indent=1) + "\n"
 
 
-def edits_from_dict(data) -> Edits:
-    """Parse what `Edits.to_dict` made (an `InputError` names what is wrong)."""
+def _schema() -> dict:
+    """What `Edits.to_dict` writes, as `onestroke.json_check` reads it."""
+    point = {"type": "array", "minItems": 2, "maxItems": 2, "items": {"type": "number"}}
+    # kinds, pairings and the number of passes are checked by `Edit`, whose messages say more
+    edit = {"type": "object", "required": ["kind", "at"], "properties": {
+        "kind": {"type": "string"}, "at": point, "pairing": {"type": ["string", "null"]},
+        "passes": {"type": ["array", "null"], "items": point}}}
+    return {"type": "object", "properties": {
+        # types here; ranges where `Edits` declares them (one check, the CLI's words)
+        "threshold": {"type": ["number", "null"]}, "blur": {"type": ["number", "null"]},
+        "multi": {"type": ["boolean", "null"]}, "tolerance": {"type": "number"},
+        "edits": {"type": "array", "items": edit}}}
+
+
+def edits_from_dict(data, *, name: str = "edits") -> Edits:
+    """Parse what `Edits.to_dict` made; `InputError` naming `name` (the file) and what in
+    it is wrong, checked against the schema before any edit is built."""
+    from onestroke.json_check import problem
+
     if not isinstance(data, dict) or data.get("format") != FORMAT:
-        raise InputError(f"not an onestroke edits file (expected \"format\": \"{FORMAT}\")")
+        raise InputError(f"{name}: not an onestroke edits file (expected \"format\": \"{FORMAT}\")")
     if data.get("version") != 1:
-        raise InputError(f"edits file version {data.get('version')!r} is not supported (expected 1)")
-    items = data.get("edits", [])
-    if not isinstance(items, list):
-        raise InputError("\"edits\" must be a list")
+        raise InputError(f"{name}: version {data.get('version')!r} is not supported (expected 1)")
+    found = problem(data, _schema())
+    if found:
+        raise InputError(f"{name}: {found}")
     try:
         edits = tuple(Edit(kind=e["kind"], at=tuple(e["at"]), pairing=e.get("pairing"), passes=e.get("passes"))
-                      for e in items)
+                      for e in data.get("edits", []))
         multi = data.get("multi")
         return Edits(threshold=_number(data.get("threshold")), blur=_number(data.get("blur")),
-                     multi=None if multi is None else bool(multi),
-                     tolerance=float(data.get("tolerance", TOLERANCE)), items=edits)
-    except (KeyError, TypeError, ValueError) as error:
-        if isinstance(error, InputError):
-            raise
-        raise InputError(f"edits file: malformed edit ({error})") from None
+                     multi=multi, tolerance=float(data.get("tolerance", TOLERANCE)), items=edits)
+    except InputError as error:
+        raise InputError(f"{name}: {error}") from None
 
 
 def _number(value) -> float | None:
     return None if value is None else float(value)
 
 
-def edits_from_json(text: str) -> Edits:
-    """Parse an edits file's text."""
-    try:
-        data = json.loads(text)
-    except json.JSONDecodeError as error:
-        raise InputError(f"edits file is not JSON: {error}") from None
-    return edits_from_dict(data)
+def edits_from_json(text: str | bytes, *, name: str = "edits file") -> Edits:
+    """Parse an edits file's text (`name`: the file, for messages)."""
+    from onestroke.json_check import parse_json
+
+    return edits_from_dict(parse_json(text, {}, what=name), name=name)  # the schema: after its format
 
 
 def read_edits(path) -> Edits:
-    """Read an edits file (`InputError` when missing, not text or malformed)."""
-    from onestroke.textfile import read_text
+    """Read an edits file (`InputError` when missing, not JSON or not an edits file)."""
+    from onestroke.paths import check_input_file
 
-    return edits_from_json(read_text(path, what="edits file"))
+    name = check_input_file(path, what="edits file", expect="an edits .json file")
+    with open(name, "rb") as handle:
+        return edits_from_json(handle.read(), name=f"edits file {name!r}")

@@ -33,13 +33,15 @@ class TracedPoints:
 
     xy: (N, 2) px; keep: (N,) bool, keep the point for the fit; split: (N,) bool, split the
     fit there; corner: (N,) bool or None (none), a corner (split, and the joint goes where
-    the two sides' tangents meet).
+    the two sides' tangents meet); radius: (N,) px, the medial axis's distance to the
+    outline at each point (half the ink width), or None (unknown).
     """
 
     xy: np.ndarray
     keep: np.ndarray
     split: np.ndarray
     corner: np.ndarray | None = None
+    radius: np.ndarray | None = None
 
     def __len__(self) -> int:
         return len(self.xy)

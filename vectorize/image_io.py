@@ -9,6 +9,7 @@ import numpy as np
 from PIL import Image, UnidentifiedImageError
 
 from onestroke.errors import InputError
+from onestroke.paths import check_input_file
 from vectorize import scan_bands
 from vectorize.options import InputFrame
 
@@ -29,9 +30,7 @@ def load_image(path: str | os.PathLike, *, max_size: int | None = None):
     Images over `MAX_PIXELS` are refused.
     """
 
-    path = str(path)
-    if not os.path.isfile(path):
-        raise InputError(f"input file {path!r} does not exist")
+    path = check_input_file(path, expect="an image")
     saved_limit = Image.MAX_IMAGE_PIXELS
     try:
         Image.MAX_IMAGE_PIXELS = None
@@ -39,6 +38,11 @@ def load_image(path: str | os.PathLike, *, max_size: int | None = None):
             warnings.simplefilter("ignore", Image.DecompressionBombWarning)
             with Image.open(path) as image:
                 original = (image.width, image.height)
+                from vectorize.binarize import MIN_SIDE
+
+                if min(original) < MIN_SIDE:  # said of the file's size, not of a downscaled copy
+                    raise InputError(f"image {path!r} is {image.width}x{image.height} px: too small for a drawing "
+                                     f"(need at least {MIN_SIDE} px a side)")
                 if image.width * image.height > MAX_PIXELS:
                     raise InputError(f"image {path!r} is {image.width} x {image.height} px "
                                      f"({image.width * image.height:,} pixels); the largest this reads is "

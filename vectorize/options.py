@@ -57,6 +57,8 @@ class VectorizeReport:
     out-and-back features kept; dropped_components: ink pieces left out (single-line mode);
     gaps_bridged: pen gaps joined across (single-line mode, `gaps.py`);
     high_degree_junctions: nodes where three or more strokes meet (not resolved);
+    odd_nodes: odd-degree nodes of the branch graph that route inspection paired by retraced
+    paths or left as the line's ends (single-line mode);
     scale: working px per input px (< 1 when downscaled); threshold: the ink/paper gray
     level used, in [0, 1] (Li's when none was given; None for an SVG of strokes); seconds:
     wall time per stage; cpu_seconds: CPU time of the process (all threads) per stage.
@@ -69,6 +71,7 @@ class VectorizeReport:
     gaps_bridged: int = 0
     high_degree_junctions: int = 0
     retries: int = 0
+    odd_nodes: int = 0
     scale: float = 1.0
     stroke_width: float = 0.0
     threshold: float | None = None

@@ -28,11 +28,9 @@ def vectorize_file(path: str | os.PathLike, options: VectorizeOptions = Vectoriz
     reused between calls on the same file (each edit then re-runs only later stages).
     progress: an `onestroke.progress.ProgressCallback` for reading a large SVG.
     """
-    path = str(path)
-    if not os.path.exists(path):
-        raise InputError(f"input file {path!r} does not exist")
-    if os.path.isdir(path):
-        raise InputError(f"input {path!r} is a directory, not an image")
+    from onestroke.paths import check_input_file
+
+    path = check_input_file(path, expect="an image or an SVG")
     suffix = os.path.splitext(path)[1].lower()
     if suffix in (".svg", ".svgz"):
         return _vectorize_svg(path, options, edits, cache, progress)

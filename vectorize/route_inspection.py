@@ -4,8 +4,9 @@ A single line visits every branch of its ink once, except where the pen went out
 (a retraced stem, a crossbar drawn out and back, a sharp spike): those branches are drawn
 twice. When the graph has more than two odd-degree nodes, no walk uses every branch once;
 the cheapest set of branches to draw twice is a minimum-weight matching of the odd nodes
-over shortest-path distances (Edmonds and Johnson's route inspection), leaving two of them
-unmatched for the pen to start and end at. Every decided junction (a crossing or a touch at
+over shortest-path distances (Edmonds and Johnson's route inspection), in which two of them
+may be left for the pen to start and end at (`route_matching`: one exact matching decides
+both). Every decided junction (a crossing or a touch at
 a degree-4 node, or a cluster where three passes cross) is a set of through-paths here, so
 retraced paths go through it the way the pairing says and the walk never turns there.
 
@@ -16,7 +17,6 @@ drawing still allows, and a stub drawn out and back is taken when the pen passes
 
 from __future__ import annotations
 
-import functools
 import heapq
 from dataclasses import dataclass
 
@@ -25,14 +25,9 @@ from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components, dijkstra
 
 from vectorize.graph import MedialGraph
+from vectorize.route_matching import match_odd
 from vectorize.simplify import slots
 from vectorize.traversal import Pass
-
-# The exact matching (bitmask dynamic programme) runs up to this many odd nodes: its states
-# grow as 2^n. Above it the matching is greedy (cheapest pair first) and then improved by
-# swapping partners between two pairs until no swap helps: within a few per cent of the
-# optimum on metric distances, not exact.
-EXACT_ODD_NODES = 14
 
 
 def _back(p: Pass) -> Pass:
@@ -57,12 +52,13 @@ class Chain:
 
 @dataclass(frozen=True)
 class Route:
-    """The single stroke: its branch passes in drawing order, whether it is closed, and the
-    retraced length (px) the matching added."""
+    """The single stroke: its branch passes in drawing order, whether it is closed, the
+    retraced length (px) the matching added and the odd-degree nodes it matched."""
 
     passes: tuple[Pass, ...]
     closed: bool
     retraced: float
+    odd_nodes: int = 0
 
 
 def _partners(pairings: dict[int, tuple[tuple[int, int], ...]]) -> dict[int, dict[int, int]]:
@@ -146,79 +142,6 @@ def pieces(graph: MedialGraph, pairings: dict) -> int:
     return int(connected_components(links, directed=False)[0])
 
 
-def match_odd(dist: np.ndarray, end_cost: np.ndarray) -> tuple[list[tuple[int, int]], list[int]]:
-    """Pairs of odd nodes to join by retraced paths, and the (0 or 2) left for the ends.
-
-    dist: (M, M) path costs between the M odd nodes (M even); end_cost: (M,) cost of the
-    pen starting or ending at each. Minimises the sum of the pairs' costs plus the ends'.
-    Exact for M <= EXACT_ODD_NODES (bitmask dynamic programme), greedy with pair swaps above.
-    """
-    m = len(dist)
-    if m == 0:
-        return [], []
-    if m <= EXACT_ODD_NODES:
-        return _match_exact(dist, end_cost)
-    return _match_greedy(dist, end_cost)
-
-
-def _match_exact(dist: np.ndarray, end_cost: np.ndarray) -> tuple[list[tuple[int, int]], list[int]]:
-    m = len(dist)
-    full = (1 << m) - 1
-    d = dist.tolist()
-    e = end_cost.tolist()
-
-    @functools.lru_cache(maxsize=None)
-    def best(mask: int, ends_left: int) -> tuple[float, tuple]:
-        if mask == full:
-            return 0.0, ()
-        i = (~mask & (mask + 1)).bit_length() - 1  # lowest node not yet placed
-        options = []
-        if ends_left:
-            cost, plan = best(mask | (1 << i), ends_left - 1)
-            options.append((cost + e[i], ((i, -1),) + plan))
-        for j in range(i + 1, m):
-            if not mask >> j & 1 and d[i][j] < np.inf:
-                cost, plan = best(mask | (1 << i) | (1 << j), ends_left)
-                options.append((cost + d[i][j], ((i, j),) + plan))
-        return min(options, key=lambda o: o[0]) if options else (np.inf, ())
-
-    _, plan = best(0, 2)
-    best.cache_clear()
-    pairs = [(i, j) for i, j in plan if j >= 0]
-    ends = [i for i, j in plan if j < 0]
-    return pairs, ends
-
-
-def _match_greedy(dist: np.ndarray, end_cost: np.ndarray) -> tuple[list[tuple[int, int]], list[int]]:
-    m = len(dist)
-    # The two ends: the pair of nodes whose removal leaves the cheapest greedy matching is
-    # too costly to search; take the two with the largest distance to their nearest other
-    # odd node, net of their end cost (the ones a retrace would reach furthest for).
-    nearest = np.where(np.eye(m, dtype=bool), np.inf, dist).min(axis=1) - end_cost
-    ends = [int(i) for i in np.argsort(-nearest, kind="stable")[:2]]
-    free = [i for i in range(m) if i not in ends]
-    order = sorted((dist[i, j], i, j) for a, i in enumerate(free) for j in free[a + 1:])
-    placed: set[int] = set()
-    pairs = []
-    for _, i, j in order:
-        if i not in placed and j not in placed:
-            pairs.append((i, j))
-            placed |= {i, j}
-    improved = True
-    while improved:
-        improved = False
-        for a in range(len(pairs)):
-            for b in range(a + 1, len(pairs)):
-                (i, j), (k, l) = pairs[a], pairs[b]
-                now = dist[i, j] + dist[k, l]
-                for x, y in (((i, k), (j, l)), ((i, l), (j, k))):
-                    if dist[x] + dist[y] < now - 1e-9:
-                        pairs[a], pairs[b] = x, y
-                        now = dist[x] + dist[y]
-                        improved = True
-    return pairs, ends
-
-
 class _Multigraph:
     """Chains (and their retraced copies) as edges between undecided nodes."""
 
@@ -289,6 +212,19 @@ def _fleury(multi: _Multigraph, start: int, first_slot: int | None, turn) -> lis
         walk.append(choice)
         node, entry = multi.far(e, end)
     return walk
+
+
+def _first_steps(pred: np.ndarray, sources: np.ndarray) -> np.ndarray:
+    """(S, N): the node after source s on its shortest path to each node (the node itself
+    where it is the source's neighbour, the source, or unreachable), from dijkstra's (S, N)
+    predecessors, by pointer doubling."""
+    own = np.arange(pred.shape[1])
+    step = np.where((pred == sources[:, None]) | (pred < 0), own, pred)
+    while True:
+        further = np.take_along_axis(step, step, axis=1)
+        if np.array_equal(further, step):
+            return step
+        step = further
 
 
 def plan_routes(graph: MedialGraph, pairings: dict, *, stroke_width: float, directions: dict,
@@ -368,28 +304,32 @@ def _route(graph: MedialGraph, chain_list: list[Chain], stroke_width: float, dir
         matrix = coo_matrix((weights, (rows, cols)), shape=(len(nodes), len(nodes))).tocsr()
         dist, pred = dijkstra(matrix, directed=False, indices=odd, return_predecessors=True)
 
+        row_of = {a: r for r, a in enumerate(odd)}
+
         def path(a: int, b: int) -> list[int]:
             """Chain indices along the shortest path from odd node a to node b."""
-            row = odd.index(a)
+            row = row_of[a]
             seq = [b]
             while seq[-1] != a:
                 seq.append(int(pred[row, seq[-1]]))
             seq.reverse()
             return [best_chain[(min(x, y), max(x, y))] for x, y in zip(seq[:-1], seq[1:])]
 
-        def end_slot(chain_index: int, node_index: int) -> int:
-            c = chain_list[chain_index]
-            return c.u_slot if where[c.u] == node_index else c.v_slot
+        def penalty(node_index: int, neighbour: int) -> float:
+            """leave_penalty of the path leaving odd node `node_index` towards `neighbour`."""
+            c = chain_list[best_chain[(min(node_index, neighbour), max(node_index, neighbour))]]
+            return leave_penalty(nodes[node_index], c.u_slot if where[c.u] == node_index else c.v_slot)
 
+        # The path from odd[i] to odd[j] leaves odd[i] towards first[i, odd[j]] and reaches
+        # odd[j] from pred[i, odd[j]]: its two end slots, without walking it.
+        first = _first_steps(pred, np.array(odd))
         m = len(odd)
         cost = np.full((m, m), np.inf)
         for i in range(m):
             for j in range(i + 1, m):
                 dij = dist[i, odd[j]]
                 if np.isfinite(dij):
-                    p = path(odd[i], odd[j])
-                    dij += leave_penalty(nodes[odd[i]], end_slot(p[0], odd[i]))
-                    dij += leave_penalty(nodes[odd[j]], end_slot(p[-1], odd[j]))
+                    dij += penalty(odd[i], int(first[i, odd[j]])) + penalty(odd[j], int(pred[i, odd[j]]))
                 cost[i, j] = cost[j, i] = dij
         ends_cost = np.array([end_cost.get(nodes[i], 0.0) for i in odd])
         pairs_out, ends = match_odd(cost, ends_cost)
@@ -416,7 +356,7 @@ def _route(graph: MedialGraph, chain_list: list[Chain], stroke_width: float, dir
         chain = chain_list[multi.edges[e]]
         seq = chain.passes if end == "u" else tuple(_back(p) for p in reversed(chain.passes))
         passes.extend(seq)
-    return Route(tuple(passes), not ends, retraced)
+    return Route(tuple(passes), not ends, retraced, len(odd))
 
 
 def connect_pairings(graph: MedialGraph, ranked: dict, costs: dict, *, fixed: dict | None = None,

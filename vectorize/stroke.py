@@ -53,6 +53,51 @@ def curve_bounds(control: np.ndarray) -> tuple[float, float, float, float]:
     return float(lo[0]), float(lo[1]), float(hi[0]), float(hi[1])
 
 
+def checked_widths(widths) -> np.ndarray:
+    """A width profile (see `Stroke`) as a read-only (M, 2) float array, or `InputError`."""
+    widths = np.array(widths, dtype=float)
+    if widths.ndim != 2 or widths.shape[1] != 2 or len(widths) < 2:
+        raise InputError(f"stroke widths must have shape (M >= 2, 2) rows (t, width), got {widths.shape}")
+    if not np.all(np.isfinite(widths)):
+        raise InputError("stroke widths must be finite numbers")
+    t, w = widths[:, 0], widths[:, 1]
+    if abs(t[0]) > 1e-9 or abs(t[-1] - 1.0) > 1e-9 or np.any(np.diff(t) <= 0):
+        raise InputError("stroke widths' parameters must rise strictly from 0 to 1")
+    if w.min() < 0 or w.max() > MAX_COORDINATE:
+        raise InputError(f"stroke widths must lie in [0, {MAX_COORDINATE:.0e}], got {w.min():.3g}-{w.max():.3g}")
+    widths[0, 0], widths[-1, 0] = 0.0, 1.0
+    widths.setflags(write=False)
+    return widths
+
+
+def scaled_widths(widths: np.ndarray | None, matrix: np.ndarray) -> np.ndarray | None:
+    """A width profile through the 2x3 affine `matrix`: widths times the square root of its
+    area scale (the exact factor of a uniform scale, a rotation or a mirror)."""
+    if widths is None:
+        return None
+    (a, b, _), (c, d, _) = np.asarray(matrix, dtype=float)
+    return np.column_stack([widths[:, 0], widths[:, 1] * np.sqrt(abs(a * d - b * c))])
+
+
+def recut_widths(widths: np.ndarray | None, old: np.ndarray, new: np.ndarray) -> np.ndarray | None:
+    """A width profile for a re-cut curve: `old` (B,) the old global parameters, rising (they
+    may run past 1 on a closed curve re-started elsewhere: taken modulo 1), of the new
+    curve's parameters `new` (B,) rising from 0 to 1, between which both run linearly."""
+    if widths is None:
+        return None
+    old, new = np.asarray(old, dtype=float), np.asarray(new, dtype=float)
+    # the old profile's rows, as old parameters within [old[0], old[-1]] (and a turn on)
+    rows = np.concatenate([widths[:, 0] + k for k in range(int(np.floor(old[0])), int(np.ceil(old[-1])) + 1)])
+    rows = rows[(rows > old[0]) & (rows < old[-1])]
+    t_old = np.union1d(old, rows)
+    t_new = np.interp(t_old, old, new)
+    keep = np.concatenate([[True], np.diff(t_new) > 1e-12])
+    t_old, t_new = t_old[keep], t_new[keep]
+    t_new[-1] = 1.0
+    return np.column_stack([t_new, np.interp(np.mod(t_old, 1.0) if old[-1] > 1.0 else t_old,
+                                             widths[:, 0], widths[:, 1])])
+
+
 @dataclass(frozen=True, eq=False)
 class Stroke:
     """A cubic Bézier spline: `control` has shape (K, 4, 2), x right, y down.
@@ -62,10 +107,16 @@ class Stroke:
     those of the `Drawing` that holds the stroke (px before placement, mm after).
     `color`: RGB 0-255 the stroke is drawn in (an SVG stroke colour), None when unknown;
     it travels with the curve through reversal and transforms.
+    `widths`: the ink width along the stroke, (M >= 2, 2) rows (t, width): global parameter
+    t rising strictly from 0 to 1, width >= 0 in the drawing's unit (the vectorizer's
+    medial-axis diameter), linear between rows; None when unknown (the drawing's
+    `stroke_width` stands in). It travels with the curve too: reversed, scaled by the
+    transform's area scale, re-cut with the segments.
     """
 
     control: np.ndarray
     color: tuple[int, int, int] | None = None
+    widths: np.ndarray | None = None
 
     def __post_init__(self) -> None:
         control = np.array(self.control, dtype=float)
@@ -84,6 +135,8 @@ class Stroke:
             if len(color) != 3 or not all(0 <= c <= 255 for c in color):
                 raise InputError(f"stroke colour {self.color!r} must be three values 0-255")
             object.__setattr__(self, "color", color)
+        if self.widths is not None:
+            object.__setattr__(self, "widths", checked_widths(self.widths))
 
     # -- construction ------------------------------------------------------------------
     @classmethod
@@ -213,14 +266,30 @@ class Stroke:
         pts = self.points_at(np.append(t, 1.0))
         return pts
 
+    # -- ink width ----------------------------------------------------------------------
+    def widths_at(self, t: np.ndarray | float) -> np.ndarray | None:
+        """Ink widths at global parameters t (same shape as t), None when unknown."""
+        if self.widths is None:
+            return None
+        return np.interp(t, self.widths[:, 0], self.widths[:, 1])
+
+    def with_widths(self, widths: np.ndarray | None) -> "Stroke":
+        """The same curve with another width profile (see the class doc)."""
+        return Stroke(self.control, self.color, widths)
+
     # -- transformations ---------------------------------------------------------------
     def reversed(self) -> "Stroke":
         """The same curve traversed from end to start."""
-        return Stroke(self.control[::-1, ::-1], self.color)
+        widths = None
+        if self.widths is not None:
+            widths = np.column_stack([1.0 - self.widths[::-1, 0], self.widths[::-1, 1]])
+            widths[0, 0], widths[-1, 0] = 0.0, 1.0
+        return Stroke(self.control[::-1, ::-1], self.color, widths)
 
     def transformed(self, matrix: np.ndarray) -> "Stroke":
         """Apply a 2x3 affine matrix [[a, b, tx], [c, d, ty]] to every control point."""
         (a, b, tx), (c, d, ty) = np.asarray(matrix, dtype=float)
         x, y = self.control[..., 0], self.control[..., 1]
         # Written out: a batched (K*4, 2) @ (2, 2) matmul is several times slower.
-        return Stroke(np.stack([a * x + b * y + tx, c * x + d * y + ty], axis=-1), self.color)
+        return Stroke(np.stack([a * x + b * y + tx, c * x + d * y + ty], axis=-1), self.color,
+                      scaled_widths(self.widths, matrix))

@@ -8,31 +8,26 @@ A line drawing stored as SVG comes in one of two forms:
   the centre-line curve from a rasterization of them.
 
 Files from the wild spell the SVG namespace in many ways (https, a trailing slash, none at
-all) or wrap the drawing in XHTML; those are normalised to the standard namespace before
-svgelements reads them. A coordinate that is not finite or lies beyond
+all), wrap the drawing in XHTML or come gzip-compressed (.svgz); `vectorize.svg_source`
+reads them within bounds (references expanded, nesting, size) before svgelements parses
+them. A coordinate that is not finite or lies beyond
 `stroke.MAX_COORDINATE` (1e7 px, 260 m at 96 dpi) is refused, naming the element.
 """
 
 from __future__ import annotations
 
-import io
 import os
-import re
-import xml.etree.ElementTree as ET
 from dataclasses import dataclass
 
 import numpy as np
 import svgelements as se
 
 from onestroke.errors import InputError
+from onestroke.paths import check_input_file
 from onestroke.progress import ProgressCallback, Stage, counted
 from vectorize.drawing import Drawing
-from vectorize.stroke import MAX_COORDINATE, Stroke
-
-SVG_NS = "http://www.w3.org/2000/svg"
-MAX_SVG_BYTES = 200_000_000  # a 200 MB SVG is far past any drawing; refuse before parsing
-# Namespaces a human meant as SVG's: http or https, www or not, with or without a final slash.
-_SVG_LIKE = re.compile(r"^(https?://)?(www\.)?w3\.org/2000/svg/?$", re.IGNORECASE)
+from vectorize.stroke import MAX_COORDINATE, Stroke, checked_widths, recut_widths
+from vectorize.svg_source import ChunkReader, svg_source
 
 
 @dataclass(frozen=True)
@@ -78,64 +73,77 @@ def _segment_row(segment) -> tuple[float, ...] | None:
     return None
 
 
-def _subpaths(path) -> list[np.ndarray]:
-    """Cubic control arrays (K, 4, 2), one per sub-path, zero-length pieces dropped."""
-    result: list[np.ndarray] = []
+def _arc_cubics(arc, element, path: str):
+    """The cubics of an elliptical arc; `InputError` naming the element when its radii,
+    angle or sweep are not finite (`A 1e308 1e308 0 1 1 10 10` overflows to NaN)."""
+    values = (arc.rx, arc.ry, arc.sweep, arc.get_rotation())
+    if not all(np.isfinite(float(v)) for v in values if v is not None):
+        raise InputError(f"SVG {path!r}: {_element_name(element)} has an arc whose radius or sweep is not a finite "
+                         "number (radii too large?)")
+    return arc.as_cubic_curves()
+
+
+def _subpaths(path, element, source: str) -> list[tuple[np.ndarray, np.ndarray, int]]:
+    """Per sub-path: cubic control array (K, 4, 2) with zero-length pieces dropped, the index
+    of each kept piece among the sub-path's drawn pieces (a closing Z's straight piece is not
+    one of them) and how many drawn pieces there were. element, source: the SVG element and
+    file, for messages."""
+    result: list[tuple[np.ndarray, np.ndarray, int]] = []
     current: list[tuple[float, ...]] = []
+    closing: list[bool] = []
 
     def close() -> None:
         if current:
             control = np.array(current, dtype=float).reshape(-1, 4, 2)
+            _check_coordinates(control, element, source)  # before NaN pieces look zero-length
             keep = np.ptp(control, axis=1).max(axis=1) > 1e-9
+            drawn = ~np.array(closing)
             if keep.any():
-                result.append(control[keep])
+                index = np.cumsum(drawn) - 1
+                result.append((control[keep], index[keep], int(drawn.sum())))
 
     for segment in path:
         if isinstance(segment, se.Move):
             close()
-            current = []
+            current, closing = [], []
             continue
         if isinstance(segment, se.Arc):
-            rows = [_segment_row(c) for c in segment.as_cubic_curves()]
+            rows = [_segment_row(c) for c in _arc_cubics(segment, element, source)]
         else:
             rows = [_segment_row(segment)]
-        current.extend(row for row in rows if row is not None)
+        rows = [row for row in rows if row is not None]
+        current.extend(rows)
+        closing.extend([isinstance(segment, se.Close)] * len(rows))
     close()
     return result
+
+
+def _widths(element, path: str, index: np.ndarray, drawn: int) -> np.ndarray | None:
+    """The `Stroke.widths` of an element's `data-widths` (onestroke's own SVGs: "t w t w ...",
+    t the path's parameter over its drawn pieces, w in user units), for the pieces `index`
+    kept of `drawn`; None without the attribute. Widths are scaled by the element's
+    transform (the viewBox included)."""
+    text = element.values.get("data-widths")
+    if text is None:
+        return None
+    try:
+        rows = np.array(str(text).replace(",", " ").split(), dtype=float).reshape(-1, 2)
+        scale = float(np.sqrt(abs(se.Matrix(element.values.get("transform", "")).determinant)))
+        widths = checked_widths(np.column_stack([rows[:, 0], rows[:, 1] * scale]))
+    except (ValueError, InputError) as error:
+        raise InputError(f"SVG {path!r}: {_element_name(element)} has data-widths that are not "
+                         f"(t, width) pairs with t rising from 0 to 1: {error}") from None
+    if len(index) == drawn and np.array_equal(index, np.arange(drawn)):
+        return widths
+    # Pieces of zero length were dropped: the kept pieces' old parameters, in turn.
+    old = np.column_stack([index, index + 1]).ravel() / drawn
+    kept = np.arange(len(index))
+    return recut_widths(widths, old, np.column_stack([kept, kept + 1]).ravel() / len(index))
 
 
 def _has_paint(value) -> bool:
     return value is not None and getattr(value, "value", None) is not None and value.value != "none" \
         and getattr(value, "opacity", 1.0) != 0
-
-
-def _local(tag) -> str:
-    return tag.rsplit("}", 1)[-1] if isinstance(tag, str) else ""
-
-
-def _namespace(tag) -> str | None:
-    return tag[1:].split("}", 1)[0] if isinstance(tag, str) and tag.startswith("{") else None
-
-
-def _svg_source(path: str):
-    """The file itself if its root is a standard <svg>; else the first <svg> element (inside
-    XHTML or any wrapper), its SVG-like namespaces made the standard one, as bytes."""
-    try:
-        if os.path.getsize(path) > MAX_SVG_BYTES:
-            raise InputError(f"SVG {path!r} is over {MAX_SVG_BYTES // 1_000_000} MB; too large to read")
-        root = ET.parse(path).getroot()
-    except ET.ParseError as error:
-        raise InputError(f"cannot read SVG {path!r}: not well-formed XML ({error})") from None
-    if root.tag == f"{{{SVG_NS}}}svg":
-        return path
-    svg = next((element for element in root.iter() if _local(element.tag) == "svg"), None)
-    if svg is None:
-        raise InputError(f"{path!r} holds no <svg> element (its root is <{_local(root.tag)}>)")
-    for element in svg.iter():
-        namespace = _namespace(element.tag)
-        if namespace is None or _SVG_LIKE.match(namespace) or namespace == "http://www.w3.org/1999/xhtml":
-            element.tag = f"{{{SVG_NS}}}{_local(element.tag)}"
-    return io.BytesIO(ET.tostring(svg))
 
 
 def _element_name(element) -> str:
@@ -171,37 +179,22 @@ def _rgb(paint) -> tuple[int, int, int] | None:
         return None
 
 
-class _CountingReader:
-    """A binary file that reports how much of it was read (svgelements parses as it reads)."""
-
-    def __init__(self, handle, report: Stage) -> None:
-        self.handle, self.report = handle, report
-
-    def read(self, size: int = -1) -> bytes:
-        data = self.handle.read(size)
-        self.report.advance(len(data))
-        return data
-
-
 def read_svg(path: str | os.PathLike, *, progress: ProgressCallback | None = None) -> SvgContent:
-    """Parse an SVG file into strokes and outline rings (px at 96 dpi, transforms applied).
+    """Parse an SVG file (or gzip-compressed .svgz) into strokes and outline rings (px at 96
+    dpi, transforms applied), within the bounds of `vectorize.svg_source`.
 
-    progress: called with `onestroke.progress.Progress` reports (bytes parsed, then shapes read).
+    progress: called with `onestroke.progress.Progress` reports (bytes read, bytes parsed,
+    then shapes read).
     """
-    path = str(path)
-    if not os.path.isfile(path):
-        raise InputError(f"input file {path!r} does not exist")
-    source = _svg_source(path)
+    path = check_input_file(path, expect="an SVG file")
+    source = svg_source(path, progress=progress)
     try:
-        if progress is not None:
-            opened = open(source, "rb") if isinstance(source, str) else source
-            with opened:
-                size = os.fstat(opened.fileno()).st_size if isinstance(source, str) else len(source.getvalue())
-                parsing = Stage(progress, "parsing", size, "bytes")
-                svg = se.SVG.parse(_CountingReader(opened, parsing), reify=True)
-                parsing.finish()
-        else:
-            svg = se.SVG.parse(source, reify=True)
+        parsing = Stage(progress, "parsing", len(source), "bytes") if progress is not None else None
+        svg = se.SVG.parse(ChunkReader(source, parsing), reify=True)
+        if parsing is not None:
+            parsing.finish()
+    except RecursionError:
+        raise InputError(f"cannot read SVG {path!r}: it nests too deeply to read") from None
     except Exception as error:  # svgelements raises many kinds on malformed XML
         raise InputError(f"cannot read SVG {path!r}: {str(error).splitlines()[0] if str(error) else type(error).__name__}") from None
     if svg is None:
@@ -234,11 +227,12 @@ def read_svg(path: str | os.PathLike, *, progress: ProgressCallback | None = Non
         stroked = _has_paint(element.stroke)
         filled = _has_paint(element.fill)
         color = _rgb(element.stroke) if stroked else None
-        for control in _subpaths(path_obj):
-            _check_coordinates(control, element, path)
+        pieces = _subpaths(path_obj, element, path)
+        for control, index, drawn in pieces:
             if stroked or not filled:
                 # Unpainted shapes are treated as strokes: a line drawing has no other use.
-                strokes.append(Stroke(control, color))
+                profile = _widths(element, path, index, drawn) if len(pieces) == 1 else None
+                strokes.append(Stroke(control, color, profile))
                 width = element.stroke_width
                 widths.append(float(width) if width and np.isfinite(float(width)) else 1.0)
             else:

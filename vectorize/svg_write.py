@@ -4,6 +4,9 @@ from __future__ import annotations
 
 import json
 import os
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from xml.sax.saxutils import quoteattr
 
 import numpy as np
 
@@ -29,26 +32,67 @@ def path_data(stroke: Stroke) -> str:
     return "".join(parts)
 
 
-def drawing_to_svg(drawing: Drawing, *, color: str = "#000000") -> str:
-    """The SVG text of `drawing`: viewBox = its canvas, stroke width = its measured width."""
+def widths_data(stroke: Stroke) -> str:
+    """A stroke's ink widths as written in `data-widths`: "t w t w ...", t the path's
+    parameter (segment k of K spans t in [k/K, (k+1)/K]) to 6 decimals, w the width in the
+    drawing's unit to 3."""
+    return " ".join(f"{_num6(t)} {_num(w)}" for t, w in stroke.widths)
+
+
+def _num6(value: float) -> str:
+    text = f"{value:.6f}".rstrip("0").rstrip(".")
+    return "0" if text in ("-0", "") else text
+
+
+@dataclass(frozen=True)
+class SvgPath:
+    """One `<path>` of the document: its sub-paths in order (one `M` each) and extra attributes.
+
+    attributes: (name, value) pairs written on the element, e.g. ("stroke-width", "0.1") or a
+    namespaced ("inkstitch:satin_column", "true") whose prefix `drawing_to_svg` declares;
+    color: RGB 0-255 overriding the group's stroke colour, None to inherit it.
+    """
+
+    subpaths: tuple[Stroke, ...]
+    attributes: tuple[tuple[str, str], ...] = ()
+    color: tuple[int, int, int] | None = None
+
+
+def drawing_to_svg(drawing: Drawing, *, color: str = "#000000", namespaces: Mapping[str, str] | None = None,
+                   paths: Sequence[SvgPath] | None = None) -> str:
+    """The SVG text of `drawing`: viewBox = its canvas, stroke width = its measured width.
+
+    By default one `<path>` per stroke, in drawing order, each whose ink widths are known
+    carrying them in `data-widths` (`widths_data`). `paths` replaces them (the same canvas
+    and group style), e.g. with a bridge's parameters on each; `namespaces` (prefix -> URI)
+    are declared on the root for their attributes.
+    """
     w, h = _num(drawing.width), _num(drawing.height)
     size = f'width="{w}mm" height="{h}mm"' if drawing.unit == "mm" else f'width="{w}" height="{h}"'
+    declared = "".join(f" xmlns:{prefix}={quoteattr(uri)}" for prefix, uri in (namespaces or {}).items())
     lines = [
         '<?xml version="1.0" encoding="UTF-8"?>',
-        f'<svg xmlns="http://www.w3.org/2000/svg" {size} viewBox="0 0 {w} {h}">',
+        f'<svg xmlns="http://www.w3.org/2000/svg"{declared} {size} viewBox="0 0 {w} {h}">',
         f'<g fill="none" stroke="{color}" stroke-width="{_num(drawing.stroke_width)}" '
         'stroke-linecap="round" stroke-linejoin="round">',
     ]
-    for index, stroke in enumerate(drawing.strokes):
-        # A stroke's own colour overrides the group's; uncoloured strokes inherit it.
-        paint = "" if stroke.color is None else ' stroke="#{:02x}{:02x}{:02x}"'.format(*stroke.color)
-        lines.append(f'<path id="stroke-{index + 1}"{paint} d="{path_data(stroke)}"/>')
+    if paths is None:
+        paths = [SvgPath((stroke,), () if stroke.widths is None else (("data-widths", widths_data(stroke)),),
+                         stroke.color) for stroke in drawing.strokes]
+    for index, path in enumerate(paths):
+        # A path's own colour overrides the group's; uncoloured paths inherit it.
+        paint = "" if path.color is None else ' stroke="#{:02x}{:02x}{:02x}"'.format(*path.color)
+        extra = "".join(f" {name}={quoteattr(str(value))}" for name, value in path.attributes)
+        data = "".join(path_data(sub) for sub in path.subpaths)
+        lines.append(f'<path id="stroke-{index + 1}"{paint}{extra} d="{data}"/>')
     lines += ["</g>", "</svg>", ""]
     return "\n".join(lines)
 
 
 def drawing_to_json(drawing: Drawing) -> str:
-    """JSON with the canvas and each stroke's control points, shape (K, 4, 2)."""
+    """JSON with the canvas and each stroke's control points, shape (K, 4, 2); "widths"
+    (when a stroke has them): one entry per stroke, its `Stroke.widths` rows [t, width] or
+    null."""
     payload = {
         "format": "onestroke-drawing",
         "version": 1,
@@ -61,30 +105,63 @@ def drawing_to_json(drawing: Drawing) -> str:
     if any(s.color is not None for s in drawing.strokes):
         # One entry per stroke: [r, g, b] or null (written only when a stroke has a colour).
         payload["colors"] = [None if s.color is None else list(s.color) for s in drawing.strokes]
+    if any(s.widths is not None for s in drawing.strokes):
+        payload["widths"] = [None if s.widths is None else np.column_stack([np.round(s.widths[:, 0], 6),
+                                                                            np.round(s.widths[:, 1], 4)]).tolist()
+                             for s in drawing.strokes]
     return json.dumps(payload, separators=(",", ":")) + "\n"
 
 
-def drawing_from_json(text: str) -> Drawing:
-    """Parse what `drawing_to_json` wrote."""
-    from onestroke.errors import InputError
+def _drawing_schema() -> dict:
+    """What `drawing_to_json` writes, as `onestroke.json_check` reads it."""
+    from vectorize.drawing import UNITS
+    from vectorize.stroke import MAX_COORDINATE
 
+    side = {"type": "number", "exclusiveMinimum": 0, "maximum": MAX_COORDINATE}
+    rgb = {"type": "array", "minItems": 3, "maxItems": 3, "items": {"type": "integer", "minimum": 0, "maximum": 255}}
+    return {"type": "object", "required": ["format", "width", "height", "strokes"], "properties": {
+        "format": {"const": "onestroke-drawing"}, "version": {"const": 1}, "unit": {"enum": list(UNITS)},
+        "width": side, "height": side, "stroke_width": {"type": "number", "minimum": 0, "maximum": MAX_COORDINATE},
+        "strokes": {"type": "array", "items": {"shape": [None, 4, 2]}},
+        "colors": {"type": ["array", "null"], "items": {"type": ["array", "null"], **rgb}},
+        "widths": {"type": ["array", "null"], "items": {"type": ["array", "null"], "items": {"shape": [2]}}}}}
+
+
+def drawing_from_json(text: str | bytes, *, name: str = "JSON drawing") -> Drawing:
+    """Parse what `drawing_to_json` wrote; `InputError` naming `name` (the file) and what in
+    it is wrong (checked against the schema before anything is built)."""
+    from onestroke.errors import InputError
+    from onestroke.json_check import parse_json
+
+    payload = parse_json(text, _drawing_schema(), what=name)
+    strokes = payload["strokes"]
+    colors = payload.get("colors") or [None] * len(strokes)
+    if len(colors) != len(strokes):
+        raise InputError(f"{name}: $.colors: {len(colors)} colours for {len(strokes)} strokes")
+    widths = payload.get("widths") or [None] * len(strokes)
+    if len(widths) != len(strokes):
+        raise InputError(f"{name}: $.widths: {len(widths)} width profiles for {len(strokes)} strokes")
     try:
-        payload = json.loads(text)
-        if payload.get("format") != "onestroke-drawing":
-            raise ValueError("not an onestroke drawing")
-        colors = payload.get("colors") or [None] * len(payload["strokes"])
-        if len(colors) != len(payload["strokes"]):
-            raise ValueError(f"{len(colors)} colours for {len(payload['strokes'])} strokes")
         return Drawing(
-            strokes=tuple(Stroke(np.array(c, dtype=float), None if rgb is None else tuple(rgb))
-                          for c, rgb in zip(payload["strokes"], colors)),
+            strokes=tuple(Stroke(np.array(c, dtype=float), None if rgb is None else tuple(rgb),
+                                 None if w is None else np.array(w, dtype=float))
+                          for c, rgb, w in zip(strokes, colors, widths)),
             width=float(payload["width"]),
             height=float(payload["height"]),
             unit=payload.get("unit", "px"),
             stroke_width=float(payload.get("stroke_width", 1.0)),
         )
-    except (ValueError, KeyError, TypeError) as error:
-        raise InputError(f"not a valid onestroke JSON drawing: {error}") from None
+    except InputError as error:
+        raise InputError(f"{name}: {error}") from None
+
+
+def read_drawing_json(path: str | os.PathLike) -> Drawing:
+    """A .json drawing file (`drawing_from_json`), refused in one line when it is not one."""
+    from onestroke.paths import check_input_file
+
+    name = check_input_file(path, what="drawing", expect="a .json drawing")
+    with open(name, "rb") as handle:
+        return drawing_from_json(handle.read(), name=f"drawing {name!r}")
 
 
 def write_drawing(drawing: Drawing, path: str | os.PathLike) -> None:

@@ -26,11 +26,13 @@ class Pass:
 
 @dataclass(frozen=True)
 class Ordering:
-    """Strokes as sequences of branch passes; `choice` is the pairing used per crossing."""
+    """Strokes as sequences of branch passes; `choice` is the pairing used per crossing;
+    `odd_nodes`: odd-degree nodes route inspection paired or left as ends (single-line mode)."""
 
     strokes: tuple[tuple[Pass, ...], ...]
     closed: tuple[bool, ...]
     choice: tuple
+    odd_nodes: int = 0
 
 
 class Walker:

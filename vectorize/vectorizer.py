@@ -16,6 +16,7 @@ from vectorize.fitting import TracedPoints, fit_stroke
 from vectorize.gaps import bridge_gaps, keep_largest_piece
 from vectorize.graph import MedialGraph, lengths
 from vectorize.ink_guard import InkGuard, guard_margin
+from vectorize.ink_width import edge_offset, ink_widths
 from vectorize.classifiers import make_classifier, shipped_pass_scorer
 from vectorize.clusters import merge_triple_points, straightest_pairs
 from vectorize.crossing_point import crossing_point
@@ -172,14 +173,16 @@ def _trace(graph: MedialGraph, simple: Simplified, ordering: Ordering, junctions
     # the foot of a V-spike (each side of the V runs to the tip on its own ink).
     not_twins = {bid for bid, b in graph.branches.items() if b.a == b.b} | foot_branches
     for passes, closed in zip(ordering.strokes, ordering.closed):
-        parts, keeps, tips, spans = [], [], [], []
+        parts, keeps, tips, spans, radii = [], [], [], [], []
         count = 0  # traced points so far
         for index, step in enumerate(passes):
             branch = graph.branches[step.branch]
             # By end, not by node: a loop starts and ends at the same node.
             points = branch.points if step.start == "a" else branch.points[::-1]
+            radius = branch.radii if step.start == "a" else branch.radii[::-1]
             far_node = branch.b if step.start == "a" else branch.a
             points = points if index == 0 else points[1:]
+            radius = radius if index == 0 else radius[1:]
             spans.append((max(count - 1, 0), count + len(points) - 1))
             if not len(points):
                 continue
@@ -191,6 +194,7 @@ def _trace(graph: MedialGraph, simple: Simplified, ordering: Ordering, junctions
             tip = np.zeros(len(points), dtype=bool)
             tip[-1] = far_node in simple.y_tips or turns_back
             parts.append(points)
+            radii.append(radius)
             keeps.append(tip | (not on_foot))
             tips.append(tip)
         twins = twin_spans([p.branch for p in passes], [p.start for p in passes], spans, not_twins)
@@ -205,7 +209,7 @@ def _trace(graph: MedialGraph, simple: Simplified, ordering: Ordering, junctions
             dist = lengths(xy - center)
             near = dist < reach
             keep[near] &= crossing & (dist[near] < 1e-6)
-        result.append((TracedPoints(xy=xy, keep=keep, split=split), closed, twins))
+        result.append((TracedPoints(xy=xy, keep=keep, split=split, radius=np.concatenate(radii)), closed, twins))
     return result
 
 
@@ -308,7 +312,8 @@ def _single_route(graph: MedialGraph, simple: Simplified, ranked: dict, costs: d
     routes = plan_routes(graph, {**simple.through, **pairing}, stroke_width=w, directions=dirs, end_cost=end_cost,
                          weight=weight)
     choice = tuple(pairing.get(n, ranked[n][0]) for n in simple.crossings)
-    return Ordering(tuple(r.passes for r in routes), tuple(r.closed for r in routes), choice), tried
+    return Ordering(tuple(r.passes for r in routes), tuple(r.closed for r in routes), choice,
+                    sum(r.odd_nodes for r in routes)), tried
 
 
 def _refuse_noise(count: int, what: str, limit: int, threshold: float, given: bool) -> None:
@@ -454,12 +459,16 @@ def run_pipeline(image: np.ndarray, options: VectorizeOptions, *,
     # grid, anti-aliasing); fitting tighter follows that wobble, looser cuts corners.
     sigma = float(np.clip(0.065 * w, 0.15, 0.8))
     guard = InkGuard(graph, ink.gray, ink.threshold, margin=guard_margin(w)) if solved is None else None
+    edge = edge_offset(ink.gray, ink.ink, rings, ink.threshold, w) if solved is None else 0.0
+    blobs = np.array([[*graph.positions[n], graph.radii[n]] for n, incident in graph.incident.items()
+                      if len(incident) >= 3]).reshape(-1, 3)
     strokes = list(solved[1]) if solved is not None else []
     for traced, closed, twins in _trace(graph, simple, ordering, junctions, verdicts, w) if solved is None else ():
         if len(traced) < 2:
             continue
-        strokes.append(_orient(fit_stroke(traced, closed=closed, sigma=sigma, stroke_width=w, guard=guard,
-                                          twins=tuple(twins)), closed))
+        fitted = fit_stroke(traced, closed=closed, sigma=sigma, stroke_width=w, guard=guard, twins=tuple(twins))
+        fitted = fitted.with_widths(ink_widths(fitted, traced.xy, traced.radius, traced.keep, w, edge, blobs))
+        strokes.append(_orient(fitted, closed))
     if refine is not None and solved is None:
         refine.keep_solved(best, strokes)
     strokes = [s for s in strokes if s.length > 0.5 * w or len(strokes) == 1]
@@ -490,7 +499,7 @@ def run_pipeline(image: np.ndarray, options: VectorizeOptions, *,
     report = VectorizeReport(
         strokes=len(strokes), intersections=len(simple.crossings), y_junctions=len(simple.y_feet),
         dropped_components=dropped, gaps_bridged=len(bridges), high_degree_junctions=len(simple.unresolved),
-        retries=tried - 1,
+        retries=tried - 1, odd_nodes=ordering.odd_nodes,
         scale=scale, stroke_width=w / scale, threshold=float(ink.threshold), warnings=tuple(warnings),
         seconds=clock.seconds,
         cpu_seconds=clock.cpu_seconds)

@@ -13,6 +13,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from onestroke.errors import InputError
+from onestroke.paths import check_input_file
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -55,10 +56,9 @@ def find_inputs(inputs, out_dir: str | os.PathLike, extensions: tuple[str, ...],
             for file in _walk(path, out):
                 if file.suffix.lower().lstrip(".") in input_extensions:
                     pairs.append((file.resolve(), file.relative_to(path).as_posix()))
-        elif path.is_file():
-            pairs.append((path.resolve(), path.name))
         else:
-            raise InputError(f"input {str(given)!r} does not exist")
+            check_input_file(path, what="input")
+            pairs.append((path.resolve(), path.name))
     items, seen_sources, writers = [], set(), {}
     for source, name in pairs:
         if source in seen_sources:  # the same file reached twice (a file inside a given folder)

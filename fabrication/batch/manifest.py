@@ -17,8 +17,25 @@ from pathlib import Path
 
 from fabrication.batch.report import FileStats
 from onestroke.atomic import atomic_write_text
+from onestroke.errors import InputError
+from onestroke.json_check import parse_json
 
 MANIFEST_NAME = "onestroke-batch-manifest.json"
+# What `save` writes, as `onestroke.json_check` reads it.
+_OUTPUT = {"type": "object", "properties": {"input": {"type": "string"}, "key": {"type": "string"}}}
+_FAILED = {"type": "object", "properties": {"key": {"type": "string"}, "error": {"type": "string"},
+                                            "stamp": {"type": "array", "minItems": 2, "maxItems": 2,
+                                                      "items": {"type": "integer"}}}}
+# the figures of `FileStats` (report.py): counts, seconds, warnings
+_COUNT, _SECONDS = {"type": "integer", "minimum": 0}, {"type": "number", "minimum": 0}
+_STATS = {"type": "object", "properties": {
+    "strokes": _COUNT, "intersections": _COUNT, "stitches": _COUNT, "sew_seconds": _SECONDS,
+    "laser_seconds": _SECONDS, "seconds": _SECONDS, "warnings": {"type": "array", "items": {"type": "string"}}}}
+SCHEMA = {"type": "object", "required": ["format"], "properties": {
+    "format": {"const": "onestroke-batch-manifest"},
+    "outputs": {"type": "object", "additionalProperties": _OUTPUT},
+    "failed": {"type": "object", "additionalProperties": _FAILED},
+    "stats": {"type": "object", "additionalProperties": _STATS}}}
 
 
 def _stamp(path: Path) -> tuple[int, int]:
@@ -35,13 +52,12 @@ class Manifest:
         self.failed: dict[str, dict] = {}
         self.stats: dict[str, dict] = {}
         try:
-            payload = json.loads(self.path.read_text(encoding="utf-8"))
-            if payload.get("format") == "onestroke-batch-manifest":
-                self.outputs = dict(payload.get("outputs", {}))
-                self.failed = dict(payload.get("failed", {}))
-                self.stats = dict(payload.get("stats", {}))
-        except (OSError, ValueError, AttributeError):
-            pass  # no manifest yet, or an unreadable one: everything is made again
+            payload = parse_json(self.path.read_bytes(), SCHEMA, what="manifest")
+            self.outputs = dict(payload.get("outputs", {}))
+            self.failed = dict(payload.get("failed", {}))
+            self.stats = dict(payload.get("stats", {}))
+        except (OSError, InputError):
+            pass  # no manifest yet, or one that is not ours (checked first): everything is made again
         self.root = Path(out_dir).resolve()
 
     def _key(self, output: Path) -> str:

@@ -129,6 +129,7 @@ COMMANDS = {
     "preview": "fabrication.cli.preview_cmd:preview",
     "studio": "fabrication.cli.studio_cmd:studio",
     "ports": "fabrication.cli.ports_cmd:ports",
+    "inkscape": "fabrication.cli.inkscape_cmd:inkscape",
     "emulator": "fabrication.cli.stream_cmd:emulator",
     "train-classifier": "fabrication.cli.train_cmd:train_classifier",
     "validate-classifier": "fabrication.cli.train_cmd:validate_classifier",

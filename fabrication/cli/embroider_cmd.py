@@ -136,10 +136,9 @@ def embroider(source: str, output: str, style: str, size: float | None, width: f
         warn(message)
 
     if source.lower().endswith(".json"):
-        from vectorize.svg_write import drawing_from_json
+        from vectorize.svg_write import read_drawing_json
 
-        with open(source, encoding="utf-8") as handle:
-            drawing = drawing_from_json(handle.read())
+        drawing = read_drawing_json(source)
     else:
         from fabrication.cli.common import read_drawing
 
@@ -163,6 +162,7 @@ def embroider(source: str, output: str, style: str, size: float | None, width: f
         console.print(line, soft_wrap=True)
     extra = f" and {preview_path}" if preview_path else ""
     done(f"wrote {output}{extra}: {stats.stitches} stitches, {stats.trims} trims, "
-         f"{stats.thread_length / 1000:.2f} m thread, {stats.width:.1f} x {stats.height:.1f} mm "
-         f"in hoop {the_hoop.name}, about {stats.seconds / 60:.1f} min "
-         f"({time.perf_counter() - started:.1f} s)")
+         f"{stats.thread_length / 1000:.2f} m thread (+ {stats.bobbin_length / 1000:.2f} m bobbin), "
+         f"{stats.width:.1f} x {stats.height:.1f} mm "
+         f"in hoop {the_hoop.name}, sewing about {stats.seconds / 60:.1f} min "
+         f"(made in {time.perf_counter() - started:.1f} s)")

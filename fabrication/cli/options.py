@@ -65,10 +65,7 @@ class Number(_Ranged):
     quote = False
 
     def parse(self, text, what: str) -> float:
-        try:
-            return float(text)
-        except (TypeError, ValueError):
-            raise InputError(f"{what} {text!r} is not a number") from None
+        return units.parse_number(text, what=what)
 
 
 class Integer(_Ranged):
@@ -78,10 +75,7 @@ class Integer(_Ranged):
     quote = False
 
     def parse(self, text, what: str) -> int:
-        try:
-            return int(str(text).strip())
-        except ValueError:
-            raise InputError(f"{what} {text!r} is not a whole number") from None
+        return units.parse_integer(text, what=what)
 
 
 class Length(_Ranged):
@@ -122,15 +116,10 @@ class InputFile(click.ParamType):
     name = "file"
 
     def convert(self, value, param, ctx):
-        path = os.fspath(value)
+        from onestroke.paths import check_input_file
+
         what = "input file" if isinstance(param, click.Argument) or param is None else _flag(param)
-        if os.path.isdir(path):
-            raise InputError(f"{what} {path!r} is a directory, not a file")
-        if not os.path.exists(path):
-            raise InputError(f"{what} {path!r} does not exist")
-        if not os.access(path, os.R_OK):
-            raise InputError(f"{what} {path!r} is not readable (permission denied)")
-        return path
+        return check_input_file(value, what=what)
 
 
 class OutputFile(click.ParamType):
@@ -172,6 +161,12 @@ class Port(click.ParamType):
             if not text.lower().startswith("sim://") or parts.netloc or parts.path not in ("", "/"):
                 raise InputError(f"{_flag(param)} {text!r}: the emulator is spelled sim:// with options after "
                                  "'?', e.g. sim://?speed=20")
+            from machines.sim_url.protocol_sim import parse_sim_url
+
+            try:  # every value now, not when the port opens after the work
+                parse_sim_url(text)
+            except ValueError as error:
+                raise InputError(f"{_flag(param)} {text!r}: {error}") from None
         return text
 
 

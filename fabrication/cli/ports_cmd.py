@@ -7,6 +7,7 @@ import dataclasses
 import click
 
 from fabrication.cli.common import console, done
+from fabrication.cli.options import BaudRate
 from machines.ports import list_ports, probe_grbl
 from onestroke.errors import MachineError
 
@@ -15,7 +16,7 @@ from onestroke.errors import MachineError
 @click.option("--probe/--no-probe", default=True, show_default=True,
               help="Open USB serial ports and wait for GRBL's welcome (resets the board).")
 @click.option("--all", "probe_all", is_flag=True, help="Probe built-in serial ports too, not only USB ones.")
-@click.option("--baud", type=int, default=115200, show_default=True, help="Baud rate for probing.")
+@click.option("--baud", type=BaudRate(), default=115200, show_default=True, help="Baud rate for probing.")
 def ports(probe: bool, probe_all: bool, baud: int) -> None:
     """List serial ports with their descriptions; mark the ones answering as GRBL."""
     found = list_ports(probe=False)

@@ -21,7 +21,7 @@ from onestroke.paths import check_distinct
 
 
 GCODE_SUFFIXES = (".gcode", ".nc", ".gc", ".ngc")
-DRAWING_SUFFIXES = (".svg", ".json")
+DRAWING_SUFFIXES = (".svg", ".svgz", ".json")
 
 
 @click.command()
@@ -69,10 +69,9 @@ def preview(source: str, output: str, width_px: int, hoop: str | None, spm: floa
         from fabrication.embroidery.preview import render_drawing_preview
 
         if suffix == ".json":
-            from vectorize.svg_write import drawing_from_json
+            from vectorize.svg_write import read_drawing_json
 
-            with open(source, encoding="utf-8") as handle:
-                drawing = drawing_from_json(handle.read())
+            drawing = read_drawing_json(source)
         else:
             from fabrication.cli.common import read_drawing
 

@@ -8,7 +8,7 @@ import time
 import click
 
 from fabrication.cli.common import console, done, edits_option, step, warn
-from fabrication.cli.options import drawing_input_options, input_argument, output_option
+from fabrication.cli.options import drawing_input_options, input_argument, output_option, placement_options
 from onestroke.atomic import all_or_nothing, check_folder
 from onestroke.errors import InputError
 from onestroke.paths import check_distinct
@@ -21,9 +21,18 @@ from onestroke.paths import check_distinct
 @click.option("--debug", "debug_dir", type=click.Path(file_okay=False, path_type=str), default=None,
               help="Write a PNG overlay of every stage into this folder.")
 @edits_option
+@placement_options()
+@click.option("--inkstitch", type=click.Choice(["running", "triple", "zigzag", "satin"]), default=None,
+              help="Write an SVG in mm that Ink/Stitch sews: this stitch's parameters on every path.")
 def vectorize(source: str, output: str, multi: bool, threshold: float | None, blur: float,
-              classifier: str, debug_dir: str | None, edits: str | None) -> None:
-    """Vectorize SOURCE into one ordered cubic Bézier curve (or several with --multi)."""
+              classifier: str, debug_dir: str | None, edits: str | None, size: float | None,
+              width: float | None, height: float | None, rotate: float, inkstitch: str | None) -> None:
+    """Vectorize SOURCE into one ordered cubic Bézier curve (or several with --multi).
+
+    With --size (or --width, --height, --rotate) or --inkstitch the output is in mm at the
+    design's physical size (without a size: the input's pixels read at 96 dpi)."""
+    if inkstitch is not None and not output.lower().endswith(".svg"):
+        raise InputError(f"--inkstitch writes an SVG; {output!r} is not a .svg file")
     if debug_dir is not None and os.path.exists(debug_dir) and not os.path.isdir(debug_dir):
         raise InputError(f"--debug {debug_dir!r} is a file; give a folder for the stage images")
     if debug_dir is not None:
@@ -38,6 +47,11 @@ def vectorize(source: str, output: str, multi: bool, threshold: float | None, bl
     from vectorize.edits import read_edits
     from vectorize.svg_write import write_drawing
 
+    placement = None  # the page at the design's size; None: the input's own page (in mm with --inkstitch)
+    if any(v is not None for v in (size, width, height)) or rotate:
+        from fabrication.placement import PlacementOptions
+
+        placement = PlacementOptions(size=size, width=width, height=height, rotate=rotate)
     replay = read_edits(edits) if edits is not None else None
     started = time.perf_counter()
     options = VectorizeOptions(multi=multi, threshold=threshold, blur=blur, classifier=classifier,
@@ -46,9 +60,20 @@ def vectorize(source: str, output: str, multi: bool, threshold: float | None, bl
         result = vectorize_file(source, options, edits=replay, progress=progress)
     for message in result.report.warnings:
         warn(message)
+    drawing = result.drawing
+    if inkstitch is not None or placement is not None:
+        from fabrication.placement import place_on_page
+
+        drawing = place_on_page(drawing, placement)
     written = []
     with all_or_nothing():  # the drawing and its stage images appear together, or none does
-        write_drawing(result.drawing, output)
+        if inkstitch is not None:
+            from fabrication.bridges.inkstitch import inkstitch_svg
+            from onestroke.atomic import atomic_write_text
+
+            atomic_write_text(output, inkstitch_svg(drawing, inkstitch))
+        else:
+            write_drawing(drawing, output)
         if debug_dir is not None:
             from vectorize.debug_overlay import write_debug_images
 

@@ -9,8 +9,9 @@ back exactly, and its pure-Python encoder (a third of the write time) is skipped
 .pes/.pec thumbnails are drawn by `pec_thumbnail` (same bytes, vectorised).
 Per-format numbers and writer settings (PES version, JEF trims) come from the profile.
 The bytes depend on the plan alone: the design name, the JEF date (pyembroidery would
-stamp the current time) and the JEF hoop code come from the plan, not from the clock or
-the design's extent.
+stamp the current time), the JEF hoop code and the PES hoop fields come from the plan,
+not from the clock or the design's extent (pyembroidery always writes a 130x180 hoop
+indicator into .pes, and 100x100 mm into version 6's hoop size).
 """
 
 from __future__ import annotations
@@ -34,6 +35,12 @@ _COMMANDS = np.array([pyembroidery.STITCH, pyembroidery.JUMP, pyembroidery.TRIM,
 JEF_HOOPS = ((1, 50.0, 50.0), (0, 110.0, 110.0), (3, 126.0, 110.0), (2, 140.0, 200.0), (4, 200.0, 200.0))
 _JEF_HOOP_OFFSET = 0x20  # int32 after the offsets, 0x14, the date, 2 pad bytes and 2 counts
 PES_VERSIONS = (1, 6)
+# PES header (libpes' description of PE-Design's files): after "#PES0001"/"#PES0060" and
+# the PEC offset, a u16 hoop size indicator (0: 100x100 mm, 1: 130x180 mm and larger).
+# Version 6 then has 2 characters, five length-prefixed strings, two u16 flags and the hoop
+# size in mm (u16 width, u16 height).
+_PES_HOOP_INDICATOR = 12
+SMALL_PES_HOOP = (100.0, 100.0)
 
 
 def check_pes_version(version, extension: str) -> int | None:
@@ -116,6 +123,60 @@ def jef_hoop_code(plan: StitchPlan) -> int | None:
     return None
 
 
+def pes_hoop_fields(data: bytes, field: tuple[float, float]) -> bytes:
+    """`data` (a .pes file as pyembroidery writes it) with its hoop fields saying `field`
+    (width, height) mm: the indicator 0 when it fits 100x100 mm, else 1; in version 6
+    also the hoop size in whole mm."""
+    w, h = field
+    small = w <= SMALL_PES_HOOP[0] + 1e-9 and h <= SMALL_PES_HOOP[1] + 1e-9
+    out = bytearray(data)
+    out[_PES_HOOP_INDICATOR:_PES_HOOP_INDICATOR + 2] = (0 if small else 1).to_bytes(2, "little")
+    if bytes(out[:8]) == b"#PES0060":
+        at = _PES_HOOP_INDICATOR + 2 + 2  # the indicator, then 2 characters ("02")
+        for _ in range(5):  # name, category, author, keywords, comments
+            at += 1 + out[at]
+        at += 4  # "optimize hoop change", "design page is custom"
+        size = int(round(w)).to_bytes(2, "little") + int(round(h)).to_bytes(2, "little")
+        out[at:at + 4] = size
+    return bytes(out)
+
+
+def _vp3_layout(data: bytes) -> tuple[int, list[int]]:
+    """Byte offsets in a .vp3 file (as pyembroidery writes it: big-endian blocks tagged
+    00 0N 00 with a length) of the design's centre and of each colour block's start."""
+    def skip_string(at: int) -> int:  # a length-prefixed string
+        return at + 2 + int.from_bytes(data[at:at + 2], "big")
+
+    at = skip_string(6)  # "%vsm%", 0, the producer
+    at = skip_string(at + 7)  # 00 02 00, length, settings
+    at += 16 + 4 + 4 + 1 + 7  # extents, count, 4 bytes, designs; 00 03 00, length
+    centre = at
+    at = skip_string(at + 8 + 3 + 16 + 8)  # centre, 3 bytes, extents, size; notes
+    at = skip_string(at + 2 + 16 + 6)  # "dd", four int32, "xxPP\x01\x00"; producer
+    count = int.from_bytes(data[at:at + 2], "big")
+    at += 2
+    starts = []
+    for _ in range(count):
+        starts.append(at + 7)
+        at += 7 + int.from_bytes(data[at + 3:at + 7], "big")
+    return centre, starts
+
+
+def vp3_exact_block_starts(data: bytes, rows: np.ndarray) -> bytes:
+    """`data` (a .vp3 file pyembroidery wrote from `rows` (M, 3): x, y in 0.1 mm and our
+    kinds) with each colour block after the first starting where the thread left off.
+    pyembroidery truncates the design's centre and each start measured from it, so with a
+    centre on half a unit the next colour was sewn 0.1 mm off."""
+    centre, starts = _vp3_layout(data)
+    cx = int.from_bytes(data[centre:centre + 4], "big", signed=True) // 100
+    cy = -int.from_bytes(data[centre + 4:centre + 8], "big", signed=True) // 100
+    out = bytearray(data)
+    for at, (x, y) in zip(starts[1:], rows[rows[:, 2] == COLOR, :2].tolist()):
+        out[at:at + 8] = ((x - cx) * 100).to_bytes(4, "big", signed=True) + \
+            (-(y - cy) * 100).to_bytes(4, "big", signed=True)
+    return bytes(out)
+
+
 def writer_settings(plan: StitchPlan, fmt: EmbroideryFormat, *, pes_version: int | None = None) -> dict:
     """pyembroidery writer settings for `plan` in `fmt` (the profile's, the JEF date)."""
     settings = {**fmt.settings}
@@ -151,6 +212,10 @@ def embroidery_bytes(plan: StitchPlan, fmt: EmbroideryFormat, *, pes_version: in
     with fast_pec_thumbnails():  # identical bytes, 40 % less .pes write time
         writer(pattern, buffer, settings)
     data = buffer.getvalue()
+    if fmt.extension == "vp3" and plan.color_changes:
+        data = vp3_exact_block_starts(data, normalized_rows(plan, fmt))
+    if fmt.extension == "pes" and plan.field is not None:
+        data = pes_hoop_fields(data, plan.field)
     code = jef_hoop_code(plan) if fmt.extension == "jef" else None
     if code is not None:
         # pyembroidery picks the code from the design's extent; the user named the hoop.
@@ -165,4 +230,4 @@ def write_embroidery(plan: StitchPlan, path: str | os.PathLike, *, pes_version: 
 
 
 __all__ = ["write_embroidery", "embroidery_bytes", "to_pattern", "plan_units", "writer_settings",
-           "jef_hoop_code", "STITCH", "JUMP", "TRIM", "COLOR"]
+           "jef_hoop_code", "pes_hoop_fields", "STITCH", "JUMP", "TRIM", "COLOR"]

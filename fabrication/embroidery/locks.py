@@ -4,6 +4,10 @@ A lock walks back along the needle path from its end by fractions of a lock leng
 returns (Ink/Stitch's "half stitch": 0.5, 1, 0.5, 0 of min(path, 1.5 mm)); a tack is the
 same figure at the start, sewn forward along the path before the path itself. We make
 them ourselves: pyembroidery's `tie_off` emits zero-length stitches and nothing useful.
+
+Where a tack or lock would crowd the needle points around it (a short stroke, a tight
+start), the planner asks for a lighter one: `level` 1 sews a single stitch there and
+back (`SINGLE`), level 2 (`TIE_LEVELS` - 1) none at all.
 """
 
 from __future__ import annotations
@@ -11,7 +15,10 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.spatial import cKDTree
 
+from fabrication.embroidery.needles import STITCH
+from fabrication.embroidery.quality import DENSITY_LIMIT, DENSITY_RADIUS
 from onestroke.errors import InputError
 from onestroke.ranges import Range, check_ranges, ranged
 from vectorize.graph import arc_lengths
@@ -22,6 +29,20 @@ LOCK_FORMS: dict[str, tuple[float, ...]] = {
     "half": (0.5, 1.0, 0.5, 0.0),
     "back_forth": (1.0, 0.0, 1.0, 0.0),
 }
+# The lighter figure of level 1: one stitch back (forward for a tack) and return.
+SINGLE = (1.0, 0.0)
+TIE_LEVELS = 3  # 0: the chosen form, 1: SINGLE, 2: none
+
+
+@dataclass(frozen=True, kw_only=True)
+class LighterTie:
+    """A tack (lock=False) or lock made lighter for density: where it starts (tack) or
+    ends (lock), x, y in mm; level 1: a single stitch there and back, 2: left out."""
+
+    x: float
+    y: float
+    lock: bool
+    level: int
 
 
 LOCK_LENGTH = Range(0.0, None, unit="mm", name="lock length", low_open=True)
@@ -52,10 +73,17 @@ def _lock_length(path: np.ndarray, options: LockOptions) -> float:
     return min(options.length, total)
 
 
-def lock_points(path: np.ndarray, options: LockOptions = LockOptions()) -> np.ndarray:
-    """Needle points (4, 2) to sew after `path` (N, 2) ends; the last one is its end."""
+def _form(options: LockOptions, level: int) -> np.ndarray:
+    if not 0 <= level < TIE_LEVELS:
+        raise ValueError(f"tie level {level} is not in [0, {TIE_LEVELS})")
+    return np.asarray(LOCK_FORMS[options.form] if level == 0 else SINGLE if level == 1 else ())
+
+
+def lock_points(path: np.ndarray, options: LockOptions = LockOptions(), level: int = 0) -> np.ndarray:
+    """Needle points (4, 2) to sew after `path` (N, 2) ends, the last one its end; (2, 2)
+    at `level` 1, (0, 2) at level 2."""
     length = _lock_length(path, options)
-    return walk_back(path, length * np.asarray(LOCK_FORMS[options.form]))
+    return walk_back(path, length * _form(options, level))
 
 
 # A tack's holes keep this far (mm, along the path) from the holes the stitches after it
@@ -83,10 +111,43 @@ def _clear_length(path: np.ndarray, length: float, form: np.ndarray) -> float:
     return float(candidates[int(np.argmax(gaps))])  # the first of the widest gaps, as before
 
 
-def tack_points(path: np.ndarray, options: LockOptions = LockOptions()) -> np.ndarray:
+def tack_points(path: np.ndarray, options: LockOptions = LockOptions(), level: int = 0) -> np.ndarray:
     """Needle points (4, 2) to sew before `path` (N, 2) begins: its start, then the lock
     figure forward along it; the path then continues from its own start. The figure is
-    shortened (to half at most) to keep clear of the path's first holes."""
-    form = np.asarray(LOCK_FORMS[options.form])
+    shortened (to half at most) to keep clear of the path's first holes. (2, 2) at
+    `level` 1, (0, 2) at level 2."""
+    form = _form(options, level)
+    if not len(form):
+        return np.zeros((0, 2))
     length = _clear_length(path, _lock_length(path, options), form)
     return np.vstack([path[:1], walk_back(path[::-1], length * form[:-1])])
+
+
+def crowding_ties(points: np.ndarray, kinds: np.ndarray, ties: np.ndarray,
+                   levels: dict[int, int]) -> set[int]:
+    """The ties (tacks and locks, by number) to make lighter, each one level: `points`
+    (N, 2) mm and `kinds` (N,) of a plan's rows, `ties` (N,) the tie of each row (2 c: the
+    tack of chain c, 2 c + 1: its lock, -1: none), `levels` the ties' levels so far. They are the ties that make a place too dense: needle points
+    within the density radius of a needle point with more than the density limit around it
+    (every needle point counted) that would be within the limit without the ties' points.
+    Where the stitches alone are too dense, the ties stay (the warning names the place)."""
+    needle = kinds == STITCH
+    pts, tie = points[needle], ties[needle]
+    at_tie = tie >= 0
+    if not at_tie.any():
+        return set()
+    reach = DENSITY_RADIUS + 1e-9
+    # Only places near a tie can be helped by a lighter tie: count there, not everywhere.
+    tree = cKDTree(pts, balanced_tree=False, compact_nodes=False)  # 3x quicker to build
+    near = np.zeros(len(pts), dtype=bool)
+    for found in tree.query_ball_point(pts[at_tie], reach):
+        near[found] = True
+    crowding: set[int] = set()
+    for found in tree.query_ball_point(pts[near], reach):
+        ours = tie[found]
+        if len(found) > DENSITY_LIMIT and len(found) - int((ours >= 0).sum()) <= DENSITY_LIMIT:
+            ours = set(ours[ours >= 0].tolist())
+            tacks = {t for t in ours if t % 2 == 0 and levels.get(t, 0) < TIE_LEVELS - 1}
+            # A lock holds the thread against the trim after it: tacks give way first.
+            crowding |= tacks or {t for t in ours if levels.get(t, 0) < TIE_LEVELS - 1}
+    return crowding

@@ -13,6 +13,10 @@ import numpy as np
 BODY, TACK, LOCK, UNDERLAY, TRAVEL, MOTIF = range(6)
 ROLE_NAMES = ("body", "tack", "lock", "underlay", "travel", "motif")
 
+# Row kinds of a stitch plan (mapped to pyembroidery's commands by the writer). COLOR:
+# change to the next thread here (after the lock and trim of the last block).
+STITCH, JUMP, TRIM, COLOR = 0, 1, 2, 3
+
 # The files' coordinate step (pyembroidery's units), mm: no length under it can be sewn;
 # and the longest stitch any format stores, mm (DST's records hold 12.1 mm: longer ones are
 # split there).

@@ -18,7 +18,7 @@ import numpy as np
 from fabrication.embroidery.thread import RGB, Thread, nearest_thread
 from onestroke.errors import InputError
 from vectorize.drawing import Drawing
-from vectorize.stroke import Stroke
+from vectorize.stroke import Stroke, recut_widths
 
 Start = str | tuple[float, float] | None
 
@@ -73,11 +73,16 @@ def _open_at(stroke: Stroke, t: float) -> Stroke:
     k = min(int(t * stroke.segment_count), stroke.segment_count - 1)
     u = t * stroke.segment_count - k
     c = stroke.control
+    n = len(c)
     if u < 1e-6 or u > 1 - 1e-6:
-        k = (k + 1) % len(c) if u > 0.5 else k
-        return Stroke(np.concatenate([c[k:], c[:k]]), stroke.color)
+        k = (k + 1) % n if u > 0.5 else k
+        widths = recut_widths(stroke.widths, np.array([k, k + n]) / n, np.array([0.0, 1.0]))
+        return Stroke(np.concatenate([c[k:], c[:k]]), stroke.color, widths)
     first, second = _split_cubic(c[k], u)
-    return Stroke(np.concatenate([second[None], c[k + 1:], c[:k], first[None]]), stroke.color)
+    # new segment j runs over old parameters k + u, k + 1, ..., k + n, k + n + u (over n)
+    old = np.concatenate([[k + u], np.arange(k + 1, k + n + 1), [k + n + u]]) / n
+    widths = recut_widths(stroke.widths, old, np.linspace(0.0, 1.0, n + 2))
+    return Stroke(np.concatenate([second[None], c[k + 1:], c[:k], first[None]]), stroke.color, widths)
 
 
 def _nearest_on_curve(strokes: tuple[Stroke, ...], point: np.ndarray) -> tuple[int, float]:

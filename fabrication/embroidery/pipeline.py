@@ -12,11 +12,13 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from fabrication.embroidery.hooping import check_plan_in_hoop, fit_to_hoop
+from fabrication.embroidery.hooping import check_plan_in_hoop, hoop_design
 from fabrication.embroidery.arrows import ArrowOptions
 from fabrication.embroidery.needles import BODY, MOTIF
 from fabrication.embroidery.plan import FIXED_DATE, PlanOptions, StitchPlan, plan_embroidery, style_reach
+from fabrication.embroidery.quality import HOLE_GAP, HOLE_WINDOW, hole_places, repeated_holes, where
 from fabrication.embroidery.stats import EmbroideryStats, embroidery_stats
+from fabrication.embroidery.triple import TripleOptions
 from fabrication.embroidery.zigzag import ZigzagOptions
 from fabrication.placement import PlacementOptions, place
 from machines.hoops import SPM, Hoop, hoop_named
@@ -52,8 +54,10 @@ class EmbroideryJob:
 
 @dataclass(frozen=True, eq=False)
 class EmbroideryResult:
-    """drawing: the curves as sewn (mm, centred); plan; stats; fit_scale: the factor --fit
-    applied (1.0 when it fitted as placed); warnings: one-line messages for the user."""
+    """drawing: the curves as sewn (mm; the stitches' bounding box centred on (0, 0)); plan;
+    stats; fit_scale: the factor --fit applied (1.0 when it fitted as placed or turned);
+    turned: --fit turned the design a quarter counter-clockwise (as --rotate 90) to fit
+    without scaling; warnings: one-line messages for the user."""
 
     drawing: Drawing
     plan: StitchPlan
@@ -61,6 +65,7 @@ class EmbroideryResult:
     hoop: Hoop
     fit_scale: float
     warnings: tuple[str, ...]
+    turned: bool = False
 
 
 def embroider(drawing: Drawing, job: EmbroideryJob = EmbroideryJob(), *, progress=None) -> EmbroideryResult:
@@ -68,12 +73,13 @@ def embroider(drawing: Drawing, job: EmbroideryJob = EmbroideryJob(), *, progres
     progress: an `onestroke.progress.ProgressCallback` (strokes stitched)."""
     warnings: list[str] = []
     placed = place(drawing, job.placement)
-    hooped = fit_to_hoop(placed, job.hoop, reach=style_reach(job.plan.style), fit=job.fit)
-    scale = 1.0
-    if hooped is not placed:
-        x0, y0, x1, y1 = hooped.bounds()
-        px0, _, px1, _ = placed.bounds()
-        scale = (x1 - x0) / max(px1 - px0, 1e-12)
+    fitted = hoop_design(placed, job.hoop, reach=style_reach(job.plan.style), fit=job.fit)
+    hooped = fitted.drawing
+    x0, y0, x1, y1 = hooped.bounds()
+    if fitted.turned:
+        warnings.append(f"turned by 90 degrees (as --rotate 90 would) to fit hoop {job.hoop.label} "
+                        f"without scaling: {x1 - x0:.1f} x {y1 - y0:.1f} mm")
+    elif fitted.scale != 1.0:
         warnings.append(f"scaled down to {x1 - x0:.1f} x {y1 - y0:.1f} mm to fit hoop {job.hoop.label}")
     style = job.plan.style
     if isinstance(style, ZigzagOptions) and style.width < 1.0:
@@ -81,7 +87,7 @@ def embroider(drawing: Drawing, job: EmbroideryJob = EmbroideryJob(), *, progres
     if isinstance(style, ZigzagOptions) and style.width > LOOSE_ZIGZAG:
         warnings.append(f"zigzag stitches {style.width:g} mm wide lie loose and snag (over "
                         f"{LOOSE_ZIGZAG:g} mm); use a narrower --stitch-width")
-    plan = plan_embroidery(hooped, job.plan, progress=progress)
+    plan = plan_embroidery(hooped, job.plan, progress=progress, centre=True)
     check_plan_in_hoop(plan, job.hoop)
     warnings.extend(plan.dropped)
     if len(job.plan.colors) > len(drawing.strokes):
@@ -90,10 +96,41 @@ def embroider(drawing: Drawing, job: EmbroideryJob = EmbroideryJob(), *, progres
     warnings.extend(_long_stitch_warnings(plan, style))
     plan = replace(plan, name=job.name, field=(job.hoop.width, job.hoop.height), date=job.date)
     stats = embroidery_stats(plan, stitches_per_minute=job.stitches_per_minute,
-                             trim_seconds=job.trim_seconds)
+                             trim_seconds=job.trim_seconds, density_advice=density_advice(style),
+                             column=isinstance(style, COLUMN_STYLES))
     warnings.extend(stats.warnings)
+    warnings.extend(_hole_warnings(plan))
     return EmbroideryResult(drawing=plan.sewn, plan=plan, stats=stats, hoop=job.hoop,
-                            fit_scale=float(scale), warnings=tuple(warnings))
+                            fit_scale=float(fitted.scale), warnings=tuple(warnings), turned=fitted.turned)
+
+
+# Styles whose body stitches cross a column (the bobbin shows only in its middle third).
+COLUMN_STYLES: tuple[type, ...] = (ZigzagOptions,)
+
+
+def density_advice(style) -> str:
+    """What to change where a design of `style` is too dense (its own options first)."""
+    for kind, advice in _DENSITY_ADVICE.items():
+        if isinstance(style, kind):
+            return advice
+    return "use a longer --stitch-length or a larger --size"
+
+
+_DENSITY_ADVICE = {
+    ZigzagOptions: "use a wider --spacing, --underlay none or a larger --size",
+    ArrowOptions: "use a wider --spacing, a smaller --arrow-size or a larger --size",
+    TripleOptions: "use a longer --stitch-length, --style running or a larger --size",
+}
+
+
+def _hole_warnings(plan: StitchPlan) -> list[str]:
+    """A warning naming the places where a needle re-enters a hole it made a moment before."""
+    rows = repeated_holes(plan)
+    if not len(rows):
+        return []
+    return [f"{len(rows)} needle points re-enter a hole made a moment before (within {HOLE_GAP:g} mm of "
+            f"one of the last {HOLE_WINDOW} on their side of the line) {where(hole_places(plan, rows))}; "
+            "the thread there may be cut or pile up; a larger --size or another --style avoids it"]
 
 
 # Stitches longer than this (mm) lie loose on the fabric and snag; zigzags wider than

@@ -13,17 +13,18 @@ and the writer's rounding of points already on the grid is then exact.
 
 from __future__ import annotations
 
-import heapq
-import math
 from dataclasses import dataclass, field
 from typing import Callable, Union
 
 import numpy as np
+from scipy.spatial import cKDTree
 
 from fabrication.embroidery.arrows import ArrowOptions, arrow_stitch
-from fabrication.embroidery.locks import LockOptions, lock_points, tack_points
-from fabrication.embroidery.needles import (BODY, GRID, LOCK, LONGEST_STITCH, MOTIF, TACK, TRAVEL,
-                                            UNDERLAY, NeedlePoints)
+from fabrication.embroidery.grid import merge_short, split_long
+from fabrication.embroidery.locks import (TIE_LEVELS, LighterTie, LockOptions, crowding_ties, lock_points,
+                                          tack_points)
+from fabrication.embroidery.needles import (COLOR, GRID, JUMP, LOCK, LONGEST_STITCH, STITCH, TACK, TRAVEL,
+                                            TRIM, NeedlePoints)
 from fabrication.embroidery.order import Start, check_start, sewing_order
 from fabrication.embroidery.running import STITCH_LENGTH, RunningOptions, running_stitch
 from fabrication.embroidery.thread import RGB, Thread, check_chart
@@ -37,10 +38,7 @@ from vectorize.stroke import Stroke
 
 StyleOptions = Union[RunningOptions, TripleOptions, ZigzagOptions, ArrowOptions]
 
-# Row kinds of a plan (mapped to pyembroidery's commands by the writer). COLOR: change to
-# the next thread here (after the lock and trim of the last block).
-STITCH, JUMP, TRIM, COLOR = 0, 1, 2, 3
-
+# STITCH, JUMP, TRIM, COLOR: the row kinds of a plan (defined in `needles`, used from here).
 # A fixed JEF date (YYYYMMDDhhmmss) so files are the same bytes from run to run; callers
 # pass the build's own date (SOURCE_DATE_EPOCH) through `StitchPlan.date`.
 FIXED_DATE = "20000101000000"
@@ -66,10 +64,6 @@ MAX_STITCH = Range(1.0, LONGEST_STITCH, unit="mm", name="--max-stitch")
 TRIM_DISTANCE = Range(0.0, 1000.0, unit="mm", name="--trim-distance")
 MIN_STROKE = Range(0.0, 100.0, unit="mm", name="--min-stroke")
 GRID_STEP = Range(0.0, None, unit="mm", name="grid", low_open=True)
-
-# Needle points the min-stitch rule may drop: body points, never tacks or locks.
-_DROPPABLE = np.zeros(8, dtype=bool)
-_DROPPABLE[[BODY, UNDERLAY, MOTIF, TRAVEL]] = True
 
 
 def style_class(name: str) -> type:
@@ -149,8 +143,10 @@ class StitchPlan:
     curve parameter t (NaN on jumps and trims); strokes (N,): index of the sewn stroke each
     row sews (-1 on trims and jumps); threads: one per colour block; blocks (N,): colour
     block of each row (None: all 0); sewn: the strokes as sewn (rows index into it);
-    dropped: one line per stroke left out; name: the design name files store; field: the
-    hoop (width, height) mm the design is meant for; date: YYYYMMDDhhmmss for JEF."""
+    dropped: one line per stroke left out; lighter: the tacks and locks made lighter (or
+    left out) because they would have crowded their place beyond the density limit; name:
+    the design name files store; field: the hoop (width, height) mm the design is meant
+    for; date: YYYYMMDDhhmmss for JEF."""
 
     points: np.ndarray
     kinds: np.ndarray
@@ -161,6 +157,7 @@ class StitchPlan:
     blocks: np.ndarray | None = None
     sewn: Drawing | None = None
     dropped: tuple[str, ...] = ()
+    lighter: tuple[LighterTie, ...] = ()
     name: str = "onestroke"
     field: tuple[float, float] | None = None
     date: str = FIXED_DATE
@@ -226,11 +223,12 @@ def _lock_paths(body: NeedlePoints) -> tuple[np.ndarray, np.ndarray]:
     return body.points[ahead], body.points[::-1][back][::-1]
 
 
-def _chains(drawing: Drawing, block: tuple[int, ...], options: PlanOptions) -> tuple[list[list[int]], list[str]]:
+def _chains(drawing: Drawing, block: tuple[int, ...], options: PlanOptions) -> tuple[list[list[int]], list[int]]:
     """Group sewn strokes into chains sewn with one tack and one lock. A stroke shorter
-    than `min_stroke` joins its nearer neighbour (same thread, within the trim distance)
-    by a travel stitch; a chain still shorter than `min_stroke` in all is dropped (a knot
-    of tacks and locks on a speck), with a line naming its strokes."""
+    than `min_stroke` joins its nearer neighbour in sewing order (same thread, within the
+    trim distance) by a travel stitch; a chain still shorter than `min_stroke` in all is
+    dropped (a knot of tacks and locks on a speck). Returns the chains and the dropped
+    strokes."""
     strokes = drawing.strokes
     n = len(strokes)
     lengths = [s.length for s in strokes]
@@ -254,16 +252,38 @@ def _chains(drawing: Drawing, block: tuple[int, ...], options: PlanOptions) -> t
             chains.append([i])
     kept, dropped = [], []
     for chain in chains:
-        total = sum(lengths[i] for i in chain)
-        if total >= max(options.min_stroke, options.min_stitch):
+        if sum(lengths[i] for i in chain) >= max(options.min_stroke, options.min_stitch):
             kept.append(chain)
-            continue
-        for i in chain:
-            x, y = strokes[i].start
-            dropped.append(f"stroke {i + 1} ({lengths[i]:.2f} mm at {x:.1f}, {y:.1f} mm) was left out: "
-                           f"shorter than --min-stroke {options.min_stroke:g} mm and more than "
-                           f"--trim-distance {options.trim_distance:g} mm from a stroke of its thread")
+        else:
+            dropped += chain
     return kept, dropped
+
+
+def _dropped_lines(drawing: Drawing, dropped: list[int], block: tuple[int, ...], source: tuple[int, ...],
+                   points: np.ndarray, blocks: np.ndarray, options: PlanOptions) -> tuple[str, ...]:
+    """One line per dropped stroke (numbered as in the input), with the distance from it to
+    the nearest needle point of its thread in the plan (`points` (N, 2) mm, `blocks` (N,)
+    of the needle rows)."""
+    lines, trees = [], {}
+    for i in dropped:
+        stroke = drawing.strokes[i]
+        if block[i] not in trees:
+            mine = points[blocks == block[i]]
+            trees[block[i]] = cKDTree(mine) if len(mine) else None
+        along = stroke.points_at(np.linspace(0.0, 1.0, 9))
+        near = float(trees[block[i]].query(along)[0].min()) if trees[block[i]] is not None else np.inf
+        x, y = stroke.start
+        if near > options.trim_distance:
+            why = (f"more than --trim-distance {options.trim_distance:g} mm from every stitch of its "
+                   f"thread (the nearest is {near:.1f} mm away)" if np.isfinite(near) else
+                   "no stitch of its thread is sewn")
+        else:
+            why = (f"the strokes sewn before and after it end more than --trim-distance "
+                   f"{options.trim_distance:g} mm away (the nearest stitch of its thread, {near:.1f} mm "
+                   "away, is in the middle of a stroke)")
+        lines.append(f"stroke {source[i] + 1} ({stroke.length:.2f} mm at {x:.1f}, {y:.1f} mm) was left out: "
+                     f"shorter than --min-stroke {options.min_stroke:g} mm and {why}")
+    return tuple(lines)
 
 
 def _chain_points(drawing: Drawing, chain: list[int], options: PlanOptions, offset: float):
@@ -289,15 +309,35 @@ def _chain_points(drawing: Drawing, chain: list[int], options: PlanOptions, offs
     return merged, np.concatenate(owners), offset
 
 
-def _assemble(drawing: Drawing, block: tuple[int, ...], options: PlanOptions, progress=None):
-    """Rows before cleanup: float points, kinds, roles, params, owners, blocks; and the
+def _stitch_chains(drawing: Drawing, block: tuple[int, ...], options: PlanOptions, progress=None):
+    """The chains (see `_chains`), each chain's needle points and stroke owners, and the
     lines about dropped strokes. `progress`: reports per stroke stitched."""
-    pts, kinds, roles, params, owners, blocks = [], [], [], [], [], []
+    chains, dropped = _chains(drawing, block, options)
+    report = Stage(progress, "stitching", sum(len(chain) for chain in chains), "strokes")
+    bodies, offset = [], 0.0
+    for chain in chains:
+        body, owner, offset = _chain_points(drawing, chain, options, offset)
+        bodies.append((body, owner))
+        report.advance(len(chain))
+    report.finish()
+    if not chains:
+        raise InputError("no stroke is long enough to stitch (all shorter than --min-stroke "
+                         f"{options.min_stroke:g} mm and far from the others)")
+    return chains, bodies, dropped
+
+
+def _assemble(chains: list[list[int]], bodies: list, block: tuple[int, ...], options: PlanOptions,
+              levels: dict[int, int], made: dict[tuple[int, int], np.ndarray]):
+    """Rows before cleanup: float points, kinds, roles, params, owners, blocks, ties; and
+    the anchor of each tie (where a tack starts, a lock ends). ties (N,): 2 c on the tack
+    of the c-th chain, 2 c + 1 on its lock, -1 elsewhere; `levels` maps a tie to its level
+    (see `locks`; 0 when absent); `made` keeps the ties' points from round to round."""
+    pts, kinds, roles, params, owners, blocks, ties = [], [], [], [], [], [], []
+    anchors: list[np.ndarray] = []  # anchors[tie]: where the tack starts / the lock ends
     current: np.ndarray | None = None
     current_block = block[0] if block else 0
-    offset = 0.0
 
-    def add(p, kind, role, param, owner):
+    def add(p, kind, role, param, owner, tie=-1):
         p = np.atleast_2d(p)
         owners.append(np.broadcast_to(np.asarray(owner, dtype=np.int64), (len(p),)))
         pts.append(p)
@@ -305,11 +345,15 @@ def _assemble(drawing: Drawing, block: tuple[int, ...], options: PlanOptions, pr
         roles.append(np.broadcast_to(np.asarray(role, dtype=np.uint8), (len(p),)))
         params.append(np.broadcast_to(np.asarray(param, dtype=float), (len(p),)))
         blocks.append(np.full(len(p), current_block, dtype=np.int64))
+        ties.append(np.full(len(p), tie, dtype=np.int64))
 
-    chains, dropped = _chains(drawing, block, options)
-    report = Stage(progress, "stitching", sum(len(chain) for chain in chains), "strokes")
-    for chain in chains:
-        body, owner, offset = _chain_points(drawing, chain, options, offset)
+    def tie_points(tie: int, make, path: np.ndarray) -> np.ndarray:
+        key = (tie, levels.get(tie, 0))
+        if key not in made:
+            made[key] = make(path, options.lock, key[1])
+        return made[key]
+
+    for c, (chain, (body, owner)) in enumerate(zip(chains, bodies)):
         path = body.points
         connect = TACK
         if current is None:
@@ -327,112 +371,50 @@ def _assemble(drawing: Drawing, block: tuple[int, ...], options: PlanOptions, pr
                 connect = TRAVEL  # a short stitch from the last stroke's end
         head, tail = _lock_paths(body)
         first, last = chain[0], chain[-1]
-        add(tack_points(head, options.lock), STITCH, [connect, TACK, TACK, TACK], body.t[0], first)
+        anchors += [path[0], path[-1]]
+        tack = tie_points(2 * c, tack_points, head)
         body_roles = body.roles.copy()
-        body_roles[0] = TACK  # the stitch into the start closes the tack
+        if len(tack):
+            add(tack, STITCH, [connect] + [TACK] * (len(tack) - 1), body.t[0], first, 2 * c)
+            body_roles[0] = TACK  # the stitch into the start closes the tack
+        elif connect == TRAVEL:
+            body_roles[0] = TRAVEL
         add(path, STITCH, body_roles, body.t, owner)
-        add(lock_points(tail, options.lock), STITCH, LOCK, body.t[-1], last)
+        lock = tie_points(2 * c + 1, lock_points, tail)
+        if len(lock):
+            add(lock, STITCH, LOCK, body.t[-1], last, 2 * c + 1)
         current = path[-1]
-        report.advance(len(chain))
-    report.finish()
-    if not pts:
-        raise InputError("no stroke is long enough to stitch (all shorter than --min-stroke "
-                         f"{options.min_stroke:g} mm and far from the others)")
-    return (np.concatenate(pts), np.concatenate(kinds), np.concatenate(roles),
-            np.concatenate(params), np.concatenate(owners), np.concatenate(blocks), tuple(dropped))
+    return (np.concatenate(pts), np.concatenate(kinds), np.concatenate(roles), np.concatenate(params),
+            np.concatenate(owners), np.concatenate(blocks), np.concatenate(ties), anchors)
 
 
-def _merge_short(units: np.ndarray, kinds: np.ndarray, roles: np.ndarray, min_units: float) -> np.ndarray:
-    """Keep-mask: drop zero-length stitches anywhere and body stitches shorter than
-    `min_units` (grid units). When the short stitch ends a body (the lock's anchor), the
-    body point before it goes instead. Only short places are visited, in row order; the
-    previous kept row is found through pointers that skip dropped rows with path
-    compression, so the work stays near linear however many rows merge (a run of a
-    million tiny stitches included)."""
-    n = len(units)
-    sewn = np.zeros(n, dtype=bool)
-    sewn[1:] = (kinds[1:] == STITCH) & (kinds[:-1] == STITCH)
-    d = np.full(n, np.inf)
-    d[1:] = np.hypot(*(units[1:] - units[:-1]).T)
-    work = np.flatnonzero(sewn & ((d == 0) | ((d < min_units) & _DROPPABLE[roles]))).tolist()
-    if not work:
-        return np.ones(n, dtype=bool)
-    heapq.heapify(work)
-    # Plain Python lists: the loop touches single rows, where numpy scalars are slow.
-    ux, uy = units[:, 0].tolist(), units[:, 1].tolist()
-    kind, role = kinds.tolist(), roles.tolist()
-    droppable = _DROPPABLE.tolist()
-    kept = [True] * n
-    # below[i]: a row at or before i - 1 from which the search for the kept row before i
-    # starts; dropped rows are skipped and the pointers shortened on the way.
-    below = list(range(-1, n - 1))
-
-    def previous_kept(i: int) -> int:
-        k = below[i]
-        trail = []
-        while not kept[k]:
-            trail.append(k)
-            k = below[k]
-        for j in trail:
-            below[j] = k
-        below[i] = k
-        return k
-
-    while work:
-        i = heapq.heappop(work)
-        if not kept[i]:
-            continue
-        k = previous_kept(i)
-        if kind[k] != STITCH or kind[i] != STITCH:
-            continue
-        dist = math.hypot(ux[i] - ux[k], uy[i] - uy[k])
-        if dist == 0:
-            kept[i] = False
-        elif dist < min_units and droppable[role[i]]:
-            anchor = i + 1 < n and role[i + 1] == LOCK and kind[i + 1] == STITCH
-            if not anchor:
-                kept[i] = False
-            elif droppable[role[k]] and k > 0 and kind[previous_kept(k)] == STITCH:
-                kept[k] = False  # the lock's anchor stays; the body point before it goes
-                heapq.heappush(work, i)
-                continue
-            else:
-                # The body shrank to one short stitch: drop its end, the lock stands in.
-                kept[i] = False
-        else:
-            continue
-        if i + 1 < n:
-            heapq.heappush(work, i + 1)  # the next stitch now starts further back
-    return np.array(kept, dtype=bool)
+def _on_grid(rows, options: PlanOptions):
+    """Rows of `_assemble` snapped to the grid (integer units), short stitches merged away
+    and long ones split: units, kinds, roles, params, owners, blocks, ties."""
+    points, kinds, roles, params, owners, blocks, ties = rows
+    units = np.rint(points / options.grid).astype(np.int64)
+    keep = merge_short(units, kinds, roles, options.min_stitch / options.grid - 1e-9)
+    max_units = int(np.floor(options.max_stitch / options.grid + 1e-9))
+    units, params, source = split_long(units[keep], kinds[keep], params[keep], max_units)
+    kinds, roles, owners, blocks, ties = (a[keep][source] for a in (kinds, roles, owners, blocks, ties))
+    return units, kinds, roles, params, owners, blocks, ties
 
 
-def _split_long(units, kinds, roles, params, owners, blocks, max_units: int):
-    """Split needle-down moves longer than `max_units` per axis into real stitches, on the grid."""
-    sewn = np.zeros(len(units), dtype=bool)
-    sewn[1:] = (kinds[1:] == STITCH) & (kinds[:-1] == STITCH)
-    step = np.zeros(len(units), dtype=np.int64)
-    step[1:] = np.abs(np.diff(units, axis=0)).max(axis=1)
-    pieces = np.where(sewn, -(-step // max_units), 1)
-    pieces = np.maximum(pieces, 1)
-    if pieces.max() == 1:
-        return units, kinds, roles, params, owners, blocks
-    # Row i becomes pieces[i] rows: intermediate points on the way from row i - 1.
-    owner = np.repeat(np.arange(len(units)), pieces)
-    k = np.arange(owner.size) - np.repeat(np.cumsum(pieces) - pieces, pieces) + 1
-    frac = k / pieces[owner]
-    prev = units[np.maximum(owner - 1, 0)]
-    # floor(k * d / n) steps differ by at most ceil(d / n) <= max_units per axis.
-    new_units = prev + np.floor((units[owner] - prev) * frac[:, None] + 0.5).astype(np.int64)
-    prev_param = params[np.maximum(owner - 1, 0)]
-    new_params = prev_param + (params[owner] - prev_param) * frac
-    return new_units, kinds[owner], roles[owner], new_params, owners[owner], blocks[owner]
+def _centring_shift(units: np.ndarray, kinds: np.ndarray) -> np.ndarray:
+    """Whole grid steps (2,) that centre the box of the needle points and jumps on (0, 0)
+    (to within half a step)."""
+    box = units[kinds <= JUMP]
+    return -np.rint((box.min(axis=0) + box.max(axis=0)) / 2).astype(np.int64)
 
 
 def plan_embroidery(drawing: Drawing, options: PlanOptions = PlanOptions(), *,
-                    progress: ProgressCallback | None = None) -> StitchPlan:
+                    progress: ProgressCallback | None = None, centre: bool = False) -> StitchPlan:
     """Stitch every stroke of `drawing` (mm, centred on (0, 0)) into one `StitchPlan`:
     colour blocks in sewing order (see `order.sewing_order`), rows indexing `plan.sewn`.
-    progress: an `onestroke.progress.ProgressCallback` (strokes stitched)."""
+    progress: an `onestroke.progress.ProgressCallback` (strokes stitched); centre: move
+    the stitches (and `plan.sewn`) by whole grid steps so that the bounding box of the
+    needle points and jumps is centred on (0, 0) (the curve's box is not the stitches': a
+    zigzag or arrows reach further on one side of it)."""
     if drawing.unit != "mm":
         raise InputError(f"place the drawing in mm before stitching (it is in {drawing.unit})")
     if not drawing.strokes:
@@ -440,26 +422,37 @@ def plan_embroidery(drawing: Drawing, options: PlanOptions = PlanOptions(), *,
     order = sewing_order(drawing, colors=options.colors, default=options.color,
                          start=options.start, thread_chart=options.thread_chart)
     sewn = order.drawing
-    points, kinds, roles, params, owners, blocks, dropped = _assemble(sewn, order.block, options, progress)
-    # Source stroke numbers in the messages, not positions in the sewing order.
-    dropped = tuple(_renumber(line, order.source) for line in dropped)
-    units = np.rint(points / options.grid).astype(np.int64)
-    keep = _merge_short(units, kinds, roles, options.min_stitch / options.grid - 1e-9)
-    rows = (units[keep], kinds[keep], roles[keep], params[keep], owners[keep], blocks[keep])
-    max_units = int(np.floor(options.max_stitch / options.grid + 1e-9))
-    units, kinds, roles, params, owners, blocks = _split_long(*rows, max_units)
+    # Tacks and locks that crowd a place beyond the density limit get lighter, one level
+    # per round (full, single, none; tacks before locks), until none does: short strokes
+    # never knot. A plan without crowding is made once.
+    chains, bodies, dropped = _stitch_chains(sewn, order.block, options, progress)
+    levels: dict[int, int] = {}
+    made: dict[tuple[int, int], np.ndarray] = {}
+    for _ in range(2 * TIE_LEVELS):
+        *rows, anchors = _assemble(chains, bodies, order.block, options, levels, made)
+        units, kinds, roles, params, owners, blocks, ties = _on_grid(rows, options)
+        lighter = crowding_ties(units * options.grid, kinds, ties, levels)
+        if not lighter:
+            break
+        levels.update({tie: levels.get(tie, 0) + 1 for tie in lighter})
     if not np.any(kinds == STITCH):
         raise FabricationError("no needle points left after merging short stitches")
+    shift = _centring_shift(units, kinds) if centre else np.zeros(2, dtype=np.int64)
+    if shift.any():
+        units = units + shift
+        dx, dy = shift * options.grid
+        sewn = sewn.transformed(np.array([[1.0, 0.0, dx], [0.0, 1.0, dy]]), width=sewn.width,
+                                height=sewn.height, unit=sewn.unit, stroke_width=sewn.stroke_width)
+    needle = kinds == STITCH
+    dropped = _dropped_lines(sewn, dropped, order.block, order.source, units[needle] * options.grid,
+                             blocks[needle], options)
     used = np.unique(blocks)
     # A block whose strokes were all dropped has no thread in the file.
     remap = np.full(len(order.threads), -1, dtype=np.int64)
     remap[used] = np.arange(len(used))
+    lighter = tuple(LighterTie(x=float(x), y=float(y), lock=bool(tie % 2), level=level)
+                    for tie, level in sorted(levels.items())
+                    for x, y in [(np.rint(anchors[tie] / options.grid) + shift) * options.grid])
     return StitchPlan(points=units * options.grid, kinds=kinds, roles=roles, params=params,
                       strokes=owners, threads=tuple(order.threads[i] for i in used),
-                      blocks=remap[blocks], sewn=sewn, dropped=dropped)
-
-
-def _renumber(line: str, source: tuple[int, ...]) -> str:
-    """'stroke 3 ...' (position in the sewing order) -> the stroke's number in the input."""
-    head, number, rest = line.split(" ", 2)
-    return f"{head} {source[int(number) - 1] + 1} {rest}"
+                      blocks=remap[blocks], sewn=sewn, dropped=dropped, lighter=lighter)

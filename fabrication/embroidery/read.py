@@ -12,6 +12,7 @@ from fabrication.embroidery.needles import BODY
 from fabrication.embroidery.plan import JUMP, STITCH, TRIM, StitchPlan
 from fabrication.embroidery.thread import Thread
 from onestroke.errors import InputError
+from onestroke.paths import check_input_file
 
 # pyembroidery commands that end a run of thread like a trim does.
 _CUTS = (pyembroidery.TRIM, pyembroidery.COLOR_CHANGE, pyembroidery.NEEDLE_SET, pyembroidery.STOP)
@@ -42,8 +43,7 @@ def read_embroidery(path: str | os.PathLike) -> EmbroideryFile:
     if suffix not in readable_extensions():
         raise InputError(f"cannot read {path!r} as embroidery; pyembroidery reads "
                          f"{', '.join(readable_extensions())}")
-    if not os.path.isfile(path):
-        raise InputError(f"embroidery file {path!r} does not exist")
+    check_input_file(path, what="embroidery file", expect=f"a {suffix} file")
     try:
         pattern = pyembroidery.read(path)
     except Exception as error:  # pyembroidery raises anything on a corrupt file

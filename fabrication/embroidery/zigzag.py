@@ -192,7 +192,10 @@ def zigzag_stitch(stroke: Stroke, options: ZigzagOptions = ZigzagOptions()) -> N
     points, t = points[keep], t[keep]
     points, t = _split_long(points, t, options.max_stitch - 2 * SNAP_ALLOWANCE)
     zig = NeedlePoints.of(points, t, BODY)
-    if not options.has_underlay:
+    # An underlay goes there and back and ends on the start; along a stroke no longer than
+    # one underlay stitch it would re-enter its first hole two stitches later (a knot on a
+    # short stroke), and so short a column does not pucker without it.
+    if not options.has_underlay or length <= options.underlay_stitch_length:
         return zig
     return NeedlePoints.concat([_underlay(stroke, curve, options), zig])
 

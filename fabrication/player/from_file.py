@@ -7,9 +7,10 @@ import os
 from fabrication.player.data import PlayerData
 from machines.laser_profile import LaserProfile
 from onestroke.errors import InputError
+from onestroke.paths import check_input_file
 
 GCODE_SUFFIXES = (".gcode", ".nc", ".gc", ".ngc")
-DRAWING_SUFFIXES = (".svg", ".json")
+DRAWING_SUFFIXES = (".svg", ".svgz", ".json")
 RASTER_SUFFIXES = (".png", ".jpg", ".jpeg", ".bmp", ".gif", ".tif", ".tiff", ".webp")
 
 
@@ -36,8 +37,7 @@ def player_data_for_file(path: str | os.PathLike, *, stitches_per_minute: float 
         raise InputError(f"cannot play {path!r}; use an embroidery file (.pes, .dst, .jef, .exp, "
                          f".vp3, ...), G-code ({', '.join(GCODE_SUFFIXES)}) or a drawing "
                          f"(.svg, .json, .png, .jpg)")
-    if not os.path.isfile(path):
-        raise InputError(f"input file {path!r} does not exist")
+    check_input_file(path)
     title = os.path.basename(path)
     if suffix in GCODE_SUFFIXES:
         from fabrication.player.from_gcode import gcode_file_player_data
@@ -50,10 +50,9 @@ def player_data_for_file(path: str | os.PathLike, *, stitches_per_minute: float 
 
         warnings: tuple[str, ...] = ()
         if suffix == ".json":
-            from onestroke.textfile import read_text
-            from vectorize.svg_write import drawing_from_json
+            from vectorize.svg_write import read_drawing_json
 
-            drawing = drawing_from_json(read_text(path, what="drawing", expect="a .json drawing"))
+            drawing = read_drawing_json(path)
         else:
             from vectorize import VectorizeOptions, vectorize_file
 

@@ -1,12 +1,18 @@
 """The studio's web app (Starlette): the page, its static files and a small JSON API.
 
-Security: the server binds 127.0.0.1 only (see `serve`); every request must carry the
-session's random token (in the URL of the first load, then a SameSite cookie or the
-X-Studio-Token header) and a Host header naming this server, so neither another page
-in the browser nor another user on the machine can drive it; request bodies are
-bounded; files are read and written only where the command line said (the drawing, its
-edits file, a laser profile); a profile the user loads in the page arrives as text and is
-parsed in memory; downloads are made in memory.
+Security: the server binds 127.0.0.1 only (see `serve`), and only the studio's own page
+drives it. Every request needs a Host header naming this server and the session's random
+token; a request that changes anything (POST) must carry the token in the X-Studio-Token
+header, which a page of another origin cannot set without a CORS preflight, and the
+preflight is refused. A request whose Origin is not this server's, or whose Sec-Fetch-Site
+is not same-origin, is refused (127.0.0.1 on another port is the same site, so the
+SameSite cookie alone would not keep other local pages out); the page itself may also be
+opened directly (Sec-Fetch-Site: none), never framed. Reads (GET) may carry the token in
+the URL of the first load or the page's cookie. Request bodies are bounded; files are read
+and written only where the command line said (the drawing, its edits file, a laser
+profile); a profile the user loads in the page arrives as text and is parsed in memory; a
+send port is a serial device or the emulator, its URL decoded before it is checked, never a
+file path; downloads are made in memory.
 """
 
 from __future__ import annotations
@@ -15,6 +21,7 @@ import hashlib
 import json
 import re
 import secrets
+import urllib.parse
 from importlib import resources
 
 from starlette.applications import Starlette
@@ -47,36 +54,68 @@ def _static(name: str) -> bytes:
     return resources.files("fabrication.studio").joinpath("static", name).read_bytes()
 
 
+class TooLarge(InputError):
+    """A request body over MAX_BODY (answered 413)."""
+
+
+# Sent with every answer: never framed by another page (clickjacking), no referrer (the
+# address carries the token), content types taken as given.
+SECURITY_HEADERS = [(b"x-frame-options", b"DENY"), (b"content-security-policy", b"frame-ancestors 'none'"),
+                    (b"referrer-policy", b"no-referrer"), (b"x-content-type-options", b"nosniff")]
+
+
 class Guard:
-    """ASGI middleware: Host header, token and body size checked before any route runs."""
+    """ASGI middleware: Host, Origin, Sec-Fetch-Site, token and body size checked before any
+    route runs (see the module docstring)."""
 
     def __init__(self, app, *, token: str, hosts: set[str]) -> None:
         self.app, self.token, self.hosts = app, token, hosts
+        self.origins = {f"http://{host}" for host in hosts}
 
-    def _allowed(self, scope) -> tuple[bool, bool]:
+    def _token(self, offered: str) -> bool:
+        return secrets.compare_digest(offered.encode("latin-1", "replace"), self.token.encode())
+
+    def allowed(self, scope) -> bool:
+        """Whether the request comes from this studio's own page (or a client holding the token
+        that is no browser page of another origin)."""
         headers = {k.decode("latin-1").lower(): v.decode("latin-1") for k, v in scope["headers"]}
         if headers.get("host", "") not in self.hosts:
-            return False, False
-        query = dict(pair.split("=", 1) for pair in scope.get("query_string", b"").decode().split("&") if "=" in pair)
+            return False
+        if "origin" in headers and headers["origin"] not in self.origins:
+            return False
+        method = scope.get("method", "GET")
+        site = headers.get("sec-fetch-site")
+        opened = site == "none" and method == "GET" and scope.get("path") == "/"  # typed or clicked address
+        if site is not None and site != "same-origin" and not opened:
+            return False
+        if self._token(headers.get("x-studio-token", "")):
+            return True
+        if method not in ("GET", "HEAD"):
+            return False  # a change needs the header: a form or a no-cors fetch cannot send it
+        query = urllib.parse.parse_qs(scope.get("query_string", b"").decode("latin-1"))
         cookies = {}
         for part in headers.get("cookie", "").split(";"):
-            if "=" in part:
-                key, value = part.strip().split("=", 1)
-                cookies[key] = value
-        offered = [query.get("token", ""), headers.get("x-studio-token", ""), cookies.get(cookie_name(self.token), "")]
-        by_url = secrets.compare_digest(offered[0].encode(), self.token.encode())
-        return any(secrets.compare_digest(o.encode(), self.token.encode()) for o in offered), by_url
+            key, _, value = part.strip().partition("=")
+            cookies[key] = value
+        return self._token(query.get("token", [""])[-1]) or self._token(cookies.get(cookie_name(self.token), ""))
 
     async def __call__(self, scope, receive, send):
+        if scope["type"] == "websocket":  # the studio has none: refuse before any handshake
+            return await send({"type": "websocket.close", "code": 1008})
         if scope["type"] != "http":
             return await self.app(scope, receive, send)
-        ok, _ = self._allowed(scope)
-        if not ok:
-            return await PlainTextResponse("forbidden", status_code=403)(scope, receive, send)
+
+        async def send_secured(message):
+            if message["type"] == "http.response.start":
+                message = dict(message, headers=list(message.get("headers", [])) + SECURITY_HEADERS)
+            await send(message)
+
+        if not self.allowed(scope):
+            return await PlainTextResponse("forbidden", status_code=403)(scope, receive, send_secured)
         headers = dict(scope["headers"])
         length = headers.get(b"content-length")
         if length is not None and (not length.isdigit() or int(length) > MAX_BODY):
-            return await PlainTextResponse("request too large", status_code=413)(scope, receive, send)
+            return await PlainTextResponse("request too large", status_code=413)(scope, receive, send_secured)
         seen = 0
 
         async def bounded():
@@ -84,24 +123,44 @@ class Guard:
             message = await receive()
             seen += len(message.get("body", b""))
             if seen > MAX_BODY:
-                raise InputError("request too large")
+                raise TooLarge("request too large")
             return message
 
-        return await self.app(scope, bounded, send)
+        return await self.app(scope, bounded, send_secured)
 
 
-def _checked_port(port: str) -> str:
-    """A serial device or the emulator; never another pyserial URL (socket://, rfc2217://
-    reach the network) nor an emulator reading a file the command line did not name."""
-    if port.startswith("sim://") and "profile" not in port:
-        return port
-    if re.fullmatch(r"/dev/[A-Za-z0-9._/-]+|COM[0-9]+", port) and ".." not in port:
-        return port
-    raise InputError(f"port {port!r}: give a serial device (/dev/ttyUSB0, COM3) or sim:// for a dry run")
+# A serial device as the port list names them: /dev/ttyUSB0, /dev/ttyACM0, /dev/cu.usbserial-1410,
+# /dev/serial/by-id/usb-1a86_USB2.0-Serial-if00-port0, COM3. No other path, no other URL.
+SERIAL_DEVICE = re.compile(r"/dev/(tty|cu\.)[A-Za-z0-9_.-]+|/dev/serial/by-(id|path)/[A-Za-z0-9_.:+-]+|COM[0-9]{1,3}")
+# What the studio's emulator may be told: every sim:// parameter but `profile` (a file path).
+SIM_KEYS = ("speed", "rx", "blocks", "laser", "travel", "drop_hold")
+
+
+def checked_port(port: str) -> str:
+    """A serial device or the emulator (`sim://`, `sim://?speed=N`), after percent-decoding;
+    never another pyserial URL (socket://, rfc2217:// reach the network) nor an emulator
+    told to read a file (`profile=`)."""
+    text = str(port).strip()
+    if SERIAL_DEVICE.fullmatch(text) and "/../" not in text:
+        return text
+    parts = urllib.parse.urlsplit(text)
+    if parts.scheme.lower() == "sim" and not parts.netloc and parts.path in ("", "/") and not parts.fragment:
+        keys = [key for key, _ in urllib.parse.parse_qsl(parts.query, keep_blank_values=True)]
+        if set(keys) <= set(SIM_KEYS):
+            from machines.sim_url.protocol_sim import parse_sim_url
+
+            try:
+                parse_sim_url(text)  # the values are the emulator's to check
+            except ValueError as error:
+                raise InputError(f"port {text!r}: {error}") from None
+            return text
+        raise InputError(f"port {text!r}: the studio's emulator takes {', '.join(SIM_KEYS)} "
+                         "(e.g. sim://?speed=1), no file")
+    raise InputError(f"port {text!r}: give a serial device (/dev/ttyUSB0, COM3) or sim:// for a dry run")
 
 
 def _error(error: Exception) -> JSONResponse:
-    status = 400 if isinstance(error, InputError) else 500
+    status = 413 if isinstance(error, TooLarge) else 400 if isinstance(error, InputError) else 500
     return JSONResponse({"error": str(error)}, status_code=status)
 
 
@@ -113,6 +172,8 @@ def create_app(session: StudioSession, *, token: str, hosts: set[str]) -> Guard:
             data = json.loads(await request.body() or b"{}")
         except (json.JSONDecodeError, UnicodeDecodeError):
             raise InputError("the request body is not JSON") from None
+        except RecursionError:
+            raise InputError("the request body is nested too deeply") from None
         if not isinstance(data, dict):
             raise InputError("the request body must be a JSON object")
         edits = edits_from_dict(data["edits"]) if data.get("edits") is not None else Edits()
@@ -193,17 +254,15 @@ def create_app(session: StudioSession, *, token: str, hosts: set[str]) -> Guard:
 
     async def send(request: Request):
         from fabrication.studio.sender import LaserSender
+        from machines.stream_types import check_baud
 
         if request.method == "GET":
             return JSONResponse(session.sender.status() if session.sender else {"state": "idle"})
         edits, options, data = await payload(request)
         if session.sender is not None and session.sender.running:
             raise InputError("a job is already being sent; abort it first")
-        port = _checked_port(str(data.get("port") or ""))
-        try:
-            baud = int(data.get("baud") or 115200)
-        except (TypeError, ValueError):
-            raise InputError(f"baud rate {data.get('baud')!r} is not a whole number") from None
+        port = checked_port(str(data.get("port") or ""))
+        baud = check_baud(data.get("baud") or 115200, name="baud rate")
         name, _, content = await run_in_threadpool(session.export, "gcode", edits, options)
         session.sender = LaserSender(content.decode(), port=port, baud=baud, name=name).start()
         return JSONResponse(session.sender.status())

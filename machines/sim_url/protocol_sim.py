@@ -14,54 +14,57 @@ import urllib.parse
 import serial
 from serial.serialutil import PortNotOpenError, SerialBase, SerialException
 
-from machines.emulator import EmulatorOptions, Faults, GrblEmulator
+from machines.emulator import TIME_SCALE, EmulatorOptions, Faults, GrblEmulator
 
 DEFAULT_SPEED = 10.0
 
 
+# Integer parameters: (lowest, highest). GRBL boards have RX buffers of 64-1024 bytes and
+# planners of 8-32 blocks; the emulator takes any buffer from 1 byte (to rehearse a line
+# that cannot fit: the sender refuses it by name) and 2-256 blocks.
+_INTEGERS = {"rx": (1, 65536), "blocks": (2, 256), "drop_hold": (0, 1000), "laser": (0, 1)}
+
+
 def parse_sim_url(url: str) -> EmulatorOptions:
-    """Emulator options from a `sim://` URL; raises ValueError naming a bad parameter."""
+    """Emulator options from a `sim://` URL; raises ValueError naming a bad parameter or value
+    (numbers in ASCII decimal, each within its range)."""
+    from onestroke.errors import InputError
+    from onestroke.units import parse_integer, parse_number, parse_size_pair
+
     parts = urllib.parse.urlsplit(url)
     if parts.scheme != "sim":
         raise ValueError(f"expected a sim:// URL, got {url!r}")
-    speed, rx, blocks, settings, faults = DEFAULT_SPEED, 128, 15, {}, {}
+    speed, numbers, settings = DEFAULT_SPEED, {"rx": 128, "blocks": 15}, {}
     for key, values in urllib.parse.parse_qs(parts.query, keep_blank_values=True).items():
         value = values[-1]
+        what = f"sim:// parameter {key!r}"
         try:
             if key == "speed":
-                speed = float(value)
-                if not speed > 0:
-                    raise ValueError
-            elif key == "rx":
-                rx = int(value)
-            elif key == "blocks":
-                blocks = int(value)
-            elif key == "drop_hold":
-                faults["drop_hold"] = int(value)
-            elif key == "laser":
-                settings[32] = float(int(value))
+                speed = TIME_SCALE.named(what).check(parse_number(value, what=what), shown=repr(value))
+            elif key in _INTEGERS:
+                low, high = _INTEGERS[key]
+                numbers[key] = parse_integer(value, what=what)
+                if not low <= numbers[key] <= high:
+                    raise ValueError(f"bad value {value!r} for {what}: give a whole number from {low} to {high}")
             elif key == "profile":
                 from machines.grbl_settings import settings_from_profile
                 from machines.laser_profile import load_laser_profile
 
-                try:
-                    settings = {**settings_from_profile(load_laser_profile(value)), **settings}
-                except Exception as error:  # noqa: BLE001 - InputError and friends, reported as one line
-                    raise ValueError(f"sim:// profile: {error}") from None
+                settings = {**settings_from_profile(load_laser_profile(value)), **settings}
             elif key == "travel":
-                width, height = (float(v) for v in value.lower().split("x"))
-                settings[130], settings[131] = width, height
+                settings[130], settings[131] = parse_size_pair(value, what=what)
             else:
-                raise KeyError(key)
-        except KeyError:
-            raise ValueError(f"unknown sim:// parameter {key!r}; use speed, rx, blocks, laser, travel, "
-                             "profile, drop_hold") from None
-        except ValueError as error:
-            if str(error).startswith("sim://"):
-                raise
-            raise ValueError(f"bad value {value!r} for sim:// parameter {key!r}") from None
-    return EmulatorOptions(time_scale=speed, rx_buffer=rx, planner_blocks=blocks, settings=settings,
-                           faults=Faults(**faults))
+                raise ValueError(f"unknown sim:// parameter {key!r}; use speed, rx, blocks, laser, travel, "
+                                 "profile, drop_hold")
+        except InputError as error:
+            if key == "travel":
+                raise ValueError(f"bad value {value!r} for {what}: give the bed as WxH in mm, e.g. 400x400") from None
+            raise ValueError(str(error)) from None
+    if "laser" in numbers:
+        settings[32] = float(numbers["laser"])
+    faults = {"drop_hold": numbers["drop_hold"]} if "drop_hold" in numbers else {}
+    return EmulatorOptions(time_scale=speed, rx_buffer=numbers["rx"], planner_blocks=numbers["blocks"],
+                           settings=settings, faults=Faults(**faults))
 
 
 class Serial(SerialBase):
