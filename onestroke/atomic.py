@@ -82,15 +82,17 @@ def _check_path(path: str | os.PathLike) -> Path:
     return path
 
 
-def check_folder(folder: str | os.PathLike, *, what: str) -> Path:
+def check_folder(folder: str | os.PathLike, *, what: str, parents: bool = False) -> Path:
     """Raise `InputError` unless `folder` is, or can be made as, a folder that takes files.
 
     For an output folder that is made if missing (batch -o, --debug): then its parent must
-    be a folder that takes files (as `mkdir` without -p: a mistyped path is not made).
-    what: the option, for messages.
+    be a folder that takes files (as `mkdir` without -p: a mistyped path is not made), or
+    with `parents` its nearest existing ancestor. what: the option, for messages.
     """
     folder = Path(folder)
     there = folder if folder.exists() else (folder.parent if str(folder.parent) else Path("."))
+    while parents and not there.exists() and there != there.parent:
+        there = there.parent
     if there.exists() and not there.is_dir():
         raise InputError(f"{what} {str(folder)!r}: {str(there)!r} is a file, not a folder")
     if not there.exists():

@@ -180,23 +180,29 @@ def test_a_scheduler_killed_mid_run_leaves_the_rest_to_a_rerun(drawings, tmp_pat
 
 
 def test_disk_full_on_the_second_of_two_outputs_leaves_neither(tmp_path):
-    """Tiny tmpfs disks: room for the first output (.pes 2.4 kB, G-code 11 kB, SVG 4 kB of
-    loops.png), not for the second (their previews, the first stage image)."""
-    disks = {name: tmp_path / name for name in ("pes", "gcode", "svg")}
-    for disk in disks.values():
+    """A tiny tmpfs per command, sized (from a run on the real disk) to hold the first output
+    and one page more, not the second output (the preview, the first stage image)."""
+    page = 4096
+    commands = {"pes": ["embroider", str(LOOPS), "-o", "{d}/a.pes", "--preview", "{d}/a.png"],
+                "gcode": ["laser", str(LOOPS), "-o", "{d}/a.gcode", "--preview", "{d}/a.png"],
+                "svg": ["vectorize", str(LOOPS), "-o", "{d}/a.svg", "--debug", "{d}/debug"]}
+    mounts, rows, seconds = [], [], {}
+    for name, argv in commands.items():
+        sized = tmp_path / f"sized-{name}"
+        sized.mkdir()
+        made = CliRunner().invoke(main, [a.replace("{d}", str(sized)) for a in argv])
+        assert made.exit_code == 0, made.output
+        first = (sized / f"a.{name}").stat().st_size
+        second = sized / ("debug/1-binary.png" if name == "svg" else "a.png")
+        assert second.stat().st_size > page  # it cannot fit in the page left
+        disk = tmp_path / name
         disk.mkdir()
-    rows = [(["embroider", str(LOOPS), "-o", f"{disks['pes']}/a.pes", "--preview", f"{disks['pes']}/a.png"],
-             str(disks["pes"])),
-            (["laser", str(LOOPS), "-o", f"{disks['gcode']}/a.gcode", "--preview", f"{disks['gcode']}/a.png"],
-             str(disks["gcode"])),
-            (["vectorize", str(LOOPS), "-o", f"{disks['svg']}/a.svg", "--debug", f"{disks['svg']}/debug"],
-             str(disks["svg"]))]
-    results = run_with_mounts([tmpfs(disks["pes"], "16k"), tmpfs(disks["gcode"], "16k"), tmpfs(disks["svg"], "8k")],
-                              rows)
-    for (argv, folder), result in zip(rows, results):
-        second = argv[argv.index("--preview") + 1] if "--preview" in argv else f"{folder}/debug/1-binary.png"
+        mounts.append(tmpfs(disk, f"{(first + page - 1) // page * page + page}"))
+        rows.append(([a.replace("{d}", str(disk)) for a in argv], str(disk)))
+        seconds[name] = str(disk / second.relative_to(sized))
+    for (argv, folder), result, name in zip(rows, run_with_mounts(mounts, rows), commands):
         assert result["code"] == 1, result
-        assert result["stderr"].strip() == f"error: cannot write {second!r}: the disk is full", result
+        assert result["stderr"].strip() == f"error: cannot write {seconds[name]!r}: the disk is full", result
         assert result["left"] == [], result  # neither output, no temporary file, no debug folder
         assert os.listdir(folder) == []  # the mount point, empty again outside the namespace
 

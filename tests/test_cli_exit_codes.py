@@ -38,6 +38,7 @@ COMMAND_LINES = {
     "studio": (["studio", "{in}/d.svg", "--no-browser", "--edits", "{dir}/e.json"], ["--port", "70000"],
                "{in}/d.svg"),
     "ports": (["ports", "--no-probe"], ["--probe", "--baud", "x"], None),
+    "inkscape": (["inkscape", "install", "--dir", "{dir}/ext"], ["--user"], None),
     "emulator": (["emulator", "--log", "{dir}/x.log"], ["--speed", "0"], None),
     "train-classifier": (["train-classifier", "--out", "{dir}/m.onnx"], ["--epochs", "0"], None),
     "validate-classifier": (["validate-classifier", "--model", "{in}/m.onnx"], ["--count", "0"], "{in}/m.onnx"),

@@ -67,6 +67,17 @@ def describe_os_error(error: OSError) -> str:
 
 
 def _interrupt(signum, frame) -> None:
+    """Ctrl-C, SIGTERM, SIGHUP: raise `KeyboardInterrupt` (`Interrupted` naming the signal)."""
+    code = getattr(frame, "f_code", None)
+    if code is not None and (code.co_filename.startswith("<frozen importlib") or code.co_name == "__del__"):
+        # raised in importlib's module-lock callback or a finalizer, the exception would be
+        # printed and dropped, and the work go on: the same signal again in a moment
+        import threading
+
+        threading.Timer(0.02, os.kill, (os.getpid(), signum)).start()
+        return
+    if signum == signal.SIGINT:
+        raise KeyboardInterrupt
     raise Interrupted(signal.Signals(signum).name)
 
 
@@ -74,14 +85,12 @@ class OnestrokeGroup(click.Group):
     """A click group that turns every error into a one-line message and an exit code."""
 
     def invoke(self, ctx: click.Context):
-        if signal.getsignal(signal.SIGINT) is _interrupted_early:
-            # From here on Ctrl-C raises KeyboardInterrupt, so atomic writes clean up.
-            signal.signal(signal.SIGINT, signal.default_int_handler)
-        # a kill or a closed terminal stops the work as Ctrl-C does (temporary files removed,
-        # a batch's workers stopped and its report written); SIG_IGN (nohup) is kept
+        # From here on Ctrl-C raises KeyboardInterrupt, so atomic writes clean up; a kill or a
+        # closed terminal does the same (temporary files removed, a batch's workers stopped and
+        # its report written); SIG_IGN (background jobs, nohup) is kept
         taken = {}
-        for signum in (signal.SIGTERM, signal.SIGHUP):
-            if signal.getsignal(signum) in (signal.SIG_DFL, _interrupted_early):
+        for signum in (signal.SIGINT, signal.SIGTERM, signal.SIGHUP):
+            if signal.getsignal(signum) in (signal.SIG_DFL, signal.default_int_handler, _interrupted_early):
                 try:
                     taken[signum] = signal.signal(signum, _interrupt)
                 except ValueError:  # invoked outside the main thread (a test): leave them
@@ -108,8 +117,10 @@ class OnestrokeGroup(click.Group):
         except Exception as error:  # noqa: BLE001 - a bug still gets one line, and a way to report it
             self._fail(f"internal error ({type(error).__name__}: {error}); please report this with the "
                        "command line and input", EXIT_FAILED)
-        finally:
+        finally:  # Python's own handling again (a program that invoked the group goes on)
             for signum, previous in taken.items():
+                if previous is _interrupted_early:
+                    previous = signal.default_int_handler if signum == signal.SIGINT else signal.SIG_DFL
                 signal.signal(signum, previous)
 
     @staticmethod
