@@ -3,10 +3,13 @@
 Run from the repository root: python benchmarks/embroidery_quality.py [--only density]
 Prints the numbers the acceptance criteria of issues 4 and 27 ask for: worst cases over
 the test designs, every style and format; then, on every benchmark drawing (the bundled
-examples, the test designs, a three-colour SVG, short strokes) and every style, the
-density with every needle point counted and the repeated holes, measured by
-`fabrication.embroidery.quality` (the same functions as the stats' warnings), and whether
-a warning names each place over the limit.
+examples, the test designs, a three-colour SVG, short strokes, corners of 30-170 degrees)
+and every style (satin included), the density with every needle point counted and the
+repeated holes, measured by `fabrication.embroidery.quality` (the same functions as the
+stats' warnings), whether a warning names each place over the limit, the slits of zigzag
+and satin columns (benchmarks/column_metrics.py) and needle points planned per second
+(the whole job); then the satin's width on the varying-width set (benchmarks/
+satin_quality.py: --only satin).
 """
 
 from __future__ import annotations
@@ -14,6 +17,7 @@ from __future__ import annotations
 import argparse
 import sys
 import tempfile
+import time
 from pathlib import Path
 
 import numpy as np
@@ -22,6 +26,7 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 sys.path.insert(0, str(ROOT / "tests"))
 
+from benchmarks.satin_quality import CORNER_ANGLES, column_slits, corner_drawing, varying_width  # noqa: E402
 from embroidery_fixtures import FORMATS, STYLE_NAMES, THREE_COLOURS, design, lock_figure_ok, spiral, stroke_rows  # noqa: E402
 from fabrication.embroidery.export import write_embroidery  # noqa: E402
 from fabrication.embroidery.needles import BODY, LOCK, TACK, UNDERLAY  # noqa: E402
@@ -32,6 +37,9 @@ from fabrication.embroidery.zigzag import ZigzagOptions  # noqa: E402
 from machines.hoops import hoop_named  # noqa: E402
 from vectorize.drawing import Drawing  # noqa: E402
 from vectorize.stroke import Stroke  # noqa: E402
+
+
+STYLES = STYLE_NAMES + ("satin",)
 
 
 def seg_dist(p, a, b):
@@ -68,6 +76,8 @@ def benchmark_drawings(folder: str) -> dict[str, tuple[Drawing, float | None]]:
     drawings["hairpin 0.8 mm"] = (Drawing((Stroke.from_polyline(np.array([[0, 0], [20, 0], [20, 0.8],
                                                                            [0, 0.8]])),), 20, 1, "mm"), None)
     drawings["1.2 mm strokes"] = (_short_strokes(), None)
+    for angle in CORNER_ANGLES:
+        drawings[f"corner {angle} degrees"] = (corner_drawing(angle), None)
     return drawings
 
 
@@ -79,14 +89,16 @@ def density_and_holes(folder: str) -> None:
     from fabrication.placement import PlacementOptions
 
     hoop = hoop_named("200x200")
-    print(f"\n{'drawing':36} {'style':8} {'needles':>7} {'density':>7} {'holes':>5} {'ties lighter':>12} "
-          f"{'box off':>7} {'curve-centred off':>17}  warned")
-    worst, holes_total, unwarned, offsets, curve_offsets = 0, 0, 0, [], []
+    print(f"\n{'drawing':36} {'style':8} {'needles':>7} {'density':>7} {'holes':>5} {'slits':>5} {'ties lighter':>12} "
+          f"{'box off':>7} {'curve-centred off':>17} {'needles/s':>9}  warned")
+    worst, holes_total, unwarned, offsets, curve_offsets, slit_total = 0, 0, 0, [], [], 0
     for name, (drawing, size) in benchmark_drawings(folder).items():
-        for style in STYLE_NAMES:
+        for style in STYLES:
             placement = PlacementOptions(size=size) if size else PlacementOptions(size=max(drawing.width, drawing.height))
             job = EmbroideryJob(placement=placement, hoop=hoop, plan=PlanOptions(style=style_options(style)))
+            start = time.perf_counter()
             result = embroider(drawing, job)
+            seconds = time.perf_counter() - start
             plan = result.plan
             density = needle_density(plan.points[plan.kinds == STITCH])
             holes = len(repeated_holes(plan))
@@ -107,22 +119,29 @@ def density_and_holes(folder: str) -> None:
             curve_off = float(np.hypot((rx0 + rx1) / 2 - (cx0 + cx1) / 2, (ry0 + ry1) / 2 - (cy0 + cy1) / 2))
             offsets.append(off)
             curve_offsets.append(curve_off)
-            print(f"{name:36} {style:8} {len(plan.points[plan.kinds == STITCH]):7d} {density.maximum:7d} "
-                  f"{holes:5d} {len(plan.lighter):12d} {off:7.3f} {curve_off:17.3f}  {warned}")
+            needles = len(plan.points[plan.kinds == STITCH])
+            cut = column_slits(plan, job.plan.style) if style in ("zigzag", "satin") else 0
+            slit_total += cut
+            print(f"{name:36} {style:8} {needles:7d} {density.maximum:7d} {holes:5d} {cut:5d} {len(plan.lighter):12d} "
+                  f"{off:7.3f} {curve_off:17.3f} {needles / seconds:9.0f}  {warned}")
     print(f"worst density, every needle point counted: {worst} within 0.5 mm (limit {DENSITY_LIMIT}); "
           f"repeated holes in all: {holes_total}; places over the limit or with holes and no warning "
-          f"naming them: {unwarned}")
+          f"naming them: {unwarned}; slits (zigzag and satin): {slit_total}")
     print(f"stitches' box centre from (0, 0): max {max(offsets):.3f} mm (curve-centred, as before: max "
           f"{max(curve_offsets):.3f} mm)")
 
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--only", choices=["density"], default=None,
-                        help="only the density and repeated holes of every benchmark drawing")
+    parser.add_argument("--only", choices=["density", "satin"], default=None,
+                        help="only the density and repeated holes of every benchmark drawing, or only the "
+                             "satin's widths on the varying-width set")
     args = parser.parse_args()
     folder = tempfile.mkdtemp()
-    density_and_holes(folder)
+    if args.only != "satin":
+        density_and_holes(folder)
+    if args.only != "density":
+        varying_width()
     if args.only:
         return
     hoop = hoop_named("100x100")

@@ -40,7 +40,7 @@ def spiral_drawing(turns: float, r0: float = 5.0, r1: float = 95.0, per_turn: in
 
 
 # Turns that give about 100,000 needle points per style (curve ~251 m for running).
-CASES = {"running": 800.0, "triple": 267.0, "zigzag": 57.0, "arrows": 285.0}
+CASES = {"running": 800.0, "triple": 267.0, "zigzag": 57.0, "satin": 57.0, "arrows": 285.0}
 
 
 def main() -> None:

@@ -33,6 +33,7 @@ def main() -> None:
     ap.add_argument("--kinds", default=",".join(KINDS), help="comma-separated subset of " + ",".join(KINDS))
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--time-bound", type=float, default=10.0, help="seconds per command line")
+    ap.add_argument("--keep", default=None, help="folder to save the input of every problem case in")
     args = ap.parse_args()
     codes, problems, slowest, total, outcomes = collections.Counter(), [], (0.0, None), 0, []
     started = time.perf_counter()
@@ -54,6 +55,9 @@ def main() -> None:
                 if outcome.hung or outcome.traceback or outcome.leftovers or outcome.over_memory or \
                         outcome.exit_code not in (0, 1, 2):
                     problems.append((kind, case, outcome))
+                    if args.keep and case[1] is not None:
+                        Path(args.keep).mkdir(parents=True, exist_ok=True)
+                        (Path(args.keep) / f"{kind}-{len(problems)}-{case[2]}.input").write_bytes(case[1])
 
             one()
             print(f"{kind}: done ({total} so far, {time.perf_counter() - started:.0f} s)", flush=True)
@@ -66,6 +70,11 @@ def main() -> None:
           f"over {args.time_bound:g} s {len(hangs)}, over {MEMORY_BOUND_MB:g} MB {len(memory)}, partial output "
           f"sets {len(leftovers)}; slowest {slowest[0]:.1f} s ({slowest[1]}); peak memory "
           f"{max(o.peak_mb for o in outcomes):.0f} MB")
+    # exit 1 is a failure of the work (a port that cannot open, a job GRBL would refuse): which
+    failures = collections.Counter(" ".join(o.message.split()[:6]) for o in outcomes if o.exit_code == 1)
+    print("exit 1, most common messages: " + "; ".join(f"{n} x {m}" for m, n in failures.most_common(6)))
+    # tracebacks first, then partial outputs, memory, time: the rarer problems are not hidden
+    problems.sort(key=lambda p: (not p[2].traceback, not p[2].leftovers, not p[2].over_memory))
     for kind, case, outcome in problems[:20]:
         data = case[1][:200] if case[1] is not None else None
         print(f"  {kind} {case[2]} {case[3]}: {outcome} input {data!r}")

@@ -157,12 +157,17 @@ def svg_structure(draw) -> bytes:
 @st.composite
 def drawing_json(draw) -> bytes:
     """A JSON drawing: valid, with a wrong type or shape somewhere, not finite, or not JSON."""
-    strokes = [[[[draw(st.floats(-100, 100)), draw(st.floats(-100, 100))] for _ in range(4)]
-                for _ in range(draw(st.integers(1, 3)))] for _ in range(draw(st.integers(0, 3)))]
+    coordinate = lambda: [draw(st.floats(-100, 100)), draw(st.floats(-100, 100))]  # noqa: E731
+    strokes = []
+    for _ in range(draw(st.integers(0, 3))):
+        pieces = [[coordinate() for _ in range(4)]]
+        for _ in range(draw(st.integers(0, 2))):  # one connected curve: each piece starts where the last ended
+            pieces.append([pieces[-1][3]] + [coordinate() for _ in range(3)])
+        strokes.append(pieces)
     payload = {"format": "onestroke-drawing", "version": 1, "unit": draw(st.sampled_from(["px", "mm"])),
                "width": 200, "height": 150, "stroke_width": 2, "strokes": strokes}
     damage = draw(st.sampled_from(["none", "none", "type", "shape", "colors", "drop", "nan", "bytes", "list",
-                                   "deep", "huge"]))
+                                   "deep", "huge", "gap"]))
     if damage == "type":
         key = draw(st.sampled_from(sorted(payload)))
         payload[key] = draw(st.sampled_from(["wide", None, True, [1, 2], {"a": 1}, -1, 1e308, 0]))
@@ -171,6 +176,8 @@ def drawing_json(draw) -> bytes:
     elif damage == "colors":
         payload["colors"] = draw(st.sampled_from([[[0, 0, 0]] * len(strokes) + [[1, 2, 3]], [[256, 0, 0]] *
                                                   len(strokes), "red", [None] * len(strokes)]))
+    elif damage == "gap" and strokes and len(strokes[0]) > 1:
+        strokes[0][1][0] = [strokes[0][1][0][0] + draw(st.sampled_from([1e-3, 0.5, 1e300])), strokes[0][1][0][1]]
     elif damage == "drop":
         payload.pop(draw(st.sampled_from(["format", "width", "height", "strokes"])))
     text = json.dumps(payload)
@@ -310,6 +317,7 @@ class Outcome:
     seconds: float
     peak_mb: float = 0.0  # the process's (or a finished child's) peak resident memory after the case
     peak_before_mb: float = 0.0  # ... and before it
+    message: str = ""  # the last line the command printed
 
     @property
     def over_memory(self) -> bool:
@@ -385,10 +393,11 @@ def run_case(case, folder: Path, *, time_bound: float) -> Outcome:
     previous = signal.signal(signal.SIGALRM, alarm)
     signal.setitimer(signal.ITIMER_REAL, time_bound)
     started = time.perf_counter()
-    hung, code, trace = False, None, None
+    hung, code, trace, message = False, None, None, ""
     try:
         result = CliRunner().invoke(main, args)
         code = result.exit_code
+        message = (result.output.strip().splitlines() or [""])[-1]
         if result.exception is not None and not isinstance(result.exception, SystemExit):
             trace = f"{type(result.exception).__name__}: {result.exception}"
         elif "Traceback" in result.output or "internal error" in result.output:
@@ -404,7 +413,7 @@ def run_case(case, folder: Path, *, time_bound: float) -> Outcome:
     leftovers = [m for m in made if code != 0 or m.endswith(".part") or m.startswith(".")]
     if code == 0:
         leftovers += [f"missing {p.name}" for p in outputs if not p.exists()]  # an incomplete set
-    return Outcome(code, trace, hung, tuple(leftovers), seconds, _peak_mb(), peak_before)
+    return Outcome(code, trace, hung, tuple(leftovers), seconds, _peak_mb(), peak_before, message)
 
 
 SUFFIX_OF = {"stream": ".gcode"}

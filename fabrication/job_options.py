@@ -29,7 +29,26 @@ _STYLE_FIELDS = {
     "repeats": ("repeats", "--repeats"),
     "arrow_size": ("size", "--arrow-size"),
     "underlay": ("underlay", "--underlay"),
+    # satin (and the corner controls, zigzag's too)
+    "width_scale": ("width_scale", "--width-scale"),
+    "min_width": ("min_width", "--min-width"),
+    "max_width": ("max_width", "--max-width"),
+    "pull_comp_percent": ("pull_compensation_percent", "--pull-comp-percent"),
+    "underlay_inset": ("edge_inset", "--underlay-inset"),
+    "underlay_spacing": ("underlay_spacing", "--underlay-spacing"),
+    "short_stitch_distance": ("short_stitch_distance", "--short-stitch-distance"),
+    "short_stitch_inset": ("short_stitch_inset", "--short-stitch-inset"),
+    "split_length": ("max_stitch_length", "--split-length"),
+    "random_width": ("random_width", "--random-width"),
+    "random_phase": ("random_phase", "--random-phase"),
+    "seed": ("seed", "--seed"),
+    "corner_angle": ("corner_angle", "--corner-angle"),
+    "mitre_limit": ("mitre_limit", "--mitre-limit"),
+    "corner_overlap": ("overlap", "--corner-overlap"),
 }
+# How each option's text is read (default: a length).
+_PERCENTS = ("pull_comp_percent", "short_stitch_inset", "random_width")
+_NUMBERS = ("width_scale", "corner_angle", "mitre_limit")
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -108,12 +127,15 @@ def embroidery_settings(*, output: str, style: str = "running", size: str | None
                         lock_form: str = "half", color: str | None = None, thread_chart: str | None = None,
                         start: str | None = None, name: str | None = None, source: str | None = None,
                         date: str | None = None,
-                        pes_version: int | None = None, spm: float | None = None) -> EmbroiderySettings:
+                        pes_version: int | None = None, spm: float | None = None,
+                        **column: str | float | bool | None) -> EmbroiderySettings:
     """The `EmbroideryJob` of `onestroke embroider`'s option values, for the format of `output`
     (a file name or just ".pes"); `InputError` naming the flag for a bad value. `color`: one
     colour or a comma-separated list (one per stroke); None keeps the drawing's colours.
     `name`: the design name files store (None: the stem of `source`, the input file, else
-    'onestroke'). `date`: YYYYMMDDhhmmss for JEF (None: the fixed default)."""
+    'onestroke'). `date`: YYYYMMDDhhmmss for JEF (None: the fixed default). `column`: the
+    satin's and the corners' options by their CLI names (width_scale="1.2", min_width="0.8mm",
+    short_stitch_inset="15%", random_phase=True, seed=3, ...; see `_STYLE_FIELDS`)."""
     from fabrication.embroidery.export import check_pes_version
     from fabrication.embroidery.locks import LockOptions
     from fabrication.embroidery.order import parse_start
@@ -122,28 +144,32 @@ def embroidery_settings(*, output: str, style: str = "running", size: str | None
     from fabrication.embroidery.thread import check_chart, parse_colors
     from machines.hoops import load_embroidery_profile
     from onestroke.ranges import ranges_of
-    from onestroke.units import parse_length
+    from onestroke.units import parse_fraction, parse_length
 
     profile = load_embroidery_profile()
     fmt = profile.format_for(output)
     pes_version = check_pes_version(pes_version, fmt.extension)
+    unknown = sorted(set(column) - set(_STYLE_FIELDS))
+    if unknown:
+        raise InputError(f"unknown embroidery option {unknown[0]!r}")
     given = {"stitch_length": stitch_length, "tolerance": tolerance, "stitch_width": stitch_width,
              "spacing": spacing, "arrow_size": arrow_size, "pull_comp": pull_comp, "repeats": repeats,
-             "underlay": underlay}
+             "underlay": underlay, **column}
     cls = style_class(style)
     style_ranges = ranges_of(cls)
     style_values, warnings = {}, []
     for key, value in given.items():
         field, flag = _STYLE_FIELDS[key]
-        if value is None:
+        if value is None or (key == "random_phase" and value is False):
             continue
         if field not in cls.__dataclass_fields__:
             warnings.append(f"{flag} has no effect with --style {style}")
-        elif key == "underlay":
-            style_values[field] = value  # a name: the style's options check it
+        elif key in ("underlay", "random_phase"):
+            style_values[field] = value  # a name or a flag: the style's options check it
         else:
-            style_values[field] = _checked(value, _whole if key == "repeats" else parse_length,
-                                           style_ranges[field])
+            parse = (_whole if key in ("repeats", "seed") else _number if key in _NUMBERS
+                     else parse_fraction if key in _PERCENTS else parse_length)
+            style_values[field] = _checked(value, parse, style_ranges[field])
     stitch_options = cls(**style_values)
     if not any(v is not None for v in (size, width, height)):
         size = "90mm"

@@ -71,7 +71,7 @@ OK = [
 BAD = [
     (["embroider", "{in}/d.svg", "-o", "out.txt"], "'.txt'"),
     (["embroider", "{in}/d.svg", "-o", "out"], "no extension"),
-    (["embroider", "{in}/d.svg", "-o", "out.pes", "--style", "satin"], "'satin'"),
+    (["embroider", "{in}/d.svg", "-o", "out.pes", "--style", "cross"], "'cross'"),
     (["embroider", "{in}/d.svg", "-o", "out.pes", "--size", "0"], "'0'"),
     (["embroider", "{in}/d.svg", "-o", "out.pes", "--size", "-5mm"], "'-5mm'"),
     (["embroider", "{in}/d.svg", "-o", "out.pes", "--width", "0mm"], "'0mm'"),

@@ -37,7 +37,7 @@ def _plan(drawing: str, style: str):
 
 
 @pytest.mark.parametrize("ext", FORMATS)
-@pytest.mark.parametrize("style", STYLE_NAMES)
+@pytest.mark.parametrize("style", STYLE_NAMES + ("satin",))
 @pytest.mark.parametrize("drawing", list(DRAWINGS))
 def test_two_readers_see_the_planned_stitches(drawing, style, ext, tmp_path):
     plan = _plan(drawing, style)

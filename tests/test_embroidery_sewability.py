@@ -169,12 +169,11 @@ def test_a_dropped_speck_is_measured_to_the_nearest_stitch_of_its_thread():
     assert second.startswith("stroke 3 ") and f"every stitch of its thread (the nearest is {near_far:.1f} mm" in second
 
 
-@pytest.mark.parametrize("style", ["running", "arrows"])
+@pytest.mark.parametrize("style", ["running", "triple", "arrows"])
 def test_a_retraced_spike_is_sewn_back_in_fresh_holes(style):
     """Out along a line and back along the same line (the vectorizer's retraced spikes):
     equal stitches on the way back used to pierce the holes of the way out (2 on the spike
-    example drawing). Not yet triple stitch: its passes 0.35 mm either side of each hole
-    can still meet a hole of the way out on this spike (1 here, and a warning names it)."""
+    example drawing); triple stitch's base holes keep clear of its passes' holes too."""
     spike = Stroke.from_polyline(np.array([[0.0, 0.0], [8.0, 0.0], [13.0, 1.0], [8.0, 0.0], [8.0, 9.0]]))
     plan = plan_embroidery(Drawing((spike,), 13, 9, "mm"), PlanOptions(style=style_options(style)))
     assert repeated_penetrations(plan) == 0

@@ -45,7 +45,7 @@ def test_nested_use_doubling_is_refused_before_expanding(tmp_path):
     svg = tmp_path / "use21.svg"
     svg.write_text(_nested_use(21))
     started = time.perf_counter()
-    with pytest.raises(InputError, match=r"id='u16'> holds 262,141 elements once its <use> references are expanded"):
+    with pytest.raises(InputError, match=r"id='u8'> adds 1,018 elements once its <use> references are expanded"):
         read_svg(svg)
     assert time.perf_counter() - started < 5.0  # before: still running at 300 s, 2.5 GB
 
@@ -73,13 +73,23 @@ def test_deep_nesting_is_refused_while_parsing(tmp_path):
 
 
 def test_path_data_budget_counts_numbers_through_references(tmp_path):
-    # one path of 5,000 numbers used 400 times: 2,000,000+ numbers once expanded
-    d = "M0 0 " + "L1 1 " * 2_500
-    uses = "".join('<use href="#p"/>' for _ in range(400))
+    # one path of 5,000 numbers used 11 times: 50,000 numbers added, over 10 times the 5,000 written
+    d = "M0 0 " + "L1 1 " * 2_499
+    uses = "".join('<use href="#p"/>' for _ in range(11))
     svg = tmp_path / "many.svg"
-    svg.write_text(SVG_HEAD + f'<defs><path id="p" d="{d}"/></defs>{uses}</svg>')
-    with pytest.raises(InputError, match="numbers of path data once its <use> references are expanded"):
+    svg.write_text(SVG_HEAD + f'<defs><path id="p" d="{d}" stroke="black" fill="none"/></defs>{uses}</svg>')
+    with pytest.raises(InputError, match="adds 55,000 numbers of path data once its <use> references are expanded, "
+                                         "over the limit of 50,000"):
         read_svg(svg)
+    svg.write_text(SVG_HEAD + f'<defs><path id="p" d="{d}" stroke="black" fill="none"/></defs>{uses[:-16]}</svg>')
+    assert len(read_svg(svg).strokes) == 10  # 10 copies: 50,000 numbers added, within the limit
+
+
+def test_a_plain_drawing_is_not_limited_by_the_reference_budget(tmp_path):
+    body = "".join(f'<path d="M {i} 0 L {i} 50" stroke="black"/>' for i in range(3000))
+    svg = tmp_path / "plain.svg"
+    svg.write_text(SVG_HEAD + body + "</svg>")
+    assert len(read_svg(svg).strokes) == 3000
 
 
 def test_a_huge_comment_is_read_in_linear_time(tmp_path):

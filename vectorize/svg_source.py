@@ -5,10 +5,10 @@ own event stream and, before svgelements expands anything, checks what the drawi
 cost once every `<use>` is replaced by what it refers to (svgelements inlines each
 reference while it parses, so 21 nested `<use>` doubling each other become 2**21 paths):
 
-- the expanded document may hold at most `MAX_EXPANDED_ELEMENTS` elements,
-  `MAX_PATH_NUMBERS` numbers of path data and `MAX_SVG_BYTES` of attributes and text (what
-  a plain file may hold), nest at most `MAX_NESTING` deep, and no reference may lead back
-  to itself;
+- <use> references may add at most `GROWTH` (10) times the elements and path-data numbers
+  of the document as written (at least `ADDED_ELEMENTS` and `ADDED_NUMBERS`); expanded, it
+  may hold at most `MAX_SVG_BYTES` of attributes and text (what a plain file may hold) and
+  nest at most `MAX_NESTING` deep; no reference may lead back to itself;
 - comments, processing instructions and elements that draw nothing (`<metadata>`,
   `<title>`, `<desc>`, `<script>`, other tools' elements) are dropped.
 
@@ -37,11 +37,14 @@ SVG_NS = "http://www.w3.org/2000/svg"
 XHTML_NS = "http://www.w3.org/1999/xhtml"
 XLINK_HREF = "{http://www.w3.org/1999/xlink}href"
 MAX_SVG_BYTES = 200_000_000  # a 200 MB SVG is far past any drawing; refuse before parsing
-MAX_EXPANDED_ELEMENTS = 200_000  # elements once every <use> is expanded (a 20,000-path drawing: 20,002)
-# Numbers in path data (`d`, `points`) once expanded: svgelements keeps ~500 B per segment
-# and needs ~20 us to make one, and a segment takes one to six numbers, so this bounds
-# its memory near 1 GB in the worst case (H/V lines) and ~330,000 cubic segments.
-MAX_PATH_NUMBERS = 2_000_000
+# What <use> references may add to the drawing as written: at most GROWTH times its own
+# elements and path-data numbers, and never less than the ADDED_* allowances. svgelements
+# makes each element and segment in Python and the commands work per stroke (embroider:
+# ~9 ms a stroke, 2,000 strokes in 17 s on 2 cores at load 9), so a small file may not
+# become a huge drawing; 21 nested <use> doubling each other add 2 million paths.
+GROWTH = 10
+ADDED_ELEMENTS = 1_000
+ADDED_NUMBERS = 20_000  # a segment takes one to six numbers
 MAX_NESTING = 200  # elements inside elements, references followed (svgelements recurses per level)
 CHUNK = 16 * 1024 * 1024  # bytes per parser feed: see the module's note on expat
 GZIP_MAGIC = b"\x1f\x8b"
@@ -142,13 +145,16 @@ def _own_cost(element: ET.Element) -> tuple[int, int]:
     return size, (_NUMBER.subn("", data)[1] if data else 0)
 
 
-def check_expansion(svg: ET.Element, path: str) -> tuple[int, int, int]:
-    """(elements, bytes, path-data numbers) of `svg` with every <use> expanded, computed
-    without expanding: each element's sums once, reused by every reference to it.
-    `InputError` when a budget (MAX_EXPANDED_ELEMENTS, MAX_SVG_BYTES, MAX_PATH_NUMBERS,
-    MAX_NESTING) is passed or a reference loops."""
+def check_expansion(svg: ET.Element, path: str) -> tuple[int, int]:
+    """(elements, path-data numbers) that `svg`'s <use> references add once expanded,
+    computed without expanding: each element's sums once, reused by every reference to it.
+    `InputError` when a budget (see GROWTH; MAX_SVG_BYTES, MAX_NESTING) is passed or a
+    reference loops."""
+    own = {id(element): _own_cost(element) for element in svg.iter()}
+    limits = (max(ADDED_ELEMENTS, GROWTH * len(own)), max(ADDED_NUMBERS, GROWTH * sum(n for _, n in own.values())))
     ids = {element.get("id"): element for element in svg.iter() if element.get("id") is not None}
     busy = object()  # an element whose sums are being computed: meeting it again is a loop
+    # id(element) -> (elements, bytes, numbers, depth) expanded, and (elements, numbers) as written
     sums: dict[int, object] = {}
     stack: list[tuple[ET.Element, bool]] = [(svg, False)]
     while stack:
@@ -168,24 +174,27 @@ def check_expansion(svg: ET.Element, path: str) -> tuple[int, int, int]:
             if target is not None:
                 stack.append((target, False))
             continue
-        parts = [sums[id(child)] for child in element] + ([sums[id(target)]] if target is not None else [])
-        size, numbers = _own_cost(element)
-        count = 1 + sum(p[0] for p in parts)
-        size += sum(p[1] for p in parts)
-        numbers += sum(p[2] for p in parts)
-        depth = 1 + max((p[3] for p in parts), default=0)
+        children = [sums[id(child)] for child in element]
+        parts = children + ([sums[id(target)]] if target is not None else [])
+        size, numbers = own[key]
+        expanded = (1 + sum(p[0] for p in parts), size + sum(p[1] for p in parts),
+                    numbers + sum(p[2] for p in parts), 1 + max((p[3] for p in parts), default=0))
+        written = (1 + sum(c[4] for c in children), numbers + sum(c[5] for c in children))
         over = [(what, value, limit) for what, value, limit in (
-            ("elements", count, MAX_EXPANDED_ELEMENTS), ("bytes of attributes and text", size, MAX_SVG_BYTES),
-            ("numbers of path data", numbers, MAX_PATH_NUMBERS), ("levels of nesting", depth, MAX_NESTING))
-            if value > limit]
+            ("adds {:,} elements", expanded[0] - written[0], limits[0]),
+            ("adds {:,} numbers of path data", expanded[2] - written[1], limits[1]),
+            ("holds {:,} bytes of attributes and text", expanded[1], MAX_SVG_BYTES),
+            ("nests {:,} levels deep", expanded[3], MAX_NESTING)) if value > limit]
         if over:
             what, value, limit = over[0]
             name = f"<{_local(element.tag)}" + (f" id={element.get('id')!r}>" if element.get("id") else ">")
-            raise InputError(f"SVG {path!r}: {name} holds {value:,} {what} once its <use> references are "
-                             f"expanded, over the limit of {limit:,}; flatten or simplify the drawing")
-        sums[key] = (count, size, numbers, depth)
-    count, size, numbers, _ = sums[id(svg)]
-    return count, size, numbers
+            raise InputError(f"SVG {path!r}: {name} {what.format(value)} once its <use> references are expanded, "
+                             f"over the limit of {limit:,} ({GROWTH} times the drawing as written, at least "
+                             f"{ADDED_ELEMENTS:,} elements and {ADDED_NUMBERS:,} numbers); unlink the clones "
+                             "(flatten) or simplify the drawing")
+        sums[key] = expanded + written
+    root = sums[id(svg)]
+    return root[0] - root[4], root[2] - root[5]
 
 
 def svg_source(path: str, *, progress: ProgressCallback | None = None) -> bytes:

@@ -141,6 +141,12 @@ def drawing_from_json(text: str | bytes, *, name: str = "JSON drawing") -> Drawi
     widths = payload.get("widths") or [None] * len(strokes)
     if len(widths) != len(strokes):
         raise InputError(f"{name}: $.widths: {len(widths)} width profiles for {len(strokes)} strokes")
+    for index, control in enumerate(strokes):  # a stroke is one curve: each piece starts where the last ended
+        control = np.asarray(control, dtype=float)
+        gaps = np.flatnonzero(~np.isclose(control[1:, 0], control[:-1, 3], rtol=1e-9, atol=1e-3).all(axis=1))
+        if len(gaps):
+            raise InputError(f"{name}: $.strokes[{index}][{gaps[0] + 1}] does not start where the piece before it "
+                             "ends; a stroke is one connected curve")
     try:
         return Drawing(
             strokes=tuple(Stroke(np.array(c, dtype=float), None if rgb is None else tuple(rgb),

@@ -8,12 +8,15 @@ import time
 import click
 
 from fabrication.cli.common import console, done, edits_option, step, warn
-from fabrication.cli.options import (Integer, Length, Number, drawing_input_options, input_argument,
+from fabrication.cli.options import (Integer, Length, Number, Percent, drawing_input_options, input_argument,
                                      output_option, placement_options)
 from fabrication.embroidery.arrows import ARROW_SIZE
+from fabrication.embroidery.columns import CORNER_ANGLE, MITRE_LIMIT, OVERLAP
 from fabrication.embroidery.plan import MAX_STITCH, MIN_STITCH, MIN_STROKE, TRIM_DISTANCE
 from fabrication.embroidery.preview import PREVIEW_WIDTH
 from fabrication.embroidery.running import STITCH_LENGTH, TOLERANCE
+from fabrication.embroidery.satin import (MAX_WIDTH, MIN_WIDTH, PULL_PERCENT, RANDOM_WIDTH, SEED, SHORT_DISTANCE,
+                                          SHORT_INSET, SPLIT_LENGTH, UNDERLAY_INSET, UNDERLAY_SPACING, WIDTH_SCALE)
 from fabrication.embroidery.triple import REPEATS
 from fabrication.embroidery.zigzag import PULL_COMPENSATION, SPACING, STITCH_WIDTH
 from machines.hoops import SPM
@@ -41,8 +44,8 @@ def source_date() -> str:
 @click.command()
 @input_argument()
 @output_option(help="Embroidery file to write: .pes, .dst, .jef, .exp or .vp3.")
-@click.option("--style", type=click.Choice(["running", "triple", "zigzag", "arrows"]), default="running",
-              show_default=True, help="Stitch style.")
+@click.option("--style", type=click.Choice(["running", "triple", "zigzag", "satin", "arrows"]), default="running",
+              show_default=True, help="Stitch style (satin: a column as wide as the drawn line).")
 @placement_options(default_size="90mm")
 @click.option("--hoop", default="100x100", show_default=True,
               help="Hoop: 100x100 (4x4), 130x180 (5x7), 150x250, 160x260 (6x10), 200x200, or WxH in mm.")
@@ -54,17 +57,50 @@ def source_date() -> str:
 @click.option("--tolerance", type=Length(TOLERANCE), default=None,
               help=f"Largest chord-to-curve distance, {TOLERANCE.span()} [default: 0.2mm].")
 @click.option("--stitch-width", "--zigzag-width", "stitch_width", type=Length(STITCH_WIDTH), default=None,
-              help=f"Zigzag width rail to rail [2mm] or arrow spread [2.5mm]; {STITCH_WIDTH.span()}.")
+              help=f"Zigzag width rail to rail [2mm], a constant satin width [the drawn width] or arrow spread "
+                   f"[2.5mm]; {STITCH_WIDTH.span()}.")
 @click.option("--spacing", type=Length(SPACING), default=None,
-              help=f"Zigzag peak-to-peak spacing [0.4mm] or arrow spacing [5mm]; {SPACING.span()}.")
+              help=f"Zigzag and satin peak-to-peak spacing [0.4mm] or arrow spacing [5mm]; {SPACING.span()}.")
 @click.option("--pull-comp", type=Length(PULL_COMPENSATION), default=None,
-              help=f"Zigzag pull compensation added to the width, {PULL_COMPENSATION.span()} [default: 0.2mm].")
+              help=f"Pull compensation added to the width (both sides), {PULL_COMPENSATION.span()} "
+                   "[zigzag 0.2mm, satin 0mm].")
+@click.option("--pull-comp-percent", type=Percent(PULL_PERCENT), default=None,
+              help=f"Satin: pull compensation as a share of the width, {PULL_PERCENT.span()} [0%].")
+@click.option("--width-scale", type=Number(WIDTH_SCALE), default=None,
+              help=f"Satin: the drawn width times this, {WIDTH_SCALE.span()} [1].")
+@click.option("--min-width", type=Length(MIN_WIDTH), default=None,
+              help=f"Satin: narrowest column, {MIN_WIDTH.span()} [0.5mm].")
+@click.option("--max-width", type=Length(MAX_WIDTH), default=None,
+              help=f"Satin: widest column, {MAX_WIDTH.span()} [8mm].")
 @click.option("--repeats", type=Integer(REPEATS), default=None,
               help=f"Triple stitch: back-and-forth passes, {REPEATS.span()} [default: 1].")
 @click.option("--arrow-size", type=Length(ARROW_SIZE), default=None,
               help=f"Arrows: arm length along the curve, {ARROW_SIZE.span()} [default: 2mm].")
-@click.option("--underlay", type=click.Choice(["center", "edge", "zigzag", "none"]), default=None,
-              help="Zigzag underlay [default: center when wider than 1.5mm].")
+@click.option("--underlay", default=None,
+              help="Underlay: center, edge, zigzag or none [zigzag: center when wider than 1.5mm]; satin also "
+                   "kinds joined by + (edge+zigzag) and auto [auto: center to 2mm, edge to 4mm, edge+zigzag "
+                   "wider].")
+@click.option("--underlay-inset", type=Length(UNDERLAY_INSET), default=None,
+              help=f"Satin: edge walk inside the rails, {UNDERLAY_INSET.span()} [0.4mm; the zigzag underlay half].")
+@click.option("--underlay-spacing", type=Length(UNDERLAY_SPACING), default=None,
+              help=f"Zigzag and satin: zigzag underlay peak to peak, {UNDERLAY_SPACING.span()} [3mm].")
+@click.option("--short-stitch-distance", type=Length(SHORT_DISTANCE), default=None,
+              help=f"Satin: short stitches where points on a rail come closer, {SHORT_DISTANCE.span()} [0.25mm].")
+@click.option("--short-stitch-inset", type=Percent(SHORT_INSET), default=None,
+              help=f"Satin: how far short stitches end inside the rail, {SHORT_INSET.span()} of the width [15%].")
+@click.option("--split-length", type=Length(SPLIT_LENGTH), default=None,
+              help=f"Satin: wider rows are split into stitches this long at most, {SPLIT_LENGTH.span()} [7mm].")
+@click.option("--random-width", type=Percent(RANDOM_WIDTH), default=None,
+              help=f"Satin: each row's reach varies by up to this, each side, {RANDOM_WIDTH.span()} [0%].")
+@click.option("--random-phase", is_flag=True, help="Satin: split stitches at a random phase (seeded).")
+@click.option("--seed", type=Integer(SEED), default=None, help=f"Satin: seed of the random options, {SEED.span()} [0].")
+@click.option("--corner-angle", type=Number(CORNER_ANGLE), default=None,
+              help=f"Zigzag and satin: corners sharper than this are mitred or split, {CORNER_ANGLE.span()} [45].")
+@click.option("--mitre-limit", type=Number(MITRE_LIMIT), default=None,
+              help=f"Zigzag and satin: a mitre reaching further (half widths) is split instead, "
+                   f"{MITRE_LIMIT.span()} [2].")
+@click.option("--corner-overlap", type=Length(OVERLAP), default=None,
+              help=f"Zigzag and satin: split and mitred columns overlap by this, {OVERLAP.span()} [0.3mm].")
 @click.option("--min-stroke", type=Length(MIN_STROKE), default="1mm", show_default=True,
               help="Shorter strokes join a neighbour within --trim-distance by travel stitches, or are "
                    f"left out with a warning; {MIN_STROKE.span()}.")
@@ -107,7 +143,7 @@ def embroider(source: str, output: str, style: str, size: float | None, width: f
               color: str | None, thread_chart: str | None, design_name: str | None, start: str | None,
               pes_version: int | None, spm: float | None, preview_path: str | None, preview_width: int,
               preview_style: str, preview_hoop: bool, multi: bool, threshold: float | None, blur: float,
-              classifier: str, edits: str | None) -> None:
+              classifier: str, edits: str | None, **column) -> None:
     """Sew SOURCE (PNG/JPG/SVG/JSON drawing) along its curve into an embroidery file."""
     from fabrication.job_options import embroidery_settings
     from fabrication.embroidery.canvas import check_preview_path
@@ -125,7 +161,7 @@ def embroider(source: str, output: str, style: str, size: float | None, width: f
         pull_comp=pull_comp, repeats=repeats, arrow_size=arrow_size, underlay=underlay,
         min_stroke=min_stroke, min_stitch=min_stitch, max_stitch=max_stitch, trim_distance=trim_distance,
         lock_form=lock_form, color=color, thread_chart=thread_chart, start=start, name=design_name,
-        source=source, date=source_date(), pes_version=pes_version, spm=spm)
+        source=source, date=source_date(), pes_version=pes_version, spm=spm, **column)
     if preview_path is not None:
         check_preview_path(preview_path)
         preview_options = PreviewOptions(width=preview_width, style=preview_style,

@@ -46,6 +46,9 @@ def _hex(rgb) -> str:
     return "#{:02x}{:02x}{:02x}".format(*(int(c) for c in rgb))
 
 
+MAX_ASPECT = 8.0  # a preview at most 8 times as tall as it is wide (or as wide as tall)
+
+
 @dataclass
 class Canvas:
     """A `width` x `height` px picture of the mm box `view` = (xmin, ymin, xmax, ymax)."""
@@ -58,10 +61,16 @@ class Canvas:
 
     @classmethod
     def fitting(cls, view: tuple[float, float, float, float], width: int, **kw) -> "Canvas":
-        """A canvas `width` px wide whose height keeps the aspect ratio of `view`."""
-        w = max(view[2] - view[0], 1e-9)
-        h = max(view[3] - view[1], 1e-9)
-        return cls(width=int(width), height=max(1, int(round(width * h / w))), view=view, **kw)
+        """A canvas `width` px wide whose height keeps the aspect ratio of `view`, the short
+        side of a view longer than MAX_ASPECT times its width widened about its centre (a
+        0.01 mm line drawn 1000 px wide would otherwise be a picture 100 million px tall)."""
+        x0, y0, x1, y1 = view
+        w, h = max(x1 - x0, 1e-9), max(y1 - y0, 1e-9)
+        if h > MAX_ASPECT * w:
+            x0, x1, w = (x0 + x1 - h / MAX_ASPECT) / 2, (x0 + x1 + h / MAX_ASPECT) / 2, h / MAX_ASPECT
+        elif w > MAX_ASPECT * h:
+            y0, y1, h = (y0 + y1 - w / MAX_ASPECT) / 2, (y0 + y1 + w / MAX_ASPECT) / 2, w / MAX_ASPECT
+        return cls(width=int(width), height=max(1, int(round(width * h / w))), view=(x0, y0, x1, y1), **kw)
 
     @property
     def scale(self) -> float:

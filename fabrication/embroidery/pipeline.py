@@ -19,6 +19,7 @@ from fabrication.embroidery.plan import FIXED_DATE, PlanOptions, StitchPlan, pla
 from fabrication.embroidery.quality import HOLE_GAP, HOLE_WINDOW, hole_places, repeated_holes, where
 from fabrication.embroidery.stats import EmbroideryStats, embroidery_stats
 from fabrication.embroidery.triple import TripleOptions
+from fabrication.embroidery.satin import SatinOptions
 from fabrication.embroidery.zigzag import ZigzagOptions
 from fabrication.placement import PlacementOptions, place
 from machines.hoops import SPM, Hoop, hoop_named
@@ -73,7 +74,7 @@ def embroider(drawing: Drawing, job: EmbroideryJob = EmbroideryJob(), *, progres
     progress: an `onestroke.progress.ProgressCallback` (strokes stitched)."""
     warnings: list[str] = []
     placed = place(drawing, job.placement)
-    fitted = hoop_design(placed, job.hoop, reach=style_reach(job.plan.style), fit=job.fit)
+    fitted = hoop_design(placed, job.hoop, reach=style_reach(job.plan.style, placed), fit=job.fit)
     hooped = fitted.drawing
     x0, y0, x1, y1 = hooped.bounds()
     if fitted.turned:
@@ -105,7 +106,7 @@ def embroider(drawing: Drawing, job: EmbroideryJob = EmbroideryJob(), *, progres
 
 
 # Styles whose body stitches cross a column (the bobbin shows only in its middle third).
-COLUMN_STYLES: tuple[type, ...] = (ZigzagOptions,)
+COLUMN_STYLES: tuple[type, ...] = (ZigzagOptions, SatinOptions)
 
 
 def density_advice(style) -> str:
@@ -118,6 +119,7 @@ def density_advice(style) -> str:
 
 _DENSITY_ADVICE = {
     ZigzagOptions: "use a wider --spacing, --underlay none or a larger --size",
+    SatinOptions: "use a wider --spacing, --underlay none, a smaller --width-scale or a larger --size",
     ArrowOptions: "use a wider --spacing, a smaller --arrow-size or a larger --size",
     TripleOptions: "use a longer --stitch-length, --style running or a larger --size",
 }

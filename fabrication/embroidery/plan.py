@@ -27,6 +27,7 @@ from fabrication.embroidery.needles import (COLOR, GRID, JUMP, LOCK, LONGEST_STI
                                             TRIM, NeedlePoints)
 from fabrication.embroidery.order import Start, check_start, sewing_order
 from fabrication.embroidery.running import STITCH_LENGTH, RunningOptions, running_stitch
+from fabrication.embroidery.satin import SatinOptions, satin_stitch
 from fabrication.embroidery.thread import RGB, Thread, check_chart
 from fabrication.embroidery.triple import TripleOptions, triple_stitch
 from fabrication.embroidery.zigzag import ZigzagOptions, zigzag_stitch
@@ -36,7 +37,7 @@ from onestroke.ranges import Range, check_ranges, ranged
 from vectorize.drawing import Drawing
 from vectorize.stroke import Stroke
 
-StyleOptions = Union[RunningOptions, TripleOptions, ZigzagOptions, ArrowOptions]
+StyleOptions = Union[RunningOptions, TripleOptions, ZigzagOptions, SatinOptions, ArrowOptions]
 
 # STITCH, JUMP, TRIM, COLOR: the row kinds of a plan (defined in `needles`, used from here).
 # A fixed JEF date (YYYYMMDDhhmmss) so files are the same bytes from run to run; callers
@@ -48,6 +49,7 @@ STYLES: dict[str, type] = {
     "running": RunningOptions,
     "triple": TripleOptions,
     "zigzag": ZigzagOptions,
+    "satin": SatinOptions,
     "arrows": ArrowOptions,
 }
 
@@ -55,6 +57,8 @@ _GENERATORS: dict[type, Callable[[Stroke, object, float], NeedlePoints]] = {
     RunningOptions: lambda stroke, o, offset: running_stitch(stroke, o),
     TripleOptions: lambda stroke, o, offset: triple_stitch(stroke, o),
     ZigzagOptions: lambda stroke, o, offset: zigzag_stitch(stroke, o),
+    # the stroke's place along the design seeds its randomness (same options, same bytes)
+    SatinOptions: lambda stroke, o, offset: satin_stitch(stroke, o, seed=int(round(offset * 1000))),
     ArrowOptions: lambda stroke, o, offset: arrow_stitch(stroke, o, offset=offset),
 }
 
@@ -67,7 +71,7 @@ GRID_STEP = Range(0.0, None, unit="mm", name="grid", low_open=True)
 
 
 def style_class(name: str) -> type:
-    """The options class of the style `name` ('running', 'triple', 'zigzag', 'arrows')."""
+    """The options class of the style `name` ('running', 'triple', 'zigzag', 'satin', 'arrows')."""
     cls = STYLES.get(str(name).lower())
     if cls is None:
         raise InputError(f"unknown stitch style {name!r}; use one of {', '.join(STYLES)}")
@@ -75,20 +79,38 @@ def style_class(name: str) -> type:
 
 
 def style_options(name: str, **values) -> StyleOptions:
-    """Options of the style `name` ('running', 'triple', 'zigzag', 'arrows'); `values` that
+    """Options of the style `name` ('running', 'triple', 'zigzag', 'satin', 'arrows'); `values` that
     are None are left at the style's default."""
     cls = style_class(name)
     fields = cls.__dataclass_fields__
     return cls(**{k: v for k, v in values.items() if v is not None and k in fields})
 
 
-def style_reach(style: StyleOptions) -> float:
-    """How far needle points may stray from the curve, mm (for hoop checks)."""
+def style_reach(style: StyleOptions, drawing: Drawing | None = None) -> float:
+    """How far needle points may stray from the curve, mm (for hoop checks); a satin's
+    reach follows the widest ink of `drawing` (mm)."""
     if isinstance(style, ZigzagOptions):
         return style.reach
+    if isinstance(style, SatinOptions):
+        return style.reach(widest_ink(drawing) if drawing is not None else style.max_width)
     if isinstance(style, ArrowOptions):
         return style.width / 2.0
     return 0.0
+
+
+def widest_ink(drawing: Drawing) -> float:
+    """The widest ink of `drawing` along any stroke (its stroke width where unknown), in its unit."""
+    return max([float(s.widths[:, 1].max()) for s in drawing.strokes if s.widths is not None]
+               + [float(drawing.stroke_width)])
+
+
+def with_known_widths(drawing: Drawing) -> Drawing:
+    """`drawing` whose strokes without an ink width take the drawing's stroke width."""
+    if all(s.widths is not None for s in drawing.strokes):
+        return drawing
+    w = float(drawing.stroke_width)
+    return drawing.with_strokes(s if s.widths is not None else s.with_widths(np.array([[0.0, w], [1.0, w]]))
+                                for s in drawing.strokes)
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -419,6 +441,8 @@ def plan_embroidery(drawing: Drawing, options: PlanOptions = PlanOptions(), *,
         raise InputError(f"place the drawing in mm before stitching (it is in {drawing.unit})")
     if not drawing.strokes:
         raise InputError("the drawing has no strokes to stitch")
+    if isinstance(options.style, SatinOptions):
+        drawing = with_known_widths(drawing)  # a satin is as wide as its stroke's ink
     order = sewing_order(drawing, colors=options.colors, default=options.color,
                          start=options.start, thread_chart=options.thread_chart)
     sewn = order.drawing

@@ -17,6 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from fabrication.embroidery.canvas import Canvas, check_preview_path, gradient
+from fabrication.embroidery.needles import UNDERLAY
 from fabrication.embroidery.plan import JUMP, STITCH, TRIM, StitchPlan
 from fabrication.embroidery.stats import EmbroideryStats
 from machines.hoops import Hoop
@@ -99,18 +100,55 @@ def realistic_canvas(plan: StitchPlan, *, hoop: Hoop | None = None,
     colors = palette[np.clip(plan.blocks[end], 0, len(palette) - 1)]
     # The highlight runs along the lit edge of each stitch (the side facing the light).
     d = b - a
-    n = np.column_stack([-d[:, 1], d[:, 0]]) / np.maximum(np.linalg.norm(d, axis=1), 1e-9)[:, None]
+    length = np.maximum(np.linalg.norm(d, axis=1), 1e-9)
+    n = np.column_stack([-d[:, 1], d[:, 0]]) / length[:, None]
     n *= np.where(n @ _LIGHT >= 0, 1.0, -1.0)[:, None]
     lit = n * (REAL_THREAD_WIDTH * 0.18)
+    column = _column_stitches(d, end)
+    # A column stitch (satin, zigzag: the thread turns back at both ends) goes into the fabric
+    # at its rails, square, and ends half a thread short of them: no round cap, which piles a
+    # blob on every rail, and no corner poking past the edge.
+    trim = np.where(column, np.minimum(0.5 * REAL_THREAD_WIDTH, 0.25 * length), 0.0)[:, None] * d / length[:, None]
+    a, b = a + trim, b - trim
     # Stitches are drawn in sewing order, so later thread lies on top, as on fabric.
-    canvas.segments(a + 0.04, b + 0.06, _shade(colors, 40, 0.55), REAL_THREAD_WIDTH * 1.15,
-                    opacity=0.35, round_caps=True)
-    canvas.segments(a, b, colors.astype(np.uint8), REAL_THREAD_WIDTH, round_caps=True)
-    # Shorten the highlight so the thread's ends stay matte, like a twisted thread.
-    inset = 0.2 * d
-    canvas.segments(a + lit + inset, b + lit - inset, _shade(colors, 255, 0.45),
-                    REAL_THREAD_WIDTH * 0.3, opacity=0.8, min_px=0.6)
+    for part, caps in ((~column, True), (column, False)):
+        if part.any():
+            canvas.segments(a[part] + 0.04, b[part] + 0.06, _shade(colors[part], 40, 0.55),
+                            REAL_THREAD_WIDTH * 1.15, opacity=0.35, round_caps=caps)
+    _threads(canvas, a, b, colors, column)
+    # Shorten the highlight so the thread's ends stay matte, like a twisted thread. Across a
+    # column the highlights line up into the satin's sheen, brightest where the stitches lie
+    # across the light, as a satin ribbon shines. Underlay lies under the top: no highlight.
+    top = plan.roles[end] != UNDERLAY
+    inset = np.where(column[:, None], 0.12, 0.2) * (b - a)
+    across = np.abs(d[:, 0] * _LIGHT[1] - d[:, 1] * _LIGHT[0]) / length
+    strength = np.where(column, 0.25 + 0.45 * across, 0.45)
+    for level in (0.3, 0.5, 0.7):  # three tones: one draw call each
+        part = top & (np.abs(strength - level) <= 0.1 + 1e-9)
+        if part.any():
+            width = np.where(column[part].any(), 0.4, 0.3) * REAL_THREAD_WIDTH
+            canvas.segments(a[part] + lit[part] + inset[part], b[part] + lit[part] - inset[part],
+                            _shade(colors[part], 255, level), width, opacity=0.7, min_px=0.6)
     return canvas
+
+
+def _column_stitches(d: np.ndarray, end: np.ndarray) -> np.ndarray:
+    """(S,) True for stitches (directions `d` (S, 2), ending at rows `end`) whose thread turns
+    back sharply (more than 120 degrees) at both ends: the rows of a satin or zigzag."""
+    unit = d / np.maximum(np.linalg.norm(d, axis=1, keepdims=True), 1e-9)
+    back = np.zeros(len(d) + 1, dtype=bool)  # back[i]: stitch i - 1 turns sharply into stitch i
+    joined = np.zeros(len(d) + 1, dtype=bool)
+    joined[1:-1] = end[1:] - 1 == end[:-1]  # consecutive stitches share a needle point
+    back[1:-1] = joined[1:-1] & (np.einsum("ij,ij->i", unit[1:], unit[:-1]) < -0.5)
+    return back[:-1] & back[1:]
+
+
+def _threads(canvas: Canvas, a, b, colors, column) -> None:
+    """The threads themselves, in sewing order: round ends on walks, square on columns."""
+    breaks = np.flatnonzero(np.diff(column.astype(np.int8))) + 1
+    for lo, hi in zip(np.concatenate([[0], breaks]), np.concatenate([breaks, [len(a)]])):
+        canvas.segments(a[lo:hi], b[lo:hi], colors[lo:hi].astype(np.uint8), REAL_THREAD_WIDTH,
+                        round_caps=not column[lo])
 
 
 def stitch_canvas(plan: StitchPlan, *, hoop: Hoop | None = None, stats: EmbroideryStats | None = None,

@@ -112,31 +112,35 @@ FRESH_HOLE = 0.35
 RECENT_HOLES = 4
 
 
-def _fresh_holes(stroke: Stroke, curve: DenseCurve, s: np.ndarray, fixed: np.ndarray) -> np.ndarray:
-    """Arc lengths `s` (n,) with each needle point that would land within FRESH_HOLE of one
-    of the RECENT_HOLES before it (its own predecessor aside) moved FRESH_HOLE along the
-    curve, forward or back, where that clears them; `fixed` (n,) points (corners, ends) stay."""
+def _fresh_holes(stroke: Stroke, curve: DenseCurve, s: np.ndarray, fixed: np.ndarray,
+                 gap: float = FRESH_HOLE) -> np.ndarray:
+    """Arc lengths `s` (n,) with each needle point that would land within `gap` mm of one
+    of the RECENT_HOLES before it (its own predecessor aside) moved `gap` along the curve,
+    forward or back, where that clears them; `fixed` (n,) points (corners, ends) stay."""
     pts = stroke.points_at(curve.t_at(s))
     near = np.zeros(len(s), dtype=bool)
     for lag in range(2, RECENT_HOLES + 1):
-        near[lag:] |= np.linalg.norm(pts[lag:] - pts[:-lag], axis=1) < FRESH_HOLE
+        near[lag:] |= np.linalg.norm(pts[lag:] - pts[:-lag], axis=1) < gap
     s = s.copy()
     for i in np.flatnonzero(near & ~fixed).tolist():  # few: only retraced places
         recent = pts[max(0, i - RECENT_HOLES):i - 1]
-        for shift in (FRESH_HOLE, -FRESH_HOLE):
+        for shift in (gap, -gap):
             moved = s[i] + shift
             if not s[i - 1] + GRID < moved < s[i + 1] - GRID:
                 continue
             point = stroke.points_at(curve.t_at(np.array([moved])))[0]
-            if np.linalg.norm(recent - point, axis=1).min() >= FRESH_HOLE:
+            if np.linalg.norm(recent - point, axis=1).min() >= gap:
                 s[i], pts[i] = moved, point
                 break
     return s
 
 
 def running_stitch(stroke: Stroke, options: RunningOptions = RunningOptions(), *,
-                   curve: DenseCurve | None = None, breaks: np.ndarray | None = None) -> NeedlePoints:
-    """Running stitch along `stroke` (mm). Returns needle points, start and end included."""
+                   curve: DenseCurve | None = None, breaks: np.ndarray | None = None,
+                   fresh: float = FRESH_HOLE) -> NeedlePoints:
+    """Running stitch along `stroke` (mm). Returns needle points, start and end included.
+    fresh: how far (mm) a needle point keeps from the last few where the line retraces
+    itself (more for the base of a triple stitch, whose passes pierce beside each hole)."""
     curve = curve if curve is not None else dense_curve(stroke, DENSE_TOLERANCE)
     s = stitch_lengths_along(curve, options, breaks=breaks)
     s, t = refine_to_tolerance(stroke, curve, s, options.tolerance - TOLERANCE_RESERVE)
@@ -145,7 +149,7 @@ def running_stitch(stroke: Stroke, options: RunningOptions = RunningOptions(), *
     fixed[[0, -1]] = True
     if breaks is not None and len(breaks):
         fixed |= np.isin(s, breaks)
-    moved = _fresh_holes(stroke, curve, s, fixed)
+    moved = _fresh_holes(stroke, curve, s, fixed, fresh)
     if not np.array_equal(moved, s):
         s, t = refine_to_tolerance(stroke, curve, moved, options.tolerance - TOLERANCE_RESERVE)
     return NeedlePoints.of(stroke.points_at(t), t, BODY)

@@ -18,8 +18,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from fabrication.embroidery.needles import BODY, NeedlePoints
-from fabrication.embroidery.running import (CORNER_ANGLE, DENSE_TOLERANCE, STITCH_LENGTH, TOLERANCE,
-                                            RunningOptions, running_stitch)
+from fabrication.embroidery.running import (CORNER_ANGLE, DENSE_TOLERANCE, FRESH_HOLE, STITCH_LENGTH,
+                                            TOLERANCE, RunningOptions, running_stitch)
 from fabrication.embroidery.sampling import dense_curve
 from onestroke.ranges import Range, check_ranges, ranged
 from vectorize.stroke import Stroke
@@ -80,7 +80,10 @@ def bean_lengths(base: np.ndarray, repeats: int, shift: float) -> np.ndarray:
 def triple_stitch(stroke: Stroke, options: TripleOptions = TripleOptions()) -> NeedlePoints:
     """Bean stitch along `stroke` (mm): forward, back, forward over every running stitch."""
     curve = dense_curve(stroke, DENSE_TOLERANCE)
-    base = running_stitch(stroke, options.running, curve=curve)
+    # Where the line retraces itself, base holes keep clear of the passes' holes beside the
+    # holes of the way out (each pass pierces up to repeats x shift from its base hole).
+    base = running_stitch(stroke, options.running, curve=curve,
+                          fresh=FRESH_HOLE + options.repeats * options.shift)
     s_base = np.interp(base.t, curve.t, curve.s)
     s = bean_lengths(s_base, options.repeats, options.shift)
     t = curve.t_at(s)

@@ -25,6 +25,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from fabrication.embroidery.column_stitches import split_long
 from fabrication.embroidery.needles import BODY, GRID, SNAP_ALLOWANCE, UNDERLAY, NeedlePoints
 from fabrication.embroidery.running import (DENSE_TOLERANCE, STITCH_LENGTH, TOLERANCE, RunningOptions,
                                             running_stitch)
@@ -134,28 +135,6 @@ def _drop_crowded(points: np.ndarray, min_gap: float, inner: np.ndarray, *, wind
     return keep
 
 
-def _split_long(points: np.ndarray, t: np.ndarray, max_length: float) -> tuple[np.ndarray, np.ndarray]:
-    """Split stitches longer than `max_length` into real stitches at staggered fractions so
-    that the split points of neighbouring zigs do not line up into a ridge."""
-    seg = np.diff(points, axis=0)
-    length = np.linalg.norm(seg, axis=1)
-    # Staggers up to 1/3 of a piece make the longest piece (1 + 1/3) / n of the stitch.
-    n = np.maximum(1, np.ceil(length * (4.0 / 3.0) / max_length)).astype(int)
-    n[length <= max_length] = 1
-    if n.max() == 1:
-        return points, t
-    stagger = np.array([0.0, 1.0 / 3.0, -1.0 / 3.0])[np.arange(len(n)) % 3]
-    extra = n - 1
-    owner = np.repeat(np.arange(len(n)), extra)
-    k = np.arange(extra.sum()) - np.repeat(np.cumsum(extra) - extra, extra) + 1
-    frac = (k - stagger[owner]) / n[owner]
-    new_pts = points[owner] + seg[owner] * frac[:, None]
-    new_t = t[owner] + (t[owner + 1] - t[owner]) * frac
-    # Insert after the start of each owning stitch, keeping the order along each stitch.
-    order = np.argsort(np.concatenate([np.arange(len(points)) * 1.0, owner + frac * 0.999]), kind="stable")
-    return np.concatenate([points, new_pts])[order], np.concatenate([t, new_t])[order]
-
-
 def zigzag_stitch(stroke: Stroke, options: ZigzagOptions = ZigzagOptions()) -> NeedlePoints:
     """Zigzag along `stroke` (mm), preceded by a there-and-back centre walk when wide."""
     curve = dense_curve(stroke, DENSE_TOLERANCE)
@@ -190,7 +169,7 @@ def zigzag_stitch(stroke: Stroke, options: ZigzagOptions = ZigzagOptions()) -> N
     # Inner points of a real curve (radius under 50 mm) may be dropped when crowded.
     keep = _drop_crowded(points, options.min_gap, inner & (np.abs(kappa) > 0.02))
     points, t = points[keep], t[keep]
-    points, t = _split_long(points, t, options.max_stitch - 2 * SNAP_ALLOWANCE)
+    points, t = split_long(points, t, options.max_stitch - 2 * SNAP_ALLOWANCE)
     zig = NeedlePoints.of(points, t, BODY)
     # An underlay goes there and back and ends on the start; along a stroke no longer than
     # one underlay stitch it would re-enter its first hole two stitches later (a knot on a

@@ -1,0 +1,182 @@
+"""The satin style: a column as wide as the drawn line (the stroke's ink widths, scaled with
+the design), its controls (width scale and limits, pull compensation, underlays, short
+stitches, split stitches, random width and phase), its corners (mitred or split, cut back
+under the column sewn on top), and the files it writes."""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+if str(ROOT) not in sys.path:
+    sys.path.insert(0, str(ROOT))
+
+from benchmarks.column_metrics import sewn_widths, slits  # noqa: E402
+from embroidery_fixtures import FORMATS, spiral  # noqa: E402
+from fabrication.embroidery.export import write_embroidery  # noqa: E402
+from fabrication.embroidery.needles import BODY, UNDERLAY  # noqa: E402
+from fabrication.embroidery.plan import STITCH, PlanOptions, plan_embroidery, style_options  # noqa: E402
+from fabrication.embroidery.quality import needle_density, repeated_holes  # noqa: E402
+from fabrication.embroidery.satin import SatinOptions, satin_stitch  # noqa: E402
+from fabrication.embroidery.stats import embroidery_stats  # noqa: E402
+from onestroke.errors import InputError  # noqa: E402
+from vectorize.drawing import Drawing  # noqa: E402
+from vectorize.stroke import Stroke  # noqa: E402
+
+
+def line(widths=None, length=30.0) -> Stroke:
+    return Stroke(Stroke.from_polyline(np.array([[0.0, 0.0], [length, 0.0]])).control, None, widths)
+
+
+def plan_of(stroke: Stroke, options: SatinOptions = SatinOptions(), width: float = 2.0):
+    return plan_embroidery(Drawing((stroke,), 40, 40, "mm", width), PlanOptions(style=options))
+
+
+def widths_along(plan) -> tuple[np.ndarray, np.ndarray]:
+    s, _, width = sewn_widths(plan, 0)
+    return s, width
+
+
+def test_the_column_follows_the_drawn_width():
+    profile = np.array([[0.0, 1.0], [0.5, 4.0], [1.0, 2.0]])  # mm
+    plan = plan_of(line(profile))
+    s, width = widths_along(plan)
+    drawn = np.interp(s / 30.0, profile[:, 0], profile[:, 1])
+    inside = (s > 1.0) & (s < 29.0)
+    error = np.abs(width[inside] - drawn[inside])
+    assert np.mean(error <= np.maximum(0.1 * drawn[inside], 0.2)) >= 0.95
+
+
+@pytest.mark.parametrize("options, expected", [
+    (SatinOptions(width=3.0), 3.0),  # a constant width overrides the drawing's
+    (SatinOptions(width_scale=1.5), 3.0),
+    (SatinOptions(max_width=1.5), 1.5),
+    (SatinOptions(min_width=2.5), 2.5),
+    (SatinOptions(pull_compensation=0.4), 2.4),
+    (SatinOptions(pull_compensation_percent=0.1, pull_compensation=0.2), 2.4),
+])
+def test_width_options(options, expected):
+    plan = plan_of(line(np.array([[0.0, 2.0], [1.0, 2.0]])), options)
+    s, width = widths_along(plan)
+    middle = (s > 3.0) & (s < 27.0)
+    assert np.median(width[middle]) == pytest.approx(expected, abs=0.12)
+
+
+def test_a_stroke_without_widths_takes_the_drawings():
+    plan = plan_of(line(), width=1.6)
+    s, width = widths_along(plan)
+    assert np.median(width[(s > 3) & (s < 27)]) == pytest.approx(1.6, abs=0.12)
+
+
+@pytest.mark.parametrize("width, kinds", [(1.5, ("center",)), (3.0, ("edge",)), (5.0, ("edge", "zigzag"))])
+def test_auto_underlay_by_width_and_each_underlay_there_and_back(width, kinds):
+    options = SatinOptions(width=width)
+    assert options.underlays_for(width) == kinds
+    needles = satin_stitch(line(), options)
+    under = needles.points[needles.roles == UNDERLAY]
+    assert len(under) > 4 and np.allclose(under[0], under[-1])  # back where the top starts
+    assert (needles.roles[:len(under)] == UNDERLAY).all()
+    assert np.abs(under[:, 1]).max() <= width / 2  # under the top stitches
+
+
+def test_named_underlays_and_none():
+    assert SatinOptions(underlay="edge+zigzag").underlay == ("edge", "zigzag")
+    assert SatinOptions(underlay="none").underlay == ()
+    assert not (satin_stitch(line(), SatinOptions(underlay="none")).roles == UNDERLAY).any()
+    for bad in ("edge+foo", "edge+edge", "sideways"):
+        with pytest.raises(InputError, match="underlay"):
+            SatinOptions(underlay=bad)
+
+
+def test_wide_rows_are_split_and_short_stitches_inset_inside_a_bend():
+    needles = satin_stitch(line(), SatinOptions(width=10.0, underlay="none", max_stitch_length=4.0))
+    steps = np.linalg.norm(np.diff(needles.points, axis=0), axis=1)
+    assert steps.max() <= 4.0
+    # a tight bend: points of the inside rail come closer than 0.25 mm, every other one is inset
+    arc = spiral(0, 0, 4.0, 4.0, 0.5, n=8)
+    body = satin_stitch(arc, SatinOptions(width=3.0, underlay="none"))
+    radius = np.linalg.norm(body.points, axis=1)
+    inner = radius[radius < 4.0]
+    assert inner.min() > 4.0 - 1.5 - 0.01 and np.unique(np.round(inner, 1)).size > 1  # rail and inset
+
+
+def test_random_width_and_phase_are_seeded():
+    options = SatinOptions(width=8.0, random_width=0.2, random_phase=True, max_stitch_length=3.0, seed=4)
+    a, b = satin_stitch(line(), options), satin_stitch(line(), options)
+    assert np.array_equal(a.points, b.points)
+    other = satin_stitch(line(), SatinOptions(width=8.0, random_width=0.2, random_phase=True,
+                                              max_stitch_length=3.0, seed=5))
+    assert not np.array_equal(a.points, other.points)
+    plain = satin_stitch(line(), SatinOptions(width=8.0, max_stitch_length=3.0))
+    top = a.points[a.roles == BODY]
+    assert np.abs(top[:, 1]).max() > np.abs(plain.points[plain.roles == BODY][:, 1]).max()
+
+
+def corner(angle: float, leg: float = 12.0) -> Stroke:
+    """Two straight legs meeting at `angle` degrees between them (180: straight on)."""
+    turn = np.radians(180.0 - angle)
+    return Stroke.from_polyline(np.array([[-leg, 0.0], [0.0, 0.0], [leg * np.cos(turn), leg * np.sin(turn)]]))
+
+
+@pytest.mark.parametrize("style", ["satin", "zigzag"])
+@pytest.mark.parametrize("angle", [30, 45, 60, 90, 120, 150, 170])
+def test_corners_are_never_piled_up_slit_or_pierced_twice(style, angle):
+    plan = plan_embroidery(Drawing((corner(angle),), 30, 30, "mm", 2.0),
+                           PlanOptions(style=style_options(style, width=2.0)))
+    density = needle_density(plan.points[plan.kinds == STITCH])
+    stats = embroidery_stats(plan)
+    # at most 6 within 0.5 mm, or the stats name the place
+    assert density.maximum <= 6 or any(f"{p.x:.1f}, {p.y:.1f}" in " ".join(stats.warnings) for p in density.places)
+    assert len(repeated_holes(plan)) == 0
+    if style == "satin":
+        half = SatinOptions(width=2.0).sewn_width(np.array([2.0]))[0] / 2
+        assert slits(plan, 0, lambda s: np.full(len(s), half), 0.4, corners=np.zeros((1, 2))) == []
+
+
+def test_a_retraced_spike_is_sewn_once():
+    out_and_back = Stroke.from_polyline(np.array([[0.0, 0.0], [10.0, 0.0], [0.0, 0.0], [0.0, 10.0]]))
+    plan = plan_of(out_and_back, SatinOptions(width=2.0, underlay="none"))
+    top = plan.points[(plan.kinds == STITCH) & (plan.roles == BODY)]
+    on_spike = top[(top[:, 0] > 2.0)]
+    # one column's rows (every 0.2 mm over 8 mm): not two layers
+    assert len(on_spike) < 60
+
+
+def test_five_formats_same_bytes_every_run(tmp_path):
+    drawing = Drawing((Stroke(spiral(0, 0, 3.0, 12.0, 1.5).control, None,
+                              np.array([[0.0, 1.0], [0.5, 3.0], [1.0, 1.5]])),), 30, 30, "mm", 2.0)
+    for ext in FORMATS:
+        a, b = tmp_path / f"a.{ext}", tmp_path / f"b.{ext}"
+        write_embroidery(plan_embroidery(drawing, PlanOptions(style=SatinOptions(random_width=0.1))), a)
+        write_embroidery(plan_embroidery(drawing, PlanOptions(style=SatinOptions(random_width=0.1))), b)
+        assert a.read_bytes() == b.read_bytes()
+
+
+def test_the_command_line_sews_a_brush_drawing_as_wide_as_it_is_drawn(tmp_path):
+    from click.testing import CliRunner
+    from PIL import Image
+
+    from benchmarks.render import render_profile, to_uint8
+    from fabrication.cli import main
+    from fabrication.embroidery.read import read_embroidery
+
+    # a line 900 px long whose ink swells from 12 to 36 px and back, at 90 mm: 1.2-3.6 mm
+    drawn = Drawing((line(length=900.0).transformed(np.array([[1.0, 0, 50.0], [0, 1.0, 500.0]])),), 1000, 1000,
+                    "px", 36.0)
+    profile = (np.array([0.0, 0.5, 1.0]), np.array([12.0, 36.0, 12.0]))
+    Image.fromarray(to_uint8(render_profile(drawn, profile))).save(tmp_path / "brush.png")
+    result = CliRunner().invoke(main, ["embroider", str(tmp_path / "brush.png"), "-o", str(tmp_path / "b.pes"),
+                                       "--style", "satin", "--underlay", "edge+zigzag", "--random-width", "5%",
+                                       "--seed", "2", "--hoop", "130x180"])
+    assert result.exit_code == 0, result.output
+    back = read_embroidery(tmp_path / "b.pes").plan
+    needles = back.points[back.kinds == STITCH]
+    across = np.ptp(needles[:, 1][np.abs(needles[:, 0]) < 3.0])  # the middle, mm
+    assert across == pytest.approx(3.6, rel=0.15)  # +-5 % random width on top of the drawn 3.6 mm
+    result = CliRunner().invoke(main, ["embroider", str(tmp_path / "brush.png"), "-o", str(tmp_path / "c.pes"),
+                                       "--style", "satin", "--min-width", "3mm", "--max-width", "2mm"])
+    assert result.exit_code == 2 and "--min-width" in result.output
