@@ -301,6 +301,7 @@ GOOD_SVG = ('<svg xmlns="http://www.w3.org/2000/svg" width="200" height="150"><p
 OUTPUT = {"vectorize": "out.svg", "preview": "out.png", "preview-html": "out.html", "embroider": "out.pes",
           "laser": "out.gcode"}
 MEMORY_BOUND_MB = 1024.0
+CHURN_MB = 64.0  # see Outcome.over_memory
 
 
 class Hang(BaseException):
@@ -322,8 +323,12 @@ class Outcome:
     @property
     def over_memory(self) -> bool:
         """The case set a new peak above MEMORY_BOUND_MB (a peak is a high-water mark: in a
-        fresh process, as benchmarks/fuzz.py runs, no case went over when this is False)."""
-        return self.peak_mb > max(MEMORY_BOUND_MB, self.peak_before_mb)
+        fresh process, as benchmarks/fuzz.py runs, no case went over when this is False).
+        A process already past the bound before the case cannot show what the case used (in
+        the whole suite, torch's training test leaves pytest at ~1.44 GB resident, within
+        20 MB of its high-water mark): there only a rise of more than CHURN_MB counts."""
+        churn = CHURN_MB if self.peak_before_mb > MEMORY_BOUND_MB else 0.0
+        return self.peak_mb > max(MEMORY_BOUND_MB, self.peak_before_mb + churn)
 
 
 def _good_png() -> bytes:
