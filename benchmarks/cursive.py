@@ -6,7 +6,7 @@ lifts writes them), from the handwriting set's letters plus a and m, with what r
 adds at the joins and in the loops:
 
 - **overshoot hooks**: where the connecting stroke arrives at a letter's entry cusp (the
-  tops of i, u, y, p, t, l, k), the pen runs on past it, bent 15-45 degrees, and comes back:
+  tops of i, u, y and p), the pen runs on past it, bent 15-45 degrees, and comes back:
   a free stub beside the junction (`HOOK_CHANCE` per cusp);
 - **entry stubs** of m and n: a short tick up and to the left from the entry cusp, drawn
   out and back (`STUB_CHANCE`);
@@ -76,6 +76,7 @@ LINES = (
 )
 SPACE = 0.45  # extra x-height units between words (the connecting stroke runs through it)
 HOOK_CHANCE = 0.4  # an overshoot hook at a letter's entry cusp
+HOOKED = "iuyp"  # letters entered at a cusp at the x-height (t, l, k, d start their stem at the entry)
 STUB_CHANCE = 0.7  # an entry stub at m and n
 DRIFT = (0.3, 1.0)  # widths the way back up or down a stem drifts from the way out, in the middle
 DRIFT_MIN_LENGTH = 0.8  # x-heights: stems from this long (ascenders, descenders) drift
@@ -106,7 +107,7 @@ def line_runs(text: str, rng: np.random.Generator) -> list[np.ndarray]:
                 tip = None
                 if ch in "mn" and rng.random() < STUB_CHANCE:
                     tip = cusp + rng.uniform(0.15, 0.3) * _turned(np.array([-0.35, 1.0]) / 1.06, rng.uniform(-15, 15))
-                elif rng.random() < HOOK_CHANCE:
+                elif ch in HOOKED and rng.random() < HOOK_CHANCE:
                     bend = rng.choice([-1.0, 1.0]) * rng.uniform(15.0, 45.0)
                     tip = cusp + rng.uniform(0.15, 0.35) * _turned(arrival, bend)
                 if tip is not None:

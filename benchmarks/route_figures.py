@@ -40,7 +40,7 @@ def ground_truth_route(gt) -> tuple[int, float]:
 def route_row(gt, output, report) -> dict:
     """The per-drawing columns (module doc)."""
     odd_gt, route_min = ground_truth_route(gt)
-    return {"odd_nodes_gt": odd_gt, "odd_nodes": report.odd_nodes if report is not None else float("nan"),
+    return {"odd_nodes_gt": odd_gt, "odd_nodes": getattr(report, "odd_nodes", float("nan")),
             "route_min": route_min, "route_ratio": output.length / route_min,
             "drawn_ratio": output.length / gt.drawing.length}
 

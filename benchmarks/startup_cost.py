@@ -1,8 +1,16 @@
 #!/usr/bin/env python
-"""What a whole `onestroke vectorize IN.png -o OUT.svg` process spends, part by part.
+"""What a whole `onestroke vectorize IN.png -o OUT.svg` process spends, part by part, and
+how it compares with a bare process that imports the same libraries.
 
     python benchmarks/startup_cost.py              # the 9 drawings of `vectorize_bench.py --whole-process 9`
     python benchmarks/startup_cost.py --count 5 --repeat 3
+    python benchmarks/startup_cost.py --pairs 15   # the command against the bare import floor, side by side
+
+`--pairs N` (`startup_ratio.py`): N drawings (as `--whole-process N` picks them), each run
+as the command and as a bare process importing exactly the third-party modules that
+command loaded (found by an unmeasured run of the command in a process that lists them),
+one right after the other (which one first alternates); the ratio command / bare per pair,
+and its median (wall and CPU).
 
 For each drawing (rendered to a PNG, as `vectorize_bench.py --whole-process` does) this
 runs two kinds of fresh process, alternately:
@@ -138,19 +146,26 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--repeat", type=int, default=1, help="runs of each kind per drawing")
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--timeout", type=float, default=120.0)
+    ap.add_argument("--pairs", type=int, default=None, metavar="N",
+                    help="instead: N pairs of the command and a bare process importing the same libraries")
     ap.add_argument("--pycache", type=Path, default=None, metavar="DIR",
                     help="let the children write and read compiled modules in DIR (PYTHONPYCACHEPREFIX), "
                          "as an installed package has them; one unmeasured run first fills it")
     args = ap.parse_args(argv)
 
     tasks = [gt for name in SETS for gt in build_set(name, DEFAULT_COUNTS[name], args.seed)]
-    picks = tasks[:: max(1, len(tasks) // args.count)][: args.count]
+    count = args.pairs or args.count
+    picks = tasks[:: max(1, len(tasks) // count)][:count]
     env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(root), os.environ.get("PYTHONPATH", "")]).rstrip(os.pathsep)}
     if args.pycache is not None:
         env.pop("PYTHONDONTWRITEBYTECODE", None)
         env["PYTHONPYCACHEPREFIX"] = str(args.pycache.resolve())
     exe = shutil.which("onestroke")
     command = [exe] if exe else [sys.executable, "-m", "fabrication.cli"]
+    if args.pairs:
+        from benchmarks.startup_ratio import ratio_pairs
+
+        return ratio_pairs(picks, command, env, args.timeout)
 
     whole_wall, whole_cpu, parts = [], [], {}
     with tempfile.TemporaryDirectory(prefix="onestroke-startup-") as tmp:

@@ -20,6 +20,7 @@ from fabrication.embroidery.pipeline import EmbroideryJob
 from fabrication.embroidery.plan import PlanOptions
 from fabrication.embroidery.preview import PreviewOptions
 from fabrication.embroidery.running import RunningOptions
+from fabrication.embroidery.satin import SatinOptions
 from fabrication.embroidery.triple import TripleOptions
 from fabrication.embroidery.zigzag import ZigzagOptions
 from fabrication.job_options import embroidery_settings, laser_settings
@@ -34,7 +35,7 @@ from vectorize.options import VectorizeOptions
 
 ROOT = Path(__file__).resolve().parents[1]
 OPTION_TYPES = [VectorizeOptions, Edits, PlacementOptions, RunningOptions, TripleOptions, ZigzagOptions,
-                ArrowOptions, LockOptions, PlanOptions, EmbroideryJob, PreviewOptions, ToolpathOptions,
+                SatinOptions, ArrowOptions, LockOptions, PlanOptions, EmbroideryJob, PreviewOptions, ToolpathOptions,
                 GcodeOptions, EmulatorOptions]
 
 

@@ -289,3 +289,27 @@ def test_abort_while_connecting(client):
         time.sleep(0.05)
         status = client.get("/api/send").json()
     assert status["state"] == "aborted" and status["acked"] < status["total"], status
+
+
+def test_the_threshold_mask_is_the_binarization(client, drawing):
+    """GET /api/mask: the working pixels darker than the threshold (the library's own
+    binarization of the image at that blur), refused in the CLI's words out of range."""
+    from io import BytesIO
+
+    import numpy as np
+    from PIL import Image
+
+    from vectorize.binarize import ink_threshold, paper_gray
+    from vectorize.image_io import load_image
+
+    image, _ = load_image(str(drawing), max_size=1000)
+    for query, threshold, blur in (("threshold=auto&blur=0", None, 0.0), ("threshold=0.6&blur=1.5", 0.6, 1.5)):
+        answer = client.get(f"/api/mask?{query}")
+        assert answer.status_code == 200 and answer.headers["content-type"] == "image/png"
+        mask = np.asarray(Image.open(BytesIO(answer.content)))[..., 1] > 0
+        gray, _ = paper_gray(image, max_size=1000, blur=blur)
+        assert np.array_equal(mask, gray < ink_threshold(gray, threshold)) and mask.any()
+    refused = client.get("/api/mask?threshold=auto&blur=30")
+    assert refused.status_code == 400 and refused.json()["error"] == "--blur 30 must be from 0 px to 25 px"
+    assert client.get("/api/mask?threshold=1").json()["error"] == "--threshold 1 must be above 0 to below 1"
+    assert client.get("/api/mask?threshold=x").status_code == 400

@@ -51,7 +51,7 @@ def test_click_a_junction_through_its_pairings_undo_redo_and_play(page):
         click_at(page, start["at"])
         settle(page, count + 1)  # the click set the busy state at once: this waits for its answer
         junction = junction_near(page, start["at"])
-        assert junction["fixed"] and "fixed by you" in page.inner_text("#junctions")
+        assert junction["fixed"] and "(yours; CNN: crossing 100%)" in page.inner_text("#junctions")
         seen.append(junction["decision"])
         orders.append(order(page))
         if click == 0:

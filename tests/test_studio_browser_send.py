@@ -32,12 +32,18 @@ def test_send_pause_resume_abort_on_the_emulator(page):
     # The emulator at twice a real machine's speed (default sim:// runs ten times faster):
     # slow enough to pause a 12 s job by hand.
     page.fill("#port", "sim://?speed=2")
+    # Every status the page shows while streaming, to check it never says the machine idles.
+    page.evaluate("""window.sendTexts = []; new MutationObserver(() => window.sendTexts.push(
+        document.getElementById('send-status').textContent)).observe(document.getElementById('send-status'),
+        {childList: true, characterData: true, subtree: true})""")
     page.click("#send")
     page.wait_for_function(f"{STATUS}.dataset.state === 'streaming' && {ACKED} > 0")
     first = page.evaluate(ACKED)
     page.wait_for_function(f"{ACKED} > {first} + 5")  # progress advances while it streams
     total = page.evaluate("document.getElementById('send-progress').max")
     assert first < page.evaluate(ACKED) < total and total > 100
+    # The estimate's line count is the lines Send streams.
+    assert f"· {total} lines ·" in page.inner_text("#laser-time"), (total, page.inner_text("#laser-time"))
     assert not page.is_enabled("#send") and page.is_enabled("#pause") and not page.is_enabled("#resume")
     # The laser preview's head follows the job: the player shows the line acknowledged last.
     shown = player_line(page)
@@ -56,6 +62,9 @@ def test_send_pause_resume_abort_on_the_emulator(page):
 
     page.click("#resume")
     page.wait_for_function(f"{STATUS}.dataset.state === 'streaming' && {ACKED} > {held}")
+    streaming = [t for t in page.evaluate("window.sendTexts") if t.startswith("streaming")]
+    machine = {t.split("machine ")[1].split(" ")[0] for t in streaming if "machine " in t}
+    assert "Run" in machine and machine <= {"Run", "Hold:0", "Hold:1"}, streaming  # never the connect's Idle
     page.click("#abort")
     page.wait_for_function(f"{STATUS}.dataset.state === 'aborted'")
     text = page.inner_text("#send-status")

@@ -158,7 +158,7 @@ ENDPOINTS = [("GET", "/api/state"), ("POST", "/api/state"), ("POST", "/api/embro
              ("POST", "/api/export/exe"), ("GET", "/api/edits"), ("POST", "/api/edits"), ("GET", "/api/send"),
              ("POST", "/api/send"), ("POST", "/api/send/pause"), ("POST", "/api/send/resume"),
              ("POST", "/api/send/abort"), ("POST", "/api/send/explode"), ("GET", "/api/ports"),
-             ("GET", "/api/profiles"), ("POST", "/api/profiles"), ("GET", "/api/image")]
+             ("GET", "/api/profiles"), ("POST", "/api/profiles"), ("GET", "/api/image"), ("GET", "/api/mask")]
 
 huge = st.sampled_from([1e308, -1e308, 1e12, 1e9, -1e9, 2**63, -(2**63), 10**30, 0, -0.0, 1e-300, math.nan,
                         math.inf, -math.inf])

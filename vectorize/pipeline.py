@@ -34,15 +34,34 @@ def vectorize_file(path: str | os.PathLike, options: VectorizeOptions = Vectoriz
     suffix = os.path.splitext(path)[1].lower()
     if suffix in (".svg", ".svgz"):
         return _vectorize_svg(path, options, edits, cache, progress)
-    if cache is not None and cache.loaded is not None and cache.loaded[0] == (path, options.max_size):
-        image, frame = cache.loaded[1]
-    else:
-        from vectorize.image_io import load_image
-
-        image, frame = load_image(path, max_size=options.max_size)
-        if cache is not None:
-            cache.loaded = ((path, options.max_size), (image, frame))
+    image, frame = _raster(path, options, cache)
     return vectorize_image(image, options, frame=frame, edits=edits, cache=cache)
+
+
+def _raster(path: str, options: VectorizeOptions, cache=None):
+    """(image, frame) of a raster file, read once per cache."""
+    if cache is not None and cache.loaded is not None and cache.loaded[0] == (path, options.max_size):
+        return cache.loaded[1]
+    from vectorize.image_io import load_image
+
+    image, frame = load_image(path, max_size=options.max_size)
+    if cache is not None:
+        cache.loaded = ((path, options.max_size), (image, frame))
+    return image, frame
+
+
+def threshold_mask_file(path: str | os.PathLike, options: VectorizeOptions = VectorizeOptions(), *,
+                        cache=None) -> tuple[np.ndarray, float]:
+    """`vectorizer.threshold_mask` of a raster file: (H, W) bool working px (the whole
+    image, downscaled to `options.max_size`) and the threshold level. An SVG has no
+    threshold: `InputError`."""
+    from vectorize.vectorizer import threshold_mask
+
+    path = str(path)
+    if os.path.splitext(path)[1].lower() in (".svg", ".svgz"):
+        raise InputError("an SVG drawing has no threshold: its strokes are read, not binarized")
+    image, _ = _raster(path, options, cache)
+    return threshold_mask(image, options, cache)
 
 
 def _vectorize_svg(path: str, options: VectorizeOptions, edits=None, cache=None,

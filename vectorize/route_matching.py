@@ -39,6 +39,12 @@ def match_odd(cost: np.ndarray, end_cost: np.ndarray) -> tuple[list[tuple[int, i
     m = len(cost)
     if m == 0:
         return [], []
+    if m == 2:
+        # The problem's perfect matchings are the pair (and the end vertices together) or the
+        # two ends: compared directly, ends first at a tie (networkx's import costs more
+        # than most drawings' whole route).
+        pair, ends = np.rint(cost[0, 1] * SCALE), np.rint((end_cost[0] + end_cost[1]) * SCALE)
+        return ([(0, 1)], []) if pair < ends else ([], [0, 1])
     n = m + 2
     first, second = np.triu_indices(m, 1)
     linked = np.isfinite(cost[first, second])

@@ -9,10 +9,9 @@ from typing import TYPE_CHECKING, NamedTuple
 import numpy as np
 
 from onestroke.errors import InputError
-from vectorize.binarize import downscaled_gray, ink_image, paper_gray
+from vectorize.binarize import downscaled_gray, ink_image, ink_threshold, paper_gray
 from vectorize.drawing import Drawing
 from vectorize.edits import Edits
-from vectorize.fitting import TracedPoints, fit_stroke
 from vectorize.gaps import bridge_gaps, keep_largest_piece
 from vectorize.graph import MedialGraph, lengths
 from vectorize.ink_guard import InkGuard, guard_margin
@@ -24,6 +23,7 @@ from vectorize.intersections import Junction, JunctionVerdict, ranked_pairings
 from vectorize.medial_axis import medial_axis
 from vectorize.outline import outline_rings
 from vectorize.options import InputFrame, VectorizeOptions, VectorizeReport, VectorizeResult
+from vectorize.preload import preload, wait
 from vectorize.pruning import prune, trim_free_ends
 from vectorize.retraces import Twin, foot_is_retraced, twin_spans
 from vectorize.route_inspection import connect_pairings, plan_routes
@@ -32,6 +32,7 @@ from vectorize.stroke import Stroke
 from vectorize.traversal import Ordering, order_strokes
 
 if TYPE_CHECKING:  # the studio's refinement is imported where edits or a session ask for it
+    from vectorize.fitting import TracedPoints
     from vectorize.refine import Refinement, StageCache
 
 # Vanishing-angle thresholds (notes: 0.95 single-line, 0.90 multi-line).
@@ -141,6 +142,9 @@ def _trace(graph: MedialGraph, simple: Simplified, ordering: Ordering, junctions
            verdicts: dict, stroke_width: float) -> list[tuple[TracedPoints, bool, list[Twin]]]:
     """Turn branch passes into point lists flagged for filtering (paper 3.4), with the
     stretches each stroke draws twice (`vectorize.retraces`)."""
+    wait("fitting")
+    from vectorize.fitting import TracedPoints
+
     # V-spikes: the foot is where both sides' inks merge, its points are uncertain; the
     # sides run straight to the tip. Retraced (T) spikes: the foot is the spike itself,
     # its points are good, and the line turns sharply at both of its ends.
@@ -251,6 +255,7 @@ def _order(graph: MedialGraph, ink, options: VectorizeOptions, ends: int, clock:
         clock.lap("simplification")
         junction_list = _junctions(graph, simple.crossings, w)
         junctions = dict(zip(simple.crossings, junction_list))
+        wait("cnn")
         verdict_list = make_classifier(options.classifier).classify(ink.gray, junction_list, w) if junction_list else []
         if options.classifier == "cnn" and junction_list:
             geometry = make_classifier("geometric").classify(ink.gray, junction_list, w)
@@ -278,6 +283,10 @@ def _order(graph: MedialGraph, ink, options: VectorizeOptions, ends: int, clock:
 # Cost (in stroke widths) of the pen starting or ending at a junction that is not a line
 # ending on another line: a whole spike of up to this length is retraced rather.
 JUNCTION_END = 20.0
+# ... but never more than this share of the whole line per end: avoiding a poor end is not
+# worth drawing more than 1 % of the drawing twice (a long spike on a closed loop then starts
+# at its tip and ends at its base, the shortest line over the ink).
+END_SHARE = 0.01
 
 
 def _junction_end_cost(graph: MedialGraph, node: int, dirs: np.ndarray, w: float) -> float:
@@ -308,6 +317,8 @@ def _single_route(graph: MedialGraph, simple: Simplified, ranked: dict, costs: d
               if n not in simple.retraced}
     end_cost = {n: 3.0 * w for n in v_tips}
     end_cost.update({n: _junction_end_cost(graph, n, dirs[n], w) for n in dirs})
+    most = END_SHARE * sum(b.length for b in graph.branches.values())
+    end_cost = {n: min(cost, most) for n, cost in end_cost.items()}
     end_cost.update(start_at or {})
     routes = plan_routes(graph, {**simple.through, **pairing}, stroke_width=w, directions=dirs, end_cost=end_cost,
                          weight=weight)
@@ -328,11 +339,9 @@ def _refuse_noise(count: int, what: str, limit: int, threshold: float, given: bo
                          f"drawing; {hint}")
 
 
-def _axis(image: np.ndarray, options: VectorizeOptions, clock: _Clock, cache: StageCache | None = None):
-    """Binarize, outline and medial axis: the stages that threshold and blur change, and the
-    mode does not. Returns (ink, rings, graph before pruning)."""
-    # Every piece of ink is kept here; in single-line mode the pieces of a line broken by
-    # pen gaps are bridged later, and only then is the largest kept.
+def working_paper(image: np.ndarray, options: VectorizeOptions, cache: StageCache | None = None):
+    """(gray, scale) of `binarize.paper_gray` at the options' blur and size: the working image
+    the threshold cuts, from the cache when one is given (and stored there)."""
     def paper():
         if cache is None:
             return paper_gray(image, max_size=options.max_size, blur=options.blur)
@@ -340,9 +349,28 @@ def _axis(image: np.ndarray, options: VectorizeOptions, clock: _Clock, cache: St
         scaled = cache.stage("gray", (options.max_size,), lambda: downscaled_gray(image, max_size=options.max_size))
         return paper_gray(image, max_size=options.max_size, blur=options.blur, downscaled=scaled)
 
-    gray, scale = paper() if cache is None else cache.stage("paper", (options.blur, options.max_size), paper)
+    return paper() if cache is None else cache.stage("paper", (options.blur, options.max_size), paper)
+
+
+def threshold_mask(image: np.ndarray, options: VectorizeOptions, cache: StageCache | None = None):
+    """(mask, level): (H, W) bool of the working pixels darker than the threshold (the options'
+    or Li's level), what the threshold catches before specks, a frame and pinholes are
+    cleaned; the studio shows it while a threshold or blur slider moves."""
+    gray, _ = working_paper(image, options, cache)
+    level = ink_threshold(gray, options.threshold)
+    return gray < level, level
+
+
+def _axis(image: np.ndarray, options: VectorizeOptions, clock: _Clock, cache: StageCache | None = None):
+    """Binarize, outline and medial axis: the stages that threshold and blur change, and the
+    mode does not. Returns (ink, rings, graph before pruning)."""
+    # Every piece of ink is kept here; in single-line mode the pieces of a line broken by
+    # pen gaps are bridged later, and only then is the largest kept.
+    gray, scale = working_paper(image, options, cache)
     ink = ink_image(gray, scale, threshold=options.threshold)
     clock.lap("binarize")
+    # The fitting's libraries (scipy.interpolate: FITPACK) load beside the next stages.
+    preload("fitting", ("vectorize.fitting",))
     w = ink.stroke_width
     spacing = float(np.clip(w / 8.0, 0.3, 1.0))
     rings = outline_rings(ink.gray, ink.threshold, spacing)
@@ -390,6 +418,9 @@ def _front(image: np.ndarray, options: VectorizeOptions, clock: _Clock, cache: S
     branch_points = sum(1 for incident in graph.incident.values() if len(incident) >= 3)
     _refuse_noise(branch_points, "branch points", MAX_BRANCH_POINTS, ink.threshold,
                   options.threshold is not None)
+    if branch_points and options.classifier == "cnn":
+        # Junctions to classify: onnxruntime and the model's session load beside the next stages.
+        preload("cnn", ("vectorize.cnn_classifier",), lambda: make_classifier("cnn").session)
     bridges: list = []
     dropped = 0
     refuse = None
@@ -463,6 +494,9 @@ def run_pipeline(image: np.ndarray, options: VectorizeOptions, *,
     blobs = np.array([[*graph.positions[n], graph.radii[n]] for n, incident in graph.incident.items()
                       if len(incident) >= 3]).reshape(-1, 3)
     strokes = list(solved[1]) if solved is not None else []
+    wait("fitting")
+    from vectorize.fitting import fit_stroke
+
     for traced, closed, twins in _trace(graph, simple, ordering, junctions, verdicts, w) if solved is None else ():
         if len(traced) < 2:
             continue

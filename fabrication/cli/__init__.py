@@ -81,6 +81,18 @@ def _interrupt(signum, frame) -> None:
     raise Interrupted(signal.Signals(signum).name)
 
 
+def _caused_by_ctrl_c(error: BaseException) -> KeyboardInterrupt | None:
+    """The KeyboardInterrupt in `error`'s chain of causes, if any (a Ctrl-C landing while
+    numpy defines a class comes out as "RuntimeError: Error calling __set_name__")."""
+    seen = set()
+    while error is not None and id(error) not in seen:
+        if isinstance(error, KeyboardInterrupt):
+            return error
+        seen.add(id(error))
+        error = error.__cause__ or error.__context__
+    return None
+
+
 class OnestrokeGroup(click.Group):
     """A click group that turns every error into a one-line message and an exit code."""
 
@@ -115,6 +127,10 @@ class OnestrokeGroup(click.Group):
         except RecursionError:
             self._fail("the input is nested too deeply to read", EXIT_BAD_REQUEST)
         except Exception as error:  # noqa: BLE001 - a bug still gets one line, and a way to report it
+            interrupt = _caused_by_ctrl_c(error)
+            if interrupt is not None:  # Python wraps an interrupt in a class body (an import) in RuntimeError
+                click.echo(f"interrupted{f' ({interrupt})' if isinstance(interrupt, Interrupted) else ''}", err=True)
+                sys.exit(EXIT_INTERRUPTED)
             self._fail(f"internal error ({type(error).__name__}: {error}); please report this with the "
                        "command line and input", EXIT_FAILED)
         finally:  # Python's own handling again (a program that invoked the group goes on)

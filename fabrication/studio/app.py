@@ -42,7 +42,7 @@ def cookie_name(token: str) -> str:
     return f"{COOKIE}_{hashlib.sha256(token.encode()).hexdigest()[:10]}"
 STATIC = {"app.js": "text/javascript", "api.js": "text/javascript", "panels.js": "text/javascript",
           "view.js": "text/javascript", "marks.js": "text/javascript", "edits.js": "text/javascript",
-          "hint.js": "text/javascript", "tools.js": "text/javascript",
+          "hint.js": "text/javascript", "tools.js": "text/javascript", "junctions.js": "text/javascript",
           "style.css": "text/css", "index.html": "text/html"}
 # The toolpath player's files, served from its own package (`fabrication.player`).
 PLAYER = {"player.js": "text/javascript", "player.css": "text/css"}
@@ -219,6 +219,15 @@ def create_app(session: StudioSession, *, token: str, hosts: set[str]) -> Guard:
             picture.convert("RGBA").save(buffer, format="PNG")
         return Response(buffer.getvalue(), media_type="image/png")
 
+    async def mask(request: Request):
+        from onestroke.units import parse_number
+
+        query = request.query_params
+        threshold = query.get("threshold", "auto")
+        threshold = None if threshold == "auto" else parse_number(threshold, what="--threshold")
+        blur = parse_number(query.get("blur", "0"), what="--blur")
+        return Response(await run_in_threadpool(session.mask, threshold, blur), media_type="image/png")
+
     async def state(request: Request):
         if request.method == "GET":
             return JSONResponse(await run_in_threadpool(session.state, session.saved_edits()))
@@ -292,6 +301,7 @@ def create_app(session: StudioSession, *, token: str, hosts: set[str]) -> Guard:
         Route("/", index),
         Route("/static/{name}", static),
         Route("/api/image", image),
+        Route("/api/mask", api(mask), methods=["GET"]),
         Route("/api/state", api(state), methods=["GET", "POST"]),
         Route("/api/embroidery", api(embroidery), methods=["POST"]),
         Route("/api/laser", api(laser), methods=["POST"]),

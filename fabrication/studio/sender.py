@@ -27,6 +27,7 @@ class LaserSender:
         self.progress: StreamProgress | None = None
         self.started = time.monotonic()
         self._streamer: GrblStreamer | None = None
+        self._before = None  # the status report from before the stream: not the machine's state in it
         self._abort = threading.Event()  # asked for at any time, also while connecting
         self._thread = threading.Thread(target=self._run, name="studio-send", daemon=True)
 
@@ -48,6 +49,7 @@ class LaserSender:
                 if self._abort.is_set():
                     state, message = "aborted", "stopped before the first line was sent"
                 else:
+                    self._before = streamer.status
                     self.state = "streaming"
                     result = streamer.stream(self.program, on_progress=self._on_progress)
                     state, message = "done", f"{result.lines} lines in {result.elapsed:.1f} s"
@@ -100,7 +102,10 @@ class LaserSender:
         p = self.progress
         streamer = self._streamer
         report = streamer.status if streamer is not None else None
-        machine = report.full_state if report is not None else (p.state if p else None)
+        if report is not None and report is self._before:
+            machine = None  # connect's "Idle": no report since the stream started
+        else:
+            machine = report.full_state if report is not None else (p.state if p else None)
         return {"state": self.state, "message": self.message, "port": self.port,
                 "acked": p.acked if p else 0, "total": p.total if p else len(self.program),
                 "elapsed": round(p.elapsed, 2) if p else 0.0, "machine": machine,

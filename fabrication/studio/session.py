@@ -223,6 +223,7 @@ class StudioSession:
         settings = edits.applied_to(self.options)
         answer = {
             "name": self.drawing_path.name, "width": drawing.width, "height": drawing.height,
+            "classifier": self.options.classifier if isinstance(self.options.classifier, str) else "custom",
             "stroke_width": round(float(drawing.stroke_width), 3), "strokes": strokes,
             "graph": result.graph.to_dict() if result.graph is not None else {"junctions": [], "branches": []},
             "report": {"strokes": report.strokes, "intersections": report.intersections,
@@ -236,6 +237,29 @@ class StudioSession:
             self.warm_neighbours(edits, self._shown, report.threshold)
         self._shown = edits
         return answer
+
+    def mask(self, threshold: float | None, blur: float) -> bytes:
+        """PNG (working px, the whole image) of the pixels darker than `threshold` (None:
+        Li's) at `blur`, black on transparent: what the page lays under the curve while a
+        threshold or blur slider moves. Values out of their declared ranges: `InputError`."""
+        from io import BytesIO
+
+        from PIL import Image
+
+        from vectorize.pipeline import threshold_mask_file
+
+        options = Edits(threshold=threshold, blur=blur).applied_to(self.options)
+        if self.lock.acquire(blocking=False):  # with the stage cache: the next re-run starts from it
+            try:
+                mask, _ = threshold_mask_file(self.drawing_path, options, cache=self.cache)
+            finally:
+                self.lock.release()
+        else:  # the vectorizer is busy with this drawing: without the cache it holds
+            mask, _ = threshold_mask_file(self.drawing_path, options)
+        alpha = mask.astype(np.uint8) * 255
+        buffer = BytesIO()
+        Image.fromarray(np.dstack([np.zeros_like(alpha), alpha]), mode="LA").save(buffer, format="PNG")
+        return buffer.getvalue()
 
     # -- make it ---------------------------------------------------------------------
     PANEL_MODULES = ("fabrication.embroidery.pipeline", "fabrication.embroidery.export", "fabrication.player",
@@ -337,7 +361,7 @@ class StudioSession:
         return {"player": data.to_dict(), "seconds": time.total_seconds,
                 "time": format_duration(time.total_seconds), "naive": format_duration(time.naive_seconds),
                 "burn_length": round(float(time.burn_length), 1), "travel_length": round(float(time.travel_length), 1),
-                "lines": len(program.lines), "profile": settings.profile.name,
+                "lines": len(program.program), "profile": settings.profile.name,  # the lines Send streams
                 "warnings": list(settings.warnings)}
 
     def export(self, kind: str, edits: Edits, values: dict) -> tuple[str, str, bytes]:

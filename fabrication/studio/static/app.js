@@ -6,11 +6,12 @@
 import { $, busy, call, report } from "./api.js";
 import { apply, redo, SETTINGS, setupEdits, undo, updateButtons, withEdit, withSettings } from "./edits.js";
 import { hint } from "./hint.js";
-import { arrows, bridges, drawPasses, junctionMarkers, placeLabels, retraces, startMarkers,
+import { setupJunctions, showJunctions } from "./junctions.js";
+import { arrows, bridges, junctionMarkers, placeLabels, retraces, selectionRing, startMarkers,
          startPlaces } from "./marks.js";
 import { fieldNames, refreshPanel, setupPanels } from "./panels.js";
-import { choosePasses, describeUnresolved, onClick, unresolvedFixes } from "./tools.js";
-import { COLORS, dist, passRank, percent, samePasses, studio, toImage, toScreen } from "./view.js";
+import { onClick } from "./tools.js";
+import { dist, studio, toImage, toScreen } from "./view.js";
 
 // Fit the view to the drawing: the ink and the curve with a margin for the markers'
 // labels (a small drawing on a large sheet fills the view), else the whole image.
@@ -30,6 +31,19 @@ function fit() {
   const bw = Math.max(1, box[2] - box[0]), bh = Math.max(1, box[3] - box[1]);
   const scale = Math.min(w / bw, h / bh);
   studio.view = { scale, x: (w - bw * scale) / 2 - box[0] * scale, y: (h - bh * scale) / 2 - box[1] * scale };
+  studio.fitScale = scale;
+}
+
+// A place chosen in the junction list: ringed and, with `zoom`, brought into view at least
+// 2.5 times the fitted scale (a junction's branches then read), centred.
+function select(place, zoom = true) {
+  studio.selected = place;
+  if (!zoom) { draw(); return; }
+  const c = $("canvas"), v = studio.view;
+  v.scale = Math.max(v.scale, Math.min(50, 2.5 * (studio.fitScale || v.scale)));
+  v.x = c.clientWidth / 2 - place.at[0] * v.scale; v.y = c.clientHeight / 2 - place.at[1] * v.scale;
+  studio.moved = true;
+  draw();
 }
 
 // The ink's bounding box in image px (dark or opaque pixels of the input, read once from a
@@ -85,12 +99,21 @@ function draw() {
   const v = studio.view;
   g.save();
   g.translate(v.x, v.y); g.scale(v.scale, v.scale);
+  // The drawing shows through more as the curve fades: at 0 the ink is seen alone.
+  const curve = studio.curveOpacity;
   if (studio.image.complete && studio.image.naturalWidth) {
-    g.globalAlpha = 0.3;
+    g.globalAlpha = 0.3 + 0.7 * (1 - curve);
     g.drawImage(studio.image, 0, 0, s.width, s.height);
-    g.globalAlpha = 1;
   }
+  // While a threshold or blur slider moves: the pixels that value makes ink, under the curve.
+  if (studio.mask && maskWanted()) {
+    g.globalAlpha = 0.6;
+    g.drawImage(studio.mask.canvas, 0, 0, s.width, s.height);
+  }
+  g.globalAlpha = 1;
   g.restore();
+  // The curve half faded over a mask, so that the mask's edges read beside it.
+  g.globalAlpha = curve * (studio.mask && maskWanted() ? 0.5 : 1);
   retraces(g);
   const t = studio.line;
   const penAt = studio.pen * t.total;
@@ -104,9 +127,11 @@ function draw() {
     g.beginPath(); g.moveTo(a[0], a[1]); g.lineTo(b[0], b[1]); g.stroke();
   }
   arrows(g, t);
+  g.globalAlpha = 1;
   junctionMarkers(g);
   bridges(g);
   const starts = studio.starts = startPlaces();  // screen px, for the tests too
+  selectionRing(g);  // under the texts: a text beside a ringed marker stays readable
   placeLabels(g, starts.map(([x, y]) => [x - 8, y - 8, 16, 16]));
   startMarkers(g, starts);
   if (studio.pen < 1 || studio.playing) penMarker(g, t, penAt);
@@ -188,81 +213,31 @@ function show(state) {
   sayShrunk(old);
   $("name").textContent = state.name;
   const r = state.report;
-  $("summary").textContent = `${r.strokes} stroke${r.strokes === 1 ? "" : "s"}, ${r.intersections} crossing` +
-    `${r.intersections === 1 ? "" : "s"}, ${state.edits.edits.length} edit${state.edits.edits.length === 1 ? "" : "s"}` +
-    ` · ${(state.answered ?? r.seconds).toFixed(2)} s`;
+  // Crossings are the junctions read as crossings; touchings and third pairings are not.
+  const read = (kind) => state.graph.junctions.filter((j) => j.role === "crossing" && j.decision === kind).length;
+  const crossings = read("crossing"), others = read("touching") + read("third");
+  $("summary").textContent = `${r.strokes} stroke${r.strokes === 1 ? "" : "s"}, ${crossings} crossing` +
+    `${crossings === 1 ? "" : "s"}${others ? `, ${others} touching${others === 1 ? "" : "s"}` : ""}, ` +
+    `${state.edits.edits.length} edit${state.edits.edits.length === 1 ? "" : "s"}` +
+    // The time this page waited for the answer (the first state comes from the command's run).
+    (state.answered === undefined ? "" : ` · ${state.answered.toFixed(2)} s`);
   $("summary").dataset.order = JSON.stringify(state.strokes.map((s) => s.points[0]));
-  const list = $("junctions"); list.innerHTML = "";
-  for (const j of state.graph.junctions.filter((j) => j.role === "crossing" || j.role === "triple")) {
-    const li = document.createElement("li");
-    const where = `(${j.at[0].toFixed(0)}, ${j.at[1].toFixed(0)})`;
-    li.style.color = COLORS[j.decision];
-    if (j.role === "triple") {
-      const offered = state.settings.multi ? `all ${j.options.length} pairings`
-        : `the ${j.options.length} pairings that keep one line`;
-      li.append(`${where} three passes: pairing ${passRank(j)} · ` +
-        `${j.confidence === null ? "straightest" : "pass scorer" + percent(j.confidence)}` +
-        `${j.fixed ? " · fixed by you" : ""} · ${offered}, likeliest first:`);
-      li.appendChild(passChoice(j));
-    } else {
-      // The marker's figure is the confidence (how far the classifier's views agree), not the
-      // probability: "touching 100%" beside p(cross) 19% reads as a contradiction unless both are named.
-      li.title = "confidence: the share of the classifier's 8 turned and mirrored views of this junction " +
-        "that agree (the figure on the marker); p(crossing): their mean probability that two strokes cross here";
-      li.textContent = `${where} ${j.decision} · confidence ${Math.round(100 * (j.confidence || 0))}% · ` +
-        `CNN p(crossing) ${(j.p_crossing * 100).toFixed(0)}%` +
-        (j.fixed ? " · fixed by you" : "");
-    }
-    list.appendChild(li);
-  }
-  for (const j of state.graph.junctions.filter((j) => j.role === "unresolved")) {
-    const li = document.createElement("li");
-    li.className = "unresolved";
-    li.append(describeUnresolved(j), ...unresolvedFixes(j));
-    list.appendChild(li);
-  }
-  const gaps = state.graph.bridges || [];
-  if (gaps.length) {
-    const li = document.createElement("li");
-    li.className = "gaps";
-    li.textContent = `pen gap${gaps.length === 1 ? "" : "s"} bridged: ${gaps.length} (dashed circle${gaps.length === 1 ? "" : "s"})`;
-    list.appendChild(li);
-  }
-  const open = state.graph.unbridged || [];
-  if (open.length) {
-    const li = document.createElement("li");
-    li.className = "open-gaps";
-    li.textContent = `pen gap${open.length === 1 ? "" : "s"} kept open by you: ${open.length} (struck-through circle${open.length === 1 ? "" : "s"})`;
-    list.appendChild(li);
-  }
-  if (r.dropped && !state.settings.multi) {
-    // What single-line mode does with ink in several pieces (as the CLI does): the largest
-    // piece is the line; the others stay grey, undrawn.
-    const li = document.createElement("li");
-    li.className = "pieces";
-    li.append(`the ink is in ${r.dropped + 1} pieces: one line keeps the largest, the grey rest is not drawn. `);
-    const keep = document.createElement("button");
-    keep.id = "keep-pieces"; keep.textContent = "Keep every piece (multi-stroke)";
-    keep.title = "Multi-stroke mode draws each piece as its own stroke (and bridges no pen gap)";
-    keep.onclick = () => settingsEdit({ multi: true });
-    li.appendChild(keep);
-    list.appendChild(li);
-  }
-  const twice = state.graph.retraces || [];
-  if (twice.length) {
-    const li = document.createElement("li");
-    li.className = "retraces";
-    li.textContent = `drawn twice (×2): ${twice.length} stretch${twice.length === 1 ? "" : "es"}, ` +
-      `${Math.round(twice.reduce((sum, r) => sum + r.length, 0))} px`;
-    list.appendChild(li);
-  }
+  showJunctions(state, () => settingsEdit({ multi: true }));
   const warnings = $("warnings"); warnings.innerHTML = "";
   for (const w of r.warnings) {
     const li = document.createElement("li"); li.textContent = fieldNames(w, null); warnings.appendChild(li);
   }
-  // The controls show the state's settings, except a slider the user holds: writing its
-  // value mid-drag would move the thumb away from the pointer.
-  const st = state.settings;
+  showSettings(state);
+  if (studio.mask && !maskWanted()) studio.mask = null;  // the answer for the slider's value came
+  draw();
+  refreshPanel();
+}
+
+// The controls show the state's settings, except a slider the user holds: writing its value
+// mid-drag would move the thumb away from the pointer. Also after a refused setting: the
+// controls go back to what the drawing shows.
+function showSettings(state) {
+  const st = state.settings, r = state.report;
   if (studio.holding !== "threshold") {
     // Automatic: the slider rests on the level Li's method chose, so a drag (or unticking
     // "automatic") starts from the threshold in use.
@@ -274,40 +249,71 @@ function show(state) {
   }
   if (studio.holding !== "blur") { $("blur").value = st.blur; $("blur-value").textContent = st.blur; }
   $("multi").checked = st.multi;
+}
+
+// A refused setting (a threshold that finds no ink): the controls and the view go back to
+// the state shown.
+function refused() {
+  if (!studio.state) return;
+  studio.mask = null;
+  showSettings(studio.state);
   draw();
-  refreshPanel();
 }
 
-// The pairings a triple point may take, likeliest first (single-line mode: those that keep
-// the line one stroke; multi-stroke: all 15), each a small drawing of its passes with its
-// place and the pass scorer's posterior; the one drawn is outlined. A click picks one.
-function passChoice(j) {
-  const box = document.createElement("div");
-  box.className = "pass-options";
-  const dpr = window.devicePixelRatio || 1;
-  j.options.forEach((o, k) => {
-    const button = document.createElement("button");
-    button.type = "button"; button.dataset.index = String(k);
-    button.className = "pass-option" + (samePasses(o.passes, j.passes) ? " current" : "");
-    button.title = `pairing ${k + 1}${percent(o.p)}: passes ` +
-      o.passes.map(([a, b]) => `${Math.round(a)}°–${Math.round(b)}°`).join(", ");
-    const c = document.createElement("canvas");
-    c.width = c.height = Math.round(34 * dpr); c.style.width = c.style.height = "34px";
-    const g = c.getContext("2d"); g.scale(dpr, dpr);
-    drawPasses(g, 17, 17, 13, o.passes, 2);
-    const caption = document.createElement("span");
-    caption.textContent = `${k + 1}${percent(o.p)}`;
-    button.append(c, caption);
-    button.onclick = () => choosePasses(j, o);
-    box.appendChild(button);
-  });
-  return box;
+// ---------------------------------------------------------------- the threshold's mask
+// While a threshold or blur slider moves: the pixels its value makes ink (the library's
+// binarization, GET /api/mask), tinted, under the curve; only the latest value's answer is
+// drawn, and the mask goes once the state for that value is shown.
+const MASK_COLOR = "#00897b";
+let maskTicket = 0, maskTimer = null;
+function askMask() { clearTimeout(maskTimer); maskTimer = setTimeout(requestMask, 60); }
+async function requestMask() {
+  const ticket = ++maskTicket;
+  const threshold = $("auto-threshold").checked ? null : Number($("threshold").value);
+  const blur = Number($("blur").value);
+  try {
+    const response = await call(`api/mask?threshold=${threshold === null ? "auto" : threshold}&blur=${blur}`, undefined, true);
+    const bitmap = await createImageBitmap(await response.blob());
+    if (ticket !== maskTicket) return;
+    const canvas = document.createElement("canvas");
+    canvas.width = bitmap.width; canvas.height = bitmap.height;
+    const g = canvas.getContext("2d");
+    g.drawImage(bitmap, 0, 0);
+    g.globalCompositeOperation = "source-in"; g.fillStyle = MASK_COLOR; g.fillRect(0, 0, canvas.width, canvas.height);
+    studio.mask = { canvas, for: { threshold, blur } };
+    draw();
+  } catch (error) { /* a refused value: the state request says why */ }
+}
+function maskWanted() {
+  const m = studio.mask, st = studio.state && studio.state.settings;
+  return !!m && (studio.holding !== null || !st || m.for.threshold !== st.threshold || m.for.blur !== st.blur);
 }
 
-
+// The canvas by keyboard: arrows pan, + and - zoom, 0 fits, Enter acts with the tool chosen
+// at the place selected in the junction list, Escape drops the selection.
+function canvasKeys(e) {
+  const c = $("canvas"), v = studio.view, step = 40;
+  const zoom = (f) => {
+    const cx = c.clientWidth / 2, cy = c.clientHeight / 2, [ix, iy] = toImage(cx, cy);
+    v.scale = Math.min(50, Math.max(0.05, v.scale * f)); v.x = cx - ix * v.scale; v.y = cy - iy * v.scale;
+  };
+  const pan = { ArrowLeft: [step, 0], ArrowRight: [-step, 0], ArrowUp: [0, step], ArrowDown: [0, -step] }[e.key];
+  if (pan) { v.x += pan[0]; v.y += pan[1]; studio.moved = true; }
+  else if (e.key === "+" || e.key === "=") { zoom(1.25); studio.moved = true; }
+  else if (e.key === "-") { zoom(0.8); studio.moved = true; }
+  else if (e.key === "0") { studio.moved = false; fit(); }
+  else if (e.key === "Escape") studio.selected = null;
+  else if (e.key === "Enter" && studio.selected) {
+    const r = c.getBoundingClientRect(), [sx, sy] = toScreen(...studio.selected.at);
+    onClick({ clientX: r.left + sx, clientY: r.top + sy });
+  } else return;
+  e.preventDefault();
+  draw();
+}
 
 function setupView() {
   const c = $("canvas");
+  c.addEventListener("keydown", canvasKeys);
   let drag = null;
   c.addEventListener("mousedown", (e) => { drag = { x: e.clientX, y: e.clientY, vx: studio.view.x, vy: studio.view.y }; studio.dragged = false; });
   window.addEventListener("mousemove", (e) => {
@@ -384,7 +390,11 @@ function setup() {
     // Space plays and pauses the pen (as in the player), unless a control has the key.
     if (e.key === " " && !e.ctrlKey && !["INPUT", "BUTTON", "SELECT", "TEXTAREA", "LABEL"].includes(e.target.tagName) &&
         !$("tab-refine").hidden) { e.preventDefault(); play(); return; }
-    if (!(e.ctrlKey || e.metaKey) || e.target.tagName === "INPUT") return;
+    // Ctrl+Z / Ctrl+Y step through the edits wherever the focus is, but in a text field (its
+    // own typing is what Ctrl+Z undoes there).
+    const typing = e.target.matches("textarea, input:not([type=range]):not([type=checkbox]):not([type=radio])" +
+      ":not([type=file]):not([type=color]):not([type=button])");
+    if (!(e.ctrlKey || e.metaKey) || typing) return;
     if (e.key === "z" && !e.shiftKey) { e.preventDefault(); undo(); }
     if (e.key === "y" || (e.key === "z" && e.shiftKey)) { e.preventDefault(); redo(); }
   });
@@ -397,21 +407,32 @@ function setup() {
     apply(withEdit({ kind: "reverse", at: pts[Math.floor(pts.length / 2)].slice(0, 2) }));
   };
   for (const id of ["threshold", "blur"]) $(id).addEventListener("pointerdown", () => { studio.holding = id; });
-  window.addEventListener("pointerup", () => { studio.holding = null; });
+  window.addEventListener("pointerup", () => { studio.holding = null; if (studio.mask) draw(); });
   $("threshold").oninput = () => {
     $("auto-threshold").checked = false;
     $("threshold-value").textContent = Number($("threshold").value).toFixed(2);
+    askMask();
     preview({ threshold: Number($("threshold").value) });
   };
   $("threshold").onchange = () => settingsEdit({ threshold: Number($("threshold").value) });
   $("auto-threshold").onchange = () => settingsEdit({ threshold: $("auto-threshold").checked ? null : Number($("threshold").value) });
-  $("blur").oninput = () => { $("blur-value").textContent = $("blur").value; preview({ blur: Number($("blur").value) }); };
+  $("blur").oninput = () => {
+    $("blur-value").textContent = $("blur").value;
+    askMask();
+    preview({ blur: Number($("blur").value) });
+  };
+  $("curve-opacity").oninput = () => {
+    studio.curveOpacity = Number($("curve-opacity").value);
+    $("curve-opacity-value").textContent = studio.curveOpacity ? `${Math.round(100 * studio.curveOpacity)}%` : "ink only";
+    draw();
+  };
   $("blur").onchange = () => settingsEdit({ blur: Number($("blur").value) });
   $("multi").onchange = () => settingsEdit({ multi: $("multi").checked });
   $("play").onclick = play;
   $("scrub").oninput = () => { studio.playing = false; $("play").textContent = "▶ Play"; studio.pen = $("scrub").value / 1000; draw(); };
   setupPanels(() => studio.shown);
-  setupEdits(show);
+  setupEdits(show, refused);
+  setupJunctions(select);
   // The first view fits the ink too: the first state is drawn once the image is read.
   const loaded = new Promise((done) => {
     studio.image.onload = () => {

@@ -6,8 +6,9 @@ import { $, busy, call } from "./api.js";
 import { hint, tell } from "./hint.js";
 import { dist, studio } from "./view.js";
 
-// What shows an answered state (the page's `show`), set by setupEdits.
-let show = null;
+// What shows an answered state (the page's `show`) and puts the controls back to the state
+// shown after a refusal (`refused`), set by setupEdits.
+let show = null, refused = () => {};
 
 export function currentEdits() { return studio.history[studio.at]; }
 export const SETTINGS = ["threshold", "blur", "multi"];
@@ -33,7 +34,7 @@ export async function apply(edits, push = true) {
   } catch (error) {
     // A refused edits state (e.g. an opened file that is not an edits file) is no step.
     if (push && studio.history[studio.at] === edits) { studio.history.pop(); studio.at -= 1; updateButtons(); }
-    if (ticket === studio.requests) tell(error.message, true);
+    if (ticket === studio.requests) { tell(error.message, true); refused(); }
   } finally {
     busy(false);
     if (rerun) rerunning(-1);
@@ -81,8 +82,8 @@ export function updateButtons() {
 }
 
 // The history's buttons and the edits files' (save, load, open); `showState` shows an answer.
-export function setupEdits(showState) {
-  show = showState;
+export function setupEdits(showState, restore) {
+  show = showState; refused = restore;
   $("undo").onclick = undo; $("redo").onclick = redo;
   $("save").onclick = async () => {
     try {

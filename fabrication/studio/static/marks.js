@@ -3,7 +3,7 @@
 // would cover each other, triple points' passes) and their texts, placed clear of each other.
 "use strict";
 import { $ } from "./api.js";
-import { COLORS, PASS_COLORS, passRank, percent, studio, toScreen } from "./view.js";
+import { COLORS, PASS_COLORS, decisionText, passRank, percent, shownRetraces, studio, toScreen } from "./view.js";
 
 // Start markers: where each stroke begins. One that would hide a junction's marker (a line
 // starting at a junction) sits just beyond the markers along its stroke: beyond the marker
@@ -53,14 +53,15 @@ export function retraces(g) {
   g.lineCap = "round"; g.lineJoin = "round";
   g.lineWidth = Math.max(8, s.stroke_width * studio.view.scale * 1.6);
   g.strokeStyle = COLORS.retrace;
-  for (const r of s.graph.retraces || []) {
+  const twice = shownRetraces();
+  for (const r of twice) {
     g.beginPath();
     r.points.forEach((p, i) => { const [x, y] = toScreen(...p); if (i) g.lineTo(x, y); else g.moveTo(x, y); });
     g.stroke();
   }
   g.restore();
   // "×2" beside the band's middle, placed like the markers' texts: clear of them and of each other.
-  for (const r of s.graph.retraces || []) { const [x, y] = toScreen(...r.at); label(g, "×2", x, y, 7); }
+  for (const r of twice) { const [x, y] = toScreen(...r.at); label(g, "×2", x, y, 7); }
 }
 
 // Pen gaps the vectorizer bridged: the two ends joined, dashed, under the curve; gaps the
@@ -191,7 +192,16 @@ export function placeLabels(g, more = []) {
       if (!n) break;
     }
     const [lx, ly] = best || spots.find(([sx, sy]) => inside(sx, sy)) || spots[0];
-    studio.placed.push({ text, x, y, box: [lx, ly - h / 2, w, h] });
+    // A text pushed beyond the first ring around its marker (a crowd) is tied to it by a
+    // line, so that it reads as its own marker's, not a neighbour's.
+    const box = [lx, ly - h / 2, w, h];
+    const near = [Math.max(box[0], Math.min(x, box[0] + w)), Math.max(box[1], Math.min(y, box[1] + h))];
+    const leader = Math.hypot(near[0] - x, near[1] - y) > gap + 16;
+    if (leader) {
+      g.strokeStyle = "rgba(60,60,60,0.7)"; g.lineWidth = 1; g.setLineDash([2, 2]);
+      g.beginPath(); g.moveTo(x, y); g.lineTo(...near); g.stroke(); g.setLineDash([]);
+    }
+    studio.placed.push({ text, x, y, box, leader });
     g.fillStyle = "rgba(255,255,255,0.8)"; g.fillRect(lx - 2, ly - h / 2, w + 4, h);
     g.strokeStyle = "rgba(255,255,255,0.9)"; g.lineWidth = 3; g.lineJoin = "round"; g.strokeText(text, lx, ly);
     g.fillStyle = "#222"; g.fillText(text, lx, ly);
@@ -299,7 +309,17 @@ export function junctionMarkers(g) {
     // Confidence as the filled share of an inner disc.
     g.fillStyle = color; g.beginPath(); g.moveTo(x, y);
     g.arc(x, y, 6, -Math.PI / 2, -Math.PI / 2 + 2 * Math.PI * (j.confidence || 0)); g.closePath(); g.fill();
-    label(g, `${j.decision} ${Math.round(100 * (j.confidence || 0))}%`, x, y, 12);
+    label(g, decisionText(j), x, y, 12);
   }
+}
+
+// The place chosen in the junction list: a ring the eye finds at once.
+export function selectionRing(g) {
+  if (!studio.selected) return;
+  const [x, y] = toScreen(...studio.selected.at);
+  g.save();
+  g.strokeStyle = "#ffd600"; g.lineWidth = 6; g.beginPath(); g.arc(x, y, 24, 0, 2 * Math.PI); g.stroke();
+  g.strokeStyle = "#111"; g.lineWidth = 2; g.beginPath(); g.arc(x, y, 24, 0, 2 * Math.PI); g.stroke();
+  g.restore();
 }
 

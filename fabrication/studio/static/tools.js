@@ -67,6 +67,19 @@ export function describeUnresolved(j) {
     "is read as going on through it, so the line's order here is a guess";
 }
 
+// The ends the line may start from: the strokes' ends and the free ends it passes (the
+// tip of a stem drawn down and back up), image px, each place once.
+export function lineEnds(state) {
+  const found = (state.graph.ends || []).map((at) => at.slice(0, 2));
+  for (const stroke of state.strokes) if (!stroke.closed) {
+    found.push(stroke.points[0].slice(0, 2), stroke.points[stroke.points.length - 1].slice(0, 2));
+  }
+  return found.filter((at, k) => found.findIndex((o) => dist(o, at) < 3) === k);
+}
+
+// Close a pen gap kept open (`ends`: its two sides): drop the edits that opened it.
+export function closeGap(ends) { return apply(without(currentEdits(), ["unbridge"], ends, toSegment)); }
+
 export function choosePasses(j, option) {
   return apply(withEdit({ kind: "passes", at: j.at, passes: option.passes }, ["passes"]));
 }
@@ -141,12 +154,8 @@ function clickTool(s, p, sx, sy) {
   if (tool === "start") {
     // A stroke's end, or a free end the line passes (the tip of a stem drawn down and back
     // up): starting there, the line retraces other branches instead.
-    const ends = (s.graph.ends || []).map((at) => ({ at }));
-    for (const stroke of s.strokes) if (!stroke.closed) {
-      ends.push({ at: stroke.points[0] }, { at: stroke.points[stroke.points.length - 1] });
-    }
-    const e = nearest(ends, p, 24);
-    return e ? apply(withEdit({ kind: "start", at: e.at.slice(0, 2) })) : null;
+    const e = nearest(lineEnds(s).map((at) => ({ at })), p, 24);
+    return e ? apply(withEdit({ kind: "start", at: e.at }, ["start"])) : null;
   }
   if (tool === "retrace") {
     // On a stretch drawn twice: draw it once; elsewhere on the line: go back over it here
@@ -160,7 +169,7 @@ function clickTool(s, p, sx, sy) {
   if (tool === "gap") {
     // A gap kept open: close it again (drop the edits that opened it); a bridged gap: open it.
     const open = nearest((s.graph.unbridged || []).map(middle), p, 24);
-    if (open) return apply(without(currentEdits(), ["unbridge"], open.ends, toSegment));
+    if (open) return closeGap(open.ends);
     const gap = nearest((s.graph.bridges || []).map(middle), p, 24);
     return gap ? apply(withEdit({ kind: "unbridge", at: gap.at })) : null;
   }

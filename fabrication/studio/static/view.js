@@ -22,6 +22,9 @@ export const studio = {
   shown: null,            // the edits of the state shown (what the panels and downloads use)
   rerunning: 0,           // pending requests that re-run from binarization
   holding: null,          // the slider the pointer holds ("threshold", "blur")
+  selected: null,         // the place chosen in the junction list ({at, key}), ringed on the drawing
+  curveOpacity: 1,        // 0: the ink alone (the curve, its arrows and bands hidden)
+  mask: null,             // the threshold's mask under the curve while a slider moves ({canvas, for})
   // This page's id: the server skips a queued state request once the page sent a newer one.
   page: Math.random().toString(36).slice(2) + Date.now().toString(36),
 };
@@ -35,6 +38,22 @@ studio.toScreen = (x, y) => {
   const [sx, sy] = toScreen(x, y);
   return [r.left + sx, r.top + sy];
 };
+
+// A crossing's decision as the page says it ("crossing 100%"); one the user forced says
+// what the classifier said too: "touching (yours; CNN: crossing 100%)".
+export function decisionText(j) {
+  const share = `${Math.round(100 * (j.confidence || 0))}%`;
+  if (!j.fixed) return `${j.decision} ${share}`;
+  const by = studio.state && studio.state.classifier === "geometric" ? "geometric rule" : "CNN";
+  return `${j.decision} (yours; ${by}: ${j.p_crossing >= 0.5 ? "crossing" : "touching"} ${share})`;
+}
+
+// Stretches drawn twice that the page bands and counts: a retrace shorter than the ink is
+// wide stays inside the ink of a junction (a split crossing's two halves), seen as nothing.
+export function shownRetraces() {
+  const s = studio.state;
+  return (s.graph.retraces || []).filter((r) => r.length >= s.stroke_width);
+}
 
 export function percent(p) { return p === null || p === undefined ? "" : p < 0.001 ? " <0.1%" : ` ${Math.round(100 * p)}%`; }
 
