@@ -17,7 +17,7 @@ import numpy as np
 import shapely
 from scipy.spatial import cKDTree
 
-from fabrication.embroidery.needles import BODY
+from fabrication.embroidery.needles import BODY, TACK, TRAVEL
 from fabrication.embroidery.plan import STITCH
 from fabrication.embroidery.running import DENSE_TOLERANCE
 from fabrication.embroidery.sampling import dense_curve
@@ -105,6 +105,12 @@ def slits(plan, k: int, half_at, spacing: float, *, margin: float = 0.15, slack:
     stroke = plan.sewn.strokes[k]
     curve, _, tangent = _frame(stroke)
     rows = _top(plan, k)
+    # The first top point of a run is the last of the tack or travel before it (the planner
+    # tags it so): the stitch from it across the column is a top stitch.
+    first = rows[np.concatenate([[True], np.diff(rows) > 1])] - 1
+    first = first[(first >= 0) & (plan.kinds[np.maximum(first, 0)] == STITCH) & (plan.strokes[np.maximum(first, 0)] == k)
+                  & np.isin(plan.roles[np.maximum(first, 0)], (TACK, TRAVEL))]
+    rows = np.union1d(rows, first)
     if len(rows) < 2:
         return []
     # dense samples of the stitches actually sewn between consecutive top needle points

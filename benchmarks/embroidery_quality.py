@@ -85,7 +85,7 @@ def density_and_holes(folder: str) -> None:
     """Every benchmark drawing x every style through the whole job (`embroider`): density
     with every needle point counted, repeated holes, and whether the warnings name them."""
     from fabrication.embroidery.pipeline import EmbroideryJob, embroider
-    from fabrication.embroidery.quality import DENSITY_LIMIT, needle_density, repeated_holes
+    from fabrication.embroidery.quality import DENSITY_LIMIT, hole_places, needle_density, repeated_holes
     from fabrication.placement import PlacementOptions
 
     hoop = hoop_named("200x200")
@@ -101,10 +101,14 @@ def density_and_holes(folder: str) -> None:
             seconds = time.perf_counter() - start
             plan = result.plan
             density = needle_density(plan.points[plan.kinds == STITCH])
-            holes = len(repeated_holes(plan))
+            hole_rows = repeated_holes(plan)
+            holes = len(hole_rows)
             assert density.maximum == result.stats.max_density  # one measure, the stats' own
-            named = all(str(p) in " ".join(result.warnings) for p in density.places)
-            hole_named = holes == 0 or any("re-enter a hole" in w for w in result.warnings)
+            said = " ".join(result.warnings)
+            # every place named, or past twelve how many there are (quality.where)
+            named = all(str(p) in said for p in density.places) or f"at {len(density.places)} places" in said
+            spots = hole_places(plan, hole_rows)
+            hole_named = holes == 0 or all(str(p) in said for p in spots) or f"at {len(spots)} places" in said
             warned = ("-" if density.maximum <= DENSITY_LIMIT and not holes else
                       "yes" if named and hole_named else "NO")
             unwarned += warned == "NO"

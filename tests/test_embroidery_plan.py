@@ -291,3 +291,24 @@ def test_random_drawings_keep_every_rule(seed, style):
     ends = np.r_[trims - 1, np.flatnonzero(plan.kinds == STITCH)[-1]]
     for end in ends[plan.roles[ends] != LOCK]:
         assert tuple(np.round(plan.points[end], 1)) in left_out
+
+
+def test_rows_after_a_jump_keep_their_own_parameter_when_long_stitches_are_split():
+    # Found by the fuzz (a JSON drawing sewn as satin): splitting a long stitch anywhere in
+    # the plan gave the first row after each jump or trim its NaN parameter, and the
+    # repeated-hole check then met NaN on the curve.
+    from fabrication.embroidery.grid import split_long
+    from fabrication.embroidery.quality import needle_sides, repeated_holes
+
+    units = np.array([[0, 0], [200, 0], [200, 0], [900, 0], [910, 0]])
+    kinds = np.array([STITCH, STITCH, TRIM, JUMP, STITCH])
+    params = np.array([0.0, 0.5, np.nan, np.nan, 1.2])
+    new_units, new_params, source = split_long(units, kinds, params, 127)
+    assert np.array_equal(new_units[source == 4], [[910, 0]]) and new_params[source == 4] == [1.2]
+    assert np.isfinite(new_params[kinds[source] == STITCH]).all()
+    assert np.allclose(new_params[source == 1], [0.5 * 1 / 2, 0.5])  # split in two, interpolated
+    wide = Drawing((_line((0, 0), (30, 0)), _line((0, 30), (40, 30))), 40, 40, "mm", 20.0)
+    plan = plan_embroidery(wide, PlanOptions(style=style_options("satin", max_width=12.0, max_stitch_length=12.7)))
+    stitched = (plan.kinds == STITCH) & (plan.strokes >= 0)
+    assert (plan.kinds == JUMP).any() and np.isfinite(plan.params[stitched]).all()
+    assert np.isfinite(needle_sides(plan)).all() and len(repeated_holes(plan)) == 0

@@ -23,7 +23,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from fabrication.embroidery.columns import Column, Rows
+from fabrication.embroidery.crowding import relieve_crowding, straight_density
 from fabrication.embroidery.needles import BODY, SNAP_ALLOWANCE, UNDERLAY, NeedlePoints
+from fabrication.embroidery.quality import DENSITY_LIMIT, stroke_sides
 from fabrication.embroidery.running import RunningOptions, running_stitch
 from fabrication.embroidery.sampling import DenseCurve
 from vectorize.stroke import Stroke
@@ -33,6 +35,8 @@ SHORT_COLUMN = 2.0  # mm
 # A crowded point is inset deeper, one short-stitch step at a time, up to this share of its
 # row's width.
 MAX_INSET = 0.5
+# A cut end may run on under the column sewn over it by up to this much more (mm).
+RUN_UNDER = 0.5
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -62,31 +66,64 @@ class ColumnStitching:
 
 def column_needles(stroke: Stroke, curve: DenseCurve, columns: list[Column], how: ColumnStitching,
                    rng: np.random.Generator | None = None) -> NeedlePoints:
-    """Every column's underlays then top stitches, in order along the stroke. A column cut
-    away entirely (its ground lies under the next one) is crossed by a walk on its centre."""
+    """Every column's underlays then top stitches, in order along the stroke, with the
+    crowding relieved (`crowding`). A column cut away entirely (its ground lies under the
+    next one) is crossed by a walk on its centre."""
     spans = [_span(c) if len(c.rows) >= 2 else (c.start, c.end) for c in columns]
     # One running stitch along the whole stroke, meeting every column's ends: the walks.
     walk = running_stitch(stroke, RunningOptions(stitch_length=how.underlay_stitch_length, tolerance=how.tolerance),
                           curve=curve, breaks=np.array(spans).ravel())
     walk_s = np.interp(walk.t, curve.t, curve.s)
-    parts = []
+    parts, inward = [], []
     for column, (lo, hi) in zip(columns, spans):
         inside = walk_s[(walk_s >= lo - 1e-9) & (walk_s <= hi + 1e-9)]
         s = inside if len(inside) >= 2 else np.array([lo, hi])
         if len(column.rows) < 2:
             t = curve.t_at(s)
             parts.append(NeedlePoints.of(stroke.points_at(t), t, UNDERLAY))
+            inward.append(np.zeros((len(s), 2)))
             continue
         # A column shorter than SHORT_COLUMN (a corner's jog, a short stroke) has no room
         # for an underlay: its walks would only pile needle points on its start.
         for kind in how.underlays if hi - lo >= SHORT_COLUMN else ():
-            parts.append(_UNDERLAY[kind](column, s, how))
-        parts.append(top_stitches(column.rows, how, rng))
-    return NeedlePoints.concat(parts)
+            under = _UNDERLAY[kind](column, s, how)
+            parts.append(under)
+            inward.append(np.zeros((len(under), 2)))
+        top, room = top_points(column.rows, how, rng)
+        parts.append(top)
+        inward.append(room)
+    merged = NeedlePoints.concat(parts)
+    if not len(merged):
+        return merged
+    widths = np.concatenate([c.rows.left + c.rows.right for c in columns if len(c.rows)] or [np.zeros(1)])
+    # Where the spacing asked is itself too dense, it is warned about, not hidden.
+    if straight_density(how.spacing, float(np.median(widths))) <= DENSITY_LIMIT:
+        points, keep = relieve_crowding(merged.points, merged.roles, np.concatenate(inward),
+                                        lambda rows, at: stroke_sides(stroke, at, merged.t[rows]),
+                                        max_gap=2.0 * how.underlay_stitch_length)
+        merged = NeedlePoints(points, merged.t, merged.roles).take(keep)
+    return split_body(merged, how.max_stitch - 2 * SNAP_ALLOWANCE, rng if how.random_phase else None)
 
 
-def top_stitches(rows: Rows, how: ColumnStitching, rng: np.random.Generator | None = None) -> NeedlePoints:
-    """Rail to rail across `rows`, alternating sides, with short stitches (module doc)."""
+def split_body(needles: NeedlePoints, max_length: float, rng: np.random.Generator | None = None) -> NeedlePoints:
+    """`needles` with each run of top stitches split where longer than `max_length` mm."""
+    body = np.concatenate([[False], needles.roles == BODY, [False]])
+    edges = np.flatnonzero(np.diff(body.astype(int)))
+    pieces, last = [], 0
+    for a, b in zip(edges[::2], edges[1::2]):
+        pieces.append(needles.take(np.arange(last, a)))
+        points, t = split_long(needles.points[a:b], needles.t[a:b], max_length, rng)
+        pieces.append(NeedlePoints.of(points, t, BODY))
+        last = b
+    pieces.append(needles.take(np.arange(last, len(needles))))
+    return NeedlePoints.concat(pieces)
+
+
+def top_points(rows: Rows, how: ColumnStitching,
+               rng: np.random.Generator | None = None) -> tuple[NeedlePoints, np.ndarray]:
+    """Rail to rail across `rows`, alternating sides, with short stitches (module doc), not
+    yet split; and how far (N, 2) mm each point may still move: inset towards its row's
+    centre (to MAX_INSET of its width), or on a cut end, on under the column over it."""
     n = len(rows)
     side = np.where(np.arange(n) % 2 == 0, 1.0, -1.0)
     width = rows.left + rows.right
@@ -113,9 +150,15 @@ def top_stitches(rows: Rows, how: ColumnStitching, rng: np.random.Generator | No
     offset = offset - side * depth
     points = rows.centre + rows.normal * offset[:, None]
     points = _keep_holes_apart(points, rows, side, offset, step, width, how.min_gap)
-    points, t = split_long(points, rows.t, how.max_stitch - 2 * SNAP_ALLOWANCE,
-                            rng if how.random_phase else None)
-    return NeedlePoints.of(points, t, BODY)
+    now = np.einsum("ij,ij->i", points - rows.centre, rows.normal)
+    deepest = side * np.maximum(reach - MAX_INSET * width, 0.0)
+    room = np.where(side * (now - deepest) > 0, deepest - now, 0.0)
+    # A point on a cut end (under the column sewn on top of this one) may instead run on
+    # deeper under it: away from that column's edge, where its own needle points crowd.
+    full = np.where(side > 0, rows.reach[:, 0], rows.reach[:, 1])
+    cut = full > reach + 1e-6
+    room = np.where(cut, side * np.minimum(full - side * now, RUN_UNDER), room)
+    return NeedlePoints.of(points, rows.t, BODY), rows.normal * room[:, None]
 
 
 def _keep_holes_apart(points, rows: Rows, side, offset, step, width, min_gap) -> np.ndarray:

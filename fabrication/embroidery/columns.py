@@ -10,8 +10,10 @@ never sparser than asked; the inside crowds and gets short stitches).
 Corners (Ink/Stitch's stroke-to-satin joins them with the path's line join, mitred up to a
 mitre limit): a corner whose mitre stays within `mitre_limit` half widths of the corner point
 is mitred, the column before it running on to the mitre line and the one after starting
-there; a sharper one is split: the column before runs on by its half width (covering the
-corner's round outside) and the column after starts at the corner, whole. In both, the rows
+there; a sharper one is split: the column before ends at the corner and the column after
+starts with a round cap that runs in by its half width ahead of the corner, covering the
+corner's round outside (a round pen's tip) on top, so no remnant of the column before
+shows beyond the tip. In both, the rows
 of the column before that lie under the column after are cut back to `overlap` inside its
 edge: each place is covered once, with no gap between the two (no slit) and no second
 layer (no pile-up). A column cut away entirely (a spike drawn out and back) is sewn by the
@@ -55,7 +57,9 @@ class Rows:
     """Rows across one column, in sewing order. centre (N, 2) mm; normal (N, 2) unit, to
     the left of the direction of travel; left / right (N,) mm from the centre to each rail
     (pull compensation included); t (N,) the stroke's parameter (rows that run on past a
-    corner keep the corner's); s (N,) arc length mm along the stroke (likewise clamped)."""
+    corner keep the corner's); s (N,) arc length mm along the stroke (likewise clamped);
+    full (N, 2) mm: the left and right reach from the centre before the rows were cut back
+    under a later column (None: not cut), how far a cut end may run on under it."""
 
     centre: np.ndarray
     normal: np.ndarray
@@ -63,6 +67,7 @@ class Rows:
     right: np.ndarray
     t: np.ndarray
     s: np.ndarray
+    full: np.ndarray | None = None
 
     def __len__(self) -> int:
         return len(self.centre)
@@ -75,14 +80,30 @@ class Rows:
     def right_points(self) -> np.ndarray:
         return self.centre - self.normal * self.right[:, None]
 
+    @property
+    def reach(self) -> np.ndarray:
+        """(N, 2) the left and right reach before any cut (`full`, or left and right)."""
+        return self.full if self.full is not None else np.column_stack([self.left, self.right])
+
     def take(self, index) -> "Rows":
         return Rows(self.centre[index], self.normal[index], self.left[index], self.right[index], self.t[index],
-                    self.s[index])
+                    self.s[index], None if self.full is None else self.full[index])
+
+    def recentred(self, index: np.ndarray, mid: np.ndarray, left: np.ndarray, right: np.ndarray) -> "Rows":
+        """These rows with rows `index` cut: their centres moved by `mid` (mm along the
+        normal) and their reach now `left` / `right`; the reach before the cut is kept."""
+        centre, new_left, new_right, full = self.centre.copy(), self.left.copy(), self.right.copy(), self.reach.copy()
+        centre[index] += self.normal[index] * mid[:, None]
+        new_left[index], new_right[index] = left, right
+        full[index, 0] -= mid
+        full[index, 1] += mid
+        return Rows(centre, self.normal, new_left, new_right, self.t, self.s, full)
 
     @staticmethod
     def concat(parts: "list[Rows]") -> "Rows":
         fields = ("centre", "normal", "left", "right", "t", "s")
-        return Rows(*(np.concatenate([getattr(p, f) for p in parts]) for f in fields))
+        full = None if all(p.full is None for p in parts) else np.concatenate([p.reach for p in parts])
+        return Rows(*(np.concatenate([getattr(p, f) for p in parts]) for f in fields), full)
 
 
 @dataclass(frozen=True, eq=False)
@@ -170,7 +191,7 @@ def column_rows(stroke: Stroke, curve: DenseCurve, half_at, lo: float, hi: float
                 before: float = 0.0, after: float = 0.0, cap: bool = False) -> Rows:
     """Rows of the column covering arc lengths [lo, hi] mm of `stroke`, running on straight
     `before` mm ahead of lo and `after` mm past hi (along the end directions; `cap`: the
-    rows past hi narrow to a round cap).
+    rows ahead of lo narrow to a round cap).
 
     half_at: arc lengths (n,) -> half widths (n,) mm. Rows are spaced so that the longer
     rail has one every `spacing` / 2 (module doc), an odd number of gaps when there is room
@@ -199,9 +220,9 @@ def column_rows(stroke: Stroke, curve: DenseCurve, half_at, lo: float, hi: float
                 left=np.interp(at, fine, left), right=np.interp(at, fine, right), t=curve.t_at(at), s=at)
     parts = [rows]
     if before > 1e-9:
-        parts.insert(0, _run_on(rows.take([0]), -direction[0], before, step, ahead=False))
+        parts.insert(0, _run_on(rows.take([0]), -direction[0], before, step, ahead=False, round_cap=cap))
     if after > 1e-9:
-        parts.append(_run_on(rows.take([-1]), direction[-1], after, step, ahead=True, round_cap=cap))
+        parts.append(_run_on(rows.take([-1]), direction[-1], after, step, ahead=True))
     return Rows.concat(parts) if len(parts) > 1 else rows
 
 
@@ -263,7 +284,7 @@ def cut_rows(rows: Rows, cover, overlap: float) -> Rows:
     if not len(hit):
         return rows
     keep = np.ones(len(rows), dtype=bool)
-    centre, left, right = rows.centre.copy(), rows.left.copy(), rows.right.copy()
+    cut, mids, lefts, rights = [], [], [], []
     for i, free in zip(hit.tolist(), shapely.difference(lines[hit], cover)):
         parts = [g for g in getattr(free, "geoms", [free]) if not g.is_empty]
         piece = max(parts, key=lambda g: g.length) if parts else None
@@ -280,10 +301,13 @@ def cut_rows(rows: Rows, cover, overlap: float) -> Rows:
         if hi < rows.left[i] - 1e-6:
             hi = min(rows.left[i], hi + overlap)
         mid = 0.5 * (lo + hi)
-        centre[i] = rows.centre[i] + n * mid
-        left[i], right[i] = hi - mid, mid - lo
-    cut = Rows(centre, rows.normal, left, right, rows.t, rows.s)
-    return cut.take(np.flatnonzero(keep))
+        cut.append(i)
+        mids.append(mid)
+        lefts.append(hi - mid)
+        rights.append(mid - lo)
+    if cut:
+        rows = rows.recentred(np.array(cut), np.array(mids), np.array(lefts), np.array(rights))
+    return rows.take(np.flatnonzero(keep))
 
 
 def _joined(corners: list[Corner], half_at) -> tuple[list[Corner], list[tuple[float, float]]]:
@@ -324,9 +348,9 @@ def stroke_columns(stroke: Stroke, curve: DenseCurve, half_at, spacing: float, *
             runs[k + 1][0] = reach * h
             mitres[k] = corner
         else:
-            runs[k][1] = h  # a round cap over the corner's outside
+            runs[k + 1][0] = h  # a round cap over the corner's outside, sewn on top
     rows = [column_rows(stroke, curve, half_at, starts[k], cuts[k + 1], spacing, before=runs[k][0],
-                        after=runs[k][1], cap=k < len(corners) and k not in mitres)
+                        after=runs[k][1], cap=k > 0 and k - 1 not in mitres)
             for k in range(len(cuts) - 1)]
     # Each side of a mitre stops at the mitre line (the one before runs on under the one
     # after by `overlap`); then the column before every corner is cut back under the one
@@ -349,7 +373,7 @@ def stroke_columns(stroke: Stroke, curve: DenseCurve, half_at, spacing: float, *
             later = [r for r in later if len(r) > 1]
             if later:
                 rows[i] = cut_rows(rows[i], shapely.union_all([_cover_area(r) for r in later]), overlap)
-    _thin_crowded(rows)
+    _thin_crowded(rows, spacing)
     columns = []
     for k, r in enumerate(rows):
         if starts[k] > cuts[k]:  # the jog before this column: walked along its centre
@@ -358,11 +382,13 @@ def stroke_columns(stroke: Stroke, curve: DenseCurve, half_at, spacing: float, *
     return columns
 
 
-def _thin_crowded(rows: list[Rows]) -> None:
+def _thin_crowded(rows: list[Rows], spacing: float) -> None:
     """In place: rows whose rail points crowd (more than CROWDED needle points of other rows
     within DENSITY_RADIUS mm: the inside of a tight bend, the ground where corners meet) are
-    left out, in sewing order, while they still crowd. Whole rows go, so the sides still
-    alternate; only the rows whose points crowd at first are visited."""
+    left out, in sewing order, while they still crowd, and only where the rows kept either
+    side of one lie within `spacing` mm of each other on both rails (the outside of the
+    bend stays covered: no slit there). Whole rows go, so the sides still alternate; only
+    the rows whose points crowd at first are visited."""
     sizes = [len(r) for r in rows]
     if sum(sizes) < 2:
         return
@@ -377,6 +403,7 @@ def _thin_crowded(rows: list[Rows]) -> None:
     if count.max(initial=0) <= 2 * CROWDED:
         return
     alive = np.ones(row_of.max() + 1, dtype=bool)
+    column_of = np.repeat(np.arange(len(sizes)), sizes)
     suspects = np.unique(row_of[count > 2 * CROWDED]).tolist()
     for row in suspects:
         mine = np.flatnonzero(row_of == row)
@@ -387,7 +414,7 @@ def _thin_crowded(rows: list[Rows]) -> None:
             if int(np.count_nonzero(alive[others] & (others != row))) > 2 * CROWDED:
                 crowded = True
                 break
-        if crowded:
+        if crowded and _gap_closed(ends, row_of, column_of, alive, row, spacing):
             alive[row] = False
     base = 0
     for j, n in enumerate(sizes):
@@ -396,6 +423,21 @@ def _thin_crowded(rows: list[Rows]) -> None:
             if len(keep) < n:
                 rows[j] = rows[j].take(keep)
             base += n
+
+
+def _gap_closed(ends: np.ndarray, row_of: np.ndarray, column_of: np.ndarray, alive: np.ndarray, row: int,
+                spacing: float) -> bool:
+    """Whether the rows kept before and after `row` in its column lie within `spacing` mm of
+    each other on both rails (`ends`: every row's left then right rail point, by `row_of`)."""
+    before, after = row - 1, row + 1
+    while before >= 0 and column_of[before] == column_of[row] and not alive[before]:
+        before -= 1
+    while after < len(alive) and column_of[after] == column_of[row] and not alive[after]:
+        after += 1
+    if before < 0 or after >= len(alive) or column_of[before] != column_of[row] or column_of[after] != column_of[row]:
+        return False  # a column's first and last rows stay
+    a, b = ends[row_of == before], ends[row_of == after]
+    return bool(np.max(np.linalg.norm(a - b, axis=1)) <= spacing + 1e-9)
 
 
 def _within(rows: Rows, point: np.ndarray, reach: float) -> Rows:
@@ -423,16 +465,20 @@ def _cut_at_line(rows: Rows, corner: Corner, *, after: bool, margin: float, with
     near = np.abs(rows.s - corner.s) <= within
     fl, fr = np.where(near, fl, 1.0), np.where(near, fr, 1.0)
     keep = (fl > 1e-9) | (fr > 1e-9)
-    centre, left, right = rows.centre.copy(), rows.left.copy(), rows.right.copy()
-    for i in np.flatnonzero(keep & ((fl < 0) | (fr < 0))).tolist():
+    cut = np.flatnonzero(keep & ((fl < 0) | (fr < 0)))
+    mids, lefts, rights = [], [], []
+    for i in cut.tolist():
         # the row from its right point (offset -right) to its left (+left), cut where f = 0
-        a, b_ = -right[i], left[i]
+        a, b_ = -rows.right[i], rows.left[i]
         x = a + (b_ - a) * (0.0 - fr[i]) / (fl[i] - fr[i])
         lo, hi = (x, b_) if fr[i] < 0 else (a, x)
         mid = 0.5 * (lo + hi)
-        centre[i] = rows.centre[i] + rows.normal[i] * mid
-        left[i], right[i] = hi - mid, mid - lo
-    return Rows(centre, rows.normal, left, right, rows.t, rows.s).take(np.flatnonzero(keep))
+        mids.append(mid)
+        lefts.append(hi - mid)
+        rights.append(mid - lo)
+    if len(cut):
+        rows = rows.recentred(cut, np.array(mids), np.array(lefts), np.array(rights))
+    return rows.take(np.flatnonzero(keep))
 
 
 def _near(rows: Rows, corner: Corner, other: Rows) -> Rows:

@@ -102,6 +102,9 @@ def split_long(units: np.ndarray, kinds: np.ndarray, params: np.ndarray,
     prev = units[np.maximum(owner - 1, 0)]
     # floor(k * d / n) steps differ by at most ceil(d / n) <= max_units per axis.
     new_units = prev + np.floor((units[owner] - prev) * frac[:, None] + 0.5).astype(np.int64)
+    # A row's last piece is the row itself, with its own parameter (the row before may be a
+    # jump or trim, whose parameter is NaN: it must not reach the rows after it).
     prev_param = params[np.maximum(owner - 1, 0)]
-    new_params = prev_param + (params[owner] - prev_param) * frac
+    last = k == pieces[owner]
+    new_params = np.where(last, params[owner], prev_param + (params[owner] - prev_param) * np.where(last, 0.0, frac))
     return new_units, new_params, owner

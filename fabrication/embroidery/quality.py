@@ -114,14 +114,20 @@ def needle_sides(plan, *, centre: float = 0.15) -> np.ndarray:
         return sides
     for k in np.unique(plan.strokes[plan.strokes >= 0]):
         rows = np.flatnonzero(plan.strokes == k)
-        t = np.clip(plan.params[rows] - k, 0.0, 1.0)
-        stroke = plan.sewn.strokes[int(k)]
-        offset = plan.points[rows] - stroke.points_at(t)
-        tangent = stroke.tangents_at(t)
-        cross = tangent[:, 0] * offset[:, 1] - tangent[:, 1] * offset[:, 0]
-        far = np.linalg.norm(offset, axis=1) > centre
-        sides[rows] = np.where(far, np.sign(cross), 0).astype(int)
+        sides[rows] = stroke_sides(plan.sewn.strokes[int(k)], plan.points[rows], plan.params[rows] - k,
+                                   centre=centre)
     return sides
+
+
+def stroke_sides(stroke, points: np.ndarray, t: np.ndarray, *, centre: float = 0.15) -> np.ndarray:
+    """(N,) int side of `stroke` of needle points `points` (N, 2) mm made at its parameters
+    `t` (N,): +1 left, -1 right, 0 within `centre` mm of the curve."""
+    t = np.clip(t, 0.0, 1.0)
+    offset = points - stroke.points_at(t)
+    tangent = stroke.tangents_at(t)
+    cross = tangent[:, 0] * offset[:, 1] - tangent[:, 1] * offset[:, 0]
+    far = np.linalg.norm(offset, axis=1) > centre
+    return np.where(far, np.sign(cross), 0).astype(int)
 
 
 def repeated_holes(plan, *, gap: float = HOLE_GAP, window: int = HOLE_WINDOW) -> np.ndarray:
@@ -152,8 +158,10 @@ def hole_places(plan, rows: np.ndarray) -> tuple[Place, ...]:
     return _places(points, counts, 2 * DENSITY_RADIUS)
 
 
-def where(places: tuple[Place, ...], most: int = 3) -> str:
-    """'at (x, y) mm (8), (x, y) mm (7) and 2 more places' for a warning."""
+def where(places: tuple[Place, ...], most: int = 12) -> str:
+    """Where a warning's problem lies: every place, 'at (x, y) mm (8), (x, y) mm (7)'; past
+    `most` places, how many and the first `most` of them: 'at 15 places, the first 12: ...'."""
     shown = ", ".join(f"{p} ({p.count})" for p in places[:most])
-    more = len(places) - most
-    return f"at {shown}" + (f" and {more} more place{'s' if more > 1 else ''}" if more > 0 else "")
+    if len(places) <= most:
+        return f"at {shown}"
+    return f"at {len(places)} places, the first {most}: {shown}"

@@ -10,8 +10,8 @@ their defaults are Ink/Stitch's satin column's (short stitches 15 % below 0.25 m
 0.4 mm, underlays with a 3 mm stitch, contour inset 0.4 mm, zigzag underlay every 3 mm at
 half the contour inset), except where noted:
 
-- underlay 'auto' (Ink/Stitch has none unless asked): a centre walk for columns up to 2 mm
-  wide, an edge walk to 4 mm, edge walk and zigzag underlay ("German underlay") above,
+- underlay 'auto' (Ink/Stitch has none unless asked): none below 1 mm, a centre walk for
+  columns up to 2 mm wide, an edge walk to 4 mm, edge walk and zigzag underlay ("German underlay") above,
   judged on the stroke's median width (the rule of thumb digitizers use);
 - max_stitch_length 7 mm (Ink/Stitch: no limit): wider rows are split, since a longer
   stitch lies loose (the planner's LOOSE_STITCH);
@@ -39,9 +39,11 @@ from onestroke.errors import InputError
 from onestroke.ranges import Range, check_ranges, ranged
 from vectorize.stroke import Stroke
 
-# 'auto' underlay: up to CENTRE_ONLY mm a centre walk, up to EDGE_ONLY an edge walk, wider
-# both edge walk and zigzag underlay.
-CENTRE_ONLY, EDGE_ONLY = 2.0, 4.0
+# 'auto' underlay: none below NARROW mm (a walk down the middle of so narrow a column
+# crowds its needle points beyond the density limit, and it needs no support), up to
+# CENTRE_ONLY mm a centre walk, up to EDGE_ONLY an edge walk, wider both edge walk and
+# zigzag underlay.
+NARROW, CENTRE_ONLY, EDGE_ONLY = 1.0, 2.0, 4.0
 
 
 def parse_underlay(value) -> tuple[str, ...] | str:
@@ -144,6 +146,8 @@ class SatinOptions:
         """The underlay kinds for a column about `width` mm wide."""
         if self.underlay != "auto":
             return self.underlay  # type: ignore[return-value]
+        if width < NARROW:
+            return ()
         if width <= CENTRE_ONLY:
             return ("center",)
         return ("edge",) if width <= EDGE_ONLY else ("edge", "zigzag")

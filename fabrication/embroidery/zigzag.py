@@ -25,10 +25,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from fabrication.embroidery.column_stitches import split_long
+from fabrication.embroidery.column_stitches import ColumnStitching, column_needles, split_body
+from fabrication.embroidery.columns import CORNER_ANGLE, MITRE_LIMIT, OVERLAP, find_corners, stroke_columns
+from fabrication.embroidery.crowding import relieve_crowding, straight_density
 from fabrication.embroidery.needles import BODY, GRID, SNAP_ALLOWANCE, UNDERLAY, NeedlePoints
 from fabrication.embroidery.running import (DENSE_TOLERANCE, STITCH_LENGTH, TOLERANCE, RunningOptions,
                                             running_stitch)
+from fabrication.embroidery.quality import DENSITY_LIMIT, stroke_sides
 from fabrication.embroidery.sampling import dense_curve
 from onestroke.errors import InputError
 from onestroke.ranges import Range, check_ranges, ranged
@@ -47,6 +50,8 @@ ZIG_MAX_STITCH = Range(1.0, None, unit="mm", name="zigzag max stitch", low_open=
 # The inside reach stays below this fraction of the curve radius, so inner points never
 # pass the centre of curvature (they would sew loops and run backwards).
 MAX_INNER_REACH = 0.75
+# A crowded point is inset towards the curve by at most this share of its reach.
+MAX_INSET = 0.5
 UNDERLAYS = ("center", "edge", "zigzag", "none")
 
 
@@ -61,7 +66,9 @@ class ZigzagOptions:
     short_stitch_distance / short_stitch_inset: inset every other inner point by this
     fraction of the reach where inner points come closer than that distance; min_gap: the
     closest two needle points may come on one rail (0.35 mm keeps them >= 0.2 mm apart
-    after snapping to the files' 0.1 mm grid); max_stitch: longer zigs are split."""
+    after snapping to the files' 0.1 mm grid); max_stitch: longer zigs are split;
+    corner_angle (degrees), mitre_limit (half widths), overlap (mm): corners, as satin's
+    (`fabrication.embroidery.columns`)."""
 
     width: float = ranged(2.0, STITCH_WIDTH)
     spacing: float = ranged(0.4, SPACING)
@@ -76,6 +83,9 @@ class ZigzagOptions:
     min_gap: float = 0.35
     max_stitch: float = ranged(12.1, ZIG_MAX_STITCH)
     tolerance: float = ranged(0.2, TOLERANCE)
+    corner_angle: float = ranged(45.0, CORNER_ANGLE)
+    mitre_limit: float = ranged(2.0, MITRE_LIMIT)
+    overlap: float = ranged(0.3, OVERLAP)
 
     def __post_init__(self) -> None:
         check_ranges(self)
@@ -106,12 +116,17 @@ class ZigzagOptions:
         return self.underlay_kind != "none"
 
 
-def _drop_crowded(points: np.ndarray, min_gap: float, inner: np.ndarray, *, window: int = 6) -> np.ndarray:
+def _inset_crowded(points: np.ndarray, centre: np.ndarray, min_gap: float, inner: np.ndarray, step: float, *,
+                   window: int = 6) -> np.ndarray:
     """Mask of points to keep so that no `inner` point comes within `min_gap` of the last
     `window` kept points on its rail (rails alternate: even and odd indices; on a very
     tight curve the inner rail winds round a small circle, so not only the previous point
-    can be near). Points outside curves or on straight parts keep the requested spacing.
-    Only crowded points and the ones after a dropped point are visited one by one."""
+    can be near). A crowded point is first inset towards its centre point `centre` (N, 2),
+    `step` (a share of its reach) at a time, up to MAX_INSET of the reach (in place, in
+    `points`): a point left out would leave its side bare between its neighbours, a slit;
+    only one that cannot be cleared so is left out. Points outside curves or on straight
+    parts keep the requested spacing. Only crowded points and the ones after a changed
+    point are visited one by one."""
     n = len(points)
     keep = np.ones(n, dtype=bool)
     nearest = np.full(n, np.inf)
@@ -121,23 +136,35 @@ def _drop_crowded(points: np.ndarray, min_gap: float, inner: np.ndarray, *, wind
     work = np.flatnonzero((nearest < min_gap) & inner).tolist()
     heapq.heapify(work)
     queued = set(work)
+    steps = np.arange(1, int(MAX_INSET / step + 1e-9) + 1) * step if step > 0 else np.zeros(0)
     while work:
         i = heapq.heappop(work)
         if i == n - 1 or not inner[i]:
             continue  # the end point anchors the lock
         kept = list(itertools.islice((k for k in range(i - 2, -1, -2) if keep[k]), window))
-        if kept and np.min(np.hypot(*(points[kept] - points[i]).T)) < min_gap:
+        if not kept or np.min(np.hypot(*(points[kept] - points[i]).T)) >= min_gap:
+            continue
+        rail = points[i].copy()
+        for share in steps:
+            q = rail + (centre[i] - rail) * share
+            if np.min(np.hypot(*(points[kept] - q).T)) >= min_gap:
+                points[i] = q
+                break
+        else:
             keep[i] = False
-            for nxt in range(i + 2, min(n, i + 2 * window + 1), 2):
-                if inner[nxt] and nxt not in queued:
-                    queued.add(nxt)
-                    heapq.heappush(work, nxt)
+        for nxt in range(i + 2, min(n, i + 2 * window + 1), 2):
+            if inner[nxt] and nxt not in queued:
+                queued.add(nxt)
+                heapq.heappush(work, nxt)
     return keep
 
 
 def zigzag_stitch(stroke: Stroke, options: ZigzagOptions = ZigzagOptions()) -> NeedlePoints:
-    """Zigzag along `stroke` (mm), preceded by a there-and-back centre walk when wide."""
+    """Zigzag along `stroke` (mm), preceded by a there-and-back centre walk when wide; a
+    stroke with corners is sewn as satin's columns are (module doc)."""
     curve = dense_curve(stroke, DENSE_TOLERANCE)
+    if find_corners(stroke, curve, np.full(len(curve.s), options.reach), options.corner_angle):
+        return _cornered(stroke, curve, options)
     length = curve.length
     steps = max(1, int(round(2.0 * length / options.spacing)))
     if steps % 2 == 0:
@@ -166,17 +193,47 @@ def zigzag_stitch(stroke: Stroke, options: ZigzagOptions = ZigzagOptions()) -> N
     short = inner & (rail_gap < options.short_stitch_distance) & ((np.arange(len(s)) // 2) % 2 == 1)
     reach[short] *= 1.0 - options.short_stitch_inset
     points = centre + normal * (side * reach)[:, None]
-    # Inner points of a real curve (radius under 50 mm) may be dropped when crowded.
-    keep = _drop_crowded(points, options.min_gap, inner & (np.abs(kappa) > 0.02))
-    points, t = points[keep], t[keep]
-    points, t = split_long(points, t, options.max_stitch - 2 * SNAP_ALLOWANCE)
+    # Inner points of a real curve (radius under 50 mm) may be inset or dropped when crowded.
+    keep = _inset_crowded(points, centre, options.min_gap, inner & (np.abs(kappa) > 0.02), options.short_stitch_inset)
+    points, t, centre = points[keep], t[keep], centre[keep]
     zig = NeedlePoints.of(points, t, BODY)
+    room = (centre - points) * MAX_INSET
     # An underlay goes there and back and ends on the start; along a stroke no longer than
     # one underlay stitch it would re-enter its first hole two stitches later (a knot on a
     # short stroke), and so short a column does not pucker without it.
-    if not options.has_underlay or length <= options.underlay_stitch_length:
-        return zig
-    return NeedlePoints.concat([_underlay(stroke, curve, options), zig])
+    if options.has_underlay and length > options.underlay_stitch_length:
+        under = _underlay(stroke, curve, options)
+        zig = NeedlePoints.concat([under, zig])
+        room = np.concatenate([np.zeros((len(under), 2)), room])
+    # Where the needle points still crowd past the density limit or re-enter a hole, they
+    # are relieved (`crowding`: underlay points left out, zigzag points inset); where the
+    # spacing asked is itself too dense, it is warned about, not hidden.
+    if straight_density(options.spacing, 2.0 * options.reach) <= DENSITY_LIMIT:
+        points, keep = relieve_crowding(zig.points, zig.roles, room,
+                                        lambda rows, at: stroke_sides(stroke, at, zig.t[rows]),
+                                        max_gap=2.0 * options.underlay_stitch_length)
+        zig = NeedlePoints(points, zig.t, zig.roles).take(keep)
+    return split_body(zig, options.max_stitch - 2 * SNAP_ALLOWANCE)
+
+
+def _cornered(stroke: Stroke, curve, options: ZigzagOptions) -> NeedlePoints:
+    """Zigzag along a stroke with corners: the constant-width columns of satin's engine,
+    mitred or split at the corners (`fabrication.embroidery.columns`)."""
+    def half_at(s: np.ndarray) -> np.ndarray:
+        return np.full(len(s), options.reach)
+
+    columns = stroke_columns(stroke, curve, half_at, options.spacing, corner_angle=options.corner_angle,
+                             mitre_limit=options.mitre_limit, overlap=options.overlap)
+    kind = options.underlay_kind if curve.length > options.underlay_stitch_length else "none"
+    # The zigzag's underlay inset counts from the drawn edge, the columns' from the rail.
+    inset = options.reach - max(0.0, options.width / 2.0 - options.underlay_inset)
+    how = ColumnStitching(
+        spacing=options.spacing, short_stitch_distance=options.short_stitch_distance,
+        # the zigzag's inset is a share of its reach, the columns' of the row's width (twice it)
+        short_stitch_inset=options.short_stitch_inset / 2.0, min_gap=options.min_gap, max_stitch=options.max_stitch,
+        underlays=() if kind == "none" else (kind,), underlay_stitch_length=options.underlay_stitch_length,
+        edge_inset=inset, zigzag_inset=inset, underlay_spacing=options.underlay_spacing, tolerance=options.tolerance)
+    return column_needles(stroke, curve, columns, how)
 
 
 def _offset(stroke: Stroke, t: np.ndarray, offset: np.ndarray) -> np.ndarray:

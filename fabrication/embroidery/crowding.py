@@ -1,0 +1,247 @@
+"""Needle points of a column stroke (satin or zigzag) held within the density limit.
+
+Where a column's needle points crowd more than `quality.DENSITY_LIMIT` within
+`quality.DENSITY_RADIUS` (the inside of a tight bend, a narrow column's centre walk, two
+columns meeting at a corner), the points there are relieved, cheapest first:
+
+1. underlay points are left out (the walk then takes one longer stitch, at most
+   `max_gap` mm, which the top stitches cover);
+2. top points are inset towards the row's centre (Ink/Stitch's short stitches made deeper),
+   a quarter of their room at a time, to where no point around exceeds the limit and the
+   needle stays clear of its last and next holes on that side.
+
+What cannot be relieved so is left to the stats' warning, which names the place. Only
+the neighbourhoods of dense points are visited (a tree query finds them), so a stroke
+with none costs one density count.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from scipy.spatial import cKDTree
+
+from fabrication.embroidery.needles import BODY, SNAP_ALLOWANCE, UNDERLAY
+from fabrication.embroidery.quality import DENSITY_LIMIT, DENSITY_RADIUS, HOLE_GAP, HOLE_WINDOW
+
+# Points are counted with this margin over the radius: snapping to the files' grid may
+# bring two points closer by up to twice SNAP_ALLOWANCE; half of that is kept in reserve
+# (the whole would thin columns that are sound as written).
+MARGIN = SNAP_ALLOWANCE
+# Inset steps tried, as shares of a point's room towards its row's centre.
+STEPS = (0.25, 0.5, 0.75, 1.0)
+# An inset needle keeps this far (mm) from the holes around it on its side of the line;
+# one closer than REENTER to a recent hole re-enters it (once snapped to the grid).
+CLEAR = HOLE_GAP + 2.0 * SNAP_ALLOWANCE
+REENTER = HOLE_GAP + SNAP_ALLOWANCE
+
+
+def relieve_crowding(points: np.ndarray, roles: np.ndarray, inward: np.ndarray, sides, *,
+                     max_gap: float, limit: int = DENSITY_LIMIT,
+                     radius: float = DENSITY_RADIUS) -> tuple[np.ndarray, np.ndarray]:
+    """(points (N, 2) mm, keep (N,) bool) with the crowding relieved (module doc).
+
+    points (N, 2) mm in sewing order; roles (N,) (UNDERLAY points may be left out: not the
+    first or last point, and only while the stitch that replaces their two stays within
+    `max_gap` mm); inward (N, 2) mm: how far each point may move towards its
+    row's centre (zeros: it stays); sides: (rows (M,), points (M, 2)) -> (M,) the side of
+    the line each is on (+1 / -1, 0 on the line: `quality.stroke_sides`), for the clearance
+    from its last and next holes on that side.
+
+    Last, a needle that re-enters one of the last HOLE_WINDOW holes on its side (the
+    repeated holes of `quality`) is inset where that clears it, or left out.
+    """
+    points = np.asarray(points, dtype=float).copy()
+    keep = np.ones(len(points), dtype=bool)
+    if not len(points):
+        return points, keep
+    side = _Sides(points, sides)
+    _relieve_density(points, keep, roles, inward, side, sides, max_gap, limit, radius + MARGIN)
+    _clear_holes(points, keep, roles, inward, side, sides, max_gap)
+    return points, keep
+
+
+class _Sides:
+    """The side of the line of each point, found when first asked (most never are)."""
+
+    UNKNOWN = 9
+
+    def __init__(self, points: np.ndarray, sides) -> None:
+        self.points, self.sides = points, sides
+        self.known = np.full(len(points), self.UNKNOWN, dtype=int)
+
+    def __getitem__(self, rows):
+        wanted = np.atleast_1d(rows)
+        ask = np.unique(wanted[self.known[wanted] == self.UNKNOWN])
+        if len(ask):
+            self.known[ask] = np.asarray(self.sides(ask, self.points[ask]), dtype=int)
+        return self.known[rows]
+
+    def __setitem__(self, row: int, value: int) -> None:
+        self.known[row] = value
+
+
+def straight_density(spacing: float, width: float, radius: float = DENSITY_RADIUS) -> int:
+    """Needle points within `radius` mm of a rail point of a straight column `width` mm
+    wide sewn at `spacing` mm peak to peak (the same rail every `spacing`, the other rail
+    half a spacing along): what the asked spacing itself makes, before any bend. Where it
+    passes the limit, the spacing asked is too dense and is warned about, not relieved."""
+    k = np.arange(-int(radius / max(spacing, 1e-9)) - 1, int(radius / max(spacing, 1e-9)) + 2)
+    same = np.abs(k * spacing) <= radius + 1e-9
+    other = np.hypot((k + 0.5) * spacing, width) <= radius + 1e-9
+    return int(same.sum() + other.sum())
+
+
+def _relieve_density(points, keep, roles, inward, side, sides, max_gap, limit, reach) -> None:
+    """In place: steps 1 and 2 of the module doc."""
+    # The limit + 1 nearest tell whether a point is dense (as `quality.needle_density`).
+    tree = cKDTree(points, balanced_tree=False, compact_nodes=False)
+    k = min(limit + 1, len(points))
+    distance, _ = tree.query(points, k=k, distance_upper_bound=reach + 1e-9)
+    dense = np.flatnonzero(np.isfinite(distance.reshape(len(points), -1)).sum(axis=1) > limit)
+    if not len(dense):
+        return
+    # The points that may change: within one radius of a dense point; their neighbours
+    # (within another radius) are counted with them.
+    movable = np.unique(np.concatenate(tree.query_ball_point(points[dense], reach)))
+    local = np.unique(np.concatenate(tree.query_ball_point(points[movable], 2.0 * reach)))
+    pts = points[local]
+    alive = np.ones(len(local), dtype=bool)
+    near = _within(pts, pts, reach)
+    count = near.sum(axis=1)
+    can_move = np.isin(local, movable)
+    underlay = (roles[local] == UNDERLAY) & can_move & _droppable(roles, local, len(points))
+
+    def over() -> np.ndarray:
+        return alive & (count > limit)
+
+    # 1. underlay points, the most crowded first, while one of their neighbours is over.
+    while True:
+        o = over()
+        if not o.any():
+            break
+        crowding = (near & o[None, :]).sum(axis=1) * (underlay & alive)
+        choice = int(np.argmax(crowding))
+        if crowding[choice] == 0 or not _gap_ok(points, keep, int(local[choice]), roles, max_gap):
+            if crowding[choice] == 0:
+                break
+            underlay[choice] = False  # its walk would take too long a stitch: try the others
+            continue
+        alive[choice] = False
+        keep[local[choice]] = False
+        count -= near[:, choice]
+        near[choice, :] = False
+        near[:, choice] = False
+        underlay[choice] = False
+
+    # 2. top points inset towards their row's centre.
+    tried = np.zeros(len(local), dtype=bool)
+    while True:
+        o = over()
+        if not o.any():
+            break
+        pull = (near & o[None, :]).sum(axis=1) * (alive & can_move & ~tried)
+        pull *= np.linalg.norm(inward[local], axis=1) > 1e-9
+        choice = int(np.argmax(pull))
+        if pull[choice] == 0:
+            break
+        tried[choice] = True
+        g = int(local[choice])
+        before = int(np.sum(np.maximum(count[alive] - limit, 0)))
+        for share in STEPS:
+            q = points[g] + inward[g] * share
+            q_side = int(sides(np.array([g]), q[None, :])[0])
+            if not _clear(points, keep, side, g, q, q_side):
+                continue
+            new_near = _within(q[None, :], pts, reach)[0] & alive
+            new_near[choice] = True
+            new_count = count - near[choice].astype(int) + new_near.astype(int)
+            new_count[choice] = int(new_near.sum())
+            excess = int(np.sum(np.maximum(new_count[alive] - limit, 0)))
+            if excess < before and not np.any(alive & (new_count > limit) & ~o):
+                points[g] = q
+                side[g] = q_side
+                pts[choice] = q
+                count = new_count
+                near[choice, :] = new_near
+                near[:, choice] = new_near
+                break
+
+
+def _clear_holes(points, keep, roles, inward, side, sides, max_gap) -> None:
+    """In place: needles within HOLE_GAP (and a snap) of one of the last HOLE_WINDOW kept
+    ones on their side are inset clear of them, or left out (module doc)."""
+    n = len(points)
+    for row in _reentering(points, keep, side).tolist():
+        if not keep[row] or roles[row] not in (BODY, UNDERLAY) or row in (0, n - 1) or \
+                _clear(points, keep, side, row, points[row], int(side[row]), ahead=False, gap=REENTER):
+            continue
+        for share in STEPS if np.linalg.norm(inward[row]) > 1e-9 else ():
+            q = points[row] + inward[row] * share
+            q_side = int(sides(np.array([row]), q[None, :])[0])
+            if _clear(points, keep, side, row, q, q_side):
+                points[row], side[row] = q, q_side
+                break
+        else:
+            if roles[row] == BODY or _gap_ok(points, keep, row, roles, max_gap):
+                keep[row] = False
+
+
+def _reentering(points: np.ndarray, keep: np.ndarray, side: np.ndarray) -> np.ndarray:
+    """Rows whose needle comes within REENTER mm of one of the HOLE_WINDOW kept needle
+    points before it on its side; ascending."""
+    rows = np.flatnonzero(keep)
+    p = points[rows]
+    found = []
+    for lag in range(1, HOLE_WINDOW + 1):
+        close = np.flatnonzero(np.linalg.norm(p[lag:] - p[:-lag], axis=1) < REENTER)
+        if len(close):
+            later, earlier = rows[close + lag], rows[close]
+            found.append(later[side[later] == side[earlier]])
+    return np.unique(np.concatenate(found)) if found else np.zeros(0, dtype=np.int64)
+
+
+def _within(a: np.ndarray, b: np.ndarray, reach: float) -> np.ndarray:
+    """(len(a), len(b)) True where a point of `a` lies within `reach` mm of one of `b`."""
+    d = np.linalg.norm(a[:, None, :] - b[None, :, :], axis=2)
+    return d <= reach + 1e-9
+
+
+def _droppable(roles: np.ndarray, rows: np.ndarray, n: int) -> np.ndarray:
+    """(len(rows),) True for underlay rows other than the stroke's first and last point."""
+    return (roles[rows] == UNDERLAY) & (rows > 0) & (rows < n - 1)
+
+
+def _gap_ok(points: np.ndarray, keep: np.ndarray, row: int, roles: np.ndarray, max_gap: float) -> bool:
+    """Whether leaving out underlay `row` keeps the stitch between the kept points before
+    and after it within `max_gap` mm."""
+    lo = row - 1
+    while lo > 0 and not keep[lo]:
+        lo -= 1
+    hi = row + 1
+    while hi < len(points) - 1 and not keep[hi]:
+        hi += 1
+    if not (keep[lo] and keep[hi]):
+        return False
+    return float(np.hypot(*(points[hi] - points[lo]))) <= max_gap
+
+
+def _clear(points: np.ndarray, keep: np.ndarray, side: np.ndarray, row: int, q: np.ndarray, q_side: int, *,
+           ahead: bool = True, gap: float = 0.0) -> bool:
+    """Whether a needle at `q` (on side `q_side`) for `row` keeps `gap` (CLEAR when 0) mm
+    from the last and (`ahead`) next HOLE_WINDOW kept needle points on its side of the line."""
+    others = []
+    k = row - 1
+    while k >= 0 and len(others) < HOLE_WINDOW:
+        if keep[k]:
+            others.append(k)
+        k -= 1
+    k, later = row + 1, 0
+    while ahead and k < len(points) and later < HOLE_WINDOW:
+        if keep[k]:
+            others.append(k)
+            later += 1
+        k += 1
+    others = [k for k in others if side[k] == q_side]
+    if not others:
+        return True
+    return bool(np.min(np.linalg.norm(points[others] - q, axis=1)) >= (gap or CLEAR))
