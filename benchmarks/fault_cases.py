@@ -181,18 +181,23 @@ def item7(cli: Cli, work: Path) -> Iterator[tuple[str, str]]:
     disk = work / "disk"
     disk.mkdir()
 
-    def tiny(size: str, *args, label: str) -> tuple[str, str]:
+    def second_does_not_fit(first: str, *args, label: str) -> tuple[str, str]:
+        """Run once on the real disk to size a tmpfs that holds the first output and one page
+        more, then again on that tmpfs: the second output meets a full disk."""
+        sized = work / "sized"
+        shutil.rmtree(sized, ignore_errors=True)
+        sized.mkdir()
+        cli.run(*[str(a).replace(str(disk), str(sized)) for a in args])
+        size = ((sized / first).stat().st_size + 4095) // 4096 * 4096 + 4096
         rc, _, err, _ = cli.run(*args, mounts=(f"mount -t tmpfs -o size={size} tmpfs {disk}",), listing=disk)
         return label, f"exit {rc}: {first_error(err)}; left: {', '.join(cli.listing()) or 'nothing'}"
 
-    # sizes: the first output fits, the second does not (measured on loops.png: .pes 2.4 kB,
-    # its preview 76 kB; G-code 11 kB, its preview 40 kB; SVG 4 kB, the stage images 8-42 kB)
-    yield tiny("16k", "embroider", png, "-o", disk / "a.pes", "--preview", disk / "a.png",
-         label="embroider --preview, disk full at the preview")
-    yield tiny("16k", "laser", png, "-o", disk / "a.gcode", "--preview", disk / "a.png",
-         label="laser --preview, disk full at the preview")
-    yield tiny("8k", "vectorize", png, "-o", disk / "a.svg", "--debug", disk / "debug",
-         label="vectorize --debug, disk full at the stage images")
+    yield second_does_not_fit("a.pes", "embroider", png, "-o", disk / "a.pes", "--preview", disk / "a.png",
+                              label="embroider --preview, disk full at the preview")
+    yield second_does_not_fit("a.gcode", "laser", png, "-o", disk / "a.gcode", "--preview", disk / "a.png",
+                              label="laser --preview, disk full at the preview")
+    yield second_does_not_fit("a.svg", "vectorize", png, "-o", disk / "a.svg", "--debug", disk / "debug",
+                              label="vectorize --debug, disk full at the stage images")
     batch_in = work / "in-batch"
     rc, out, err, _ = cli.run("batch", batch_in, "-o", disk / "out", "--to", "svg,pes,gcode", "--jobs", "1",
                               mounts=(f"mount -t tmpfs -o size=64k tmpfs {disk}",), listing=disk)
