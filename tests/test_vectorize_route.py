@@ -154,3 +154,18 @@ def test_three_passes_through_one_point_go_straight_through():
         before = stroke.tangents_at(stroke.parameters_at_lengths(s[v[0]] - 4 * WIDTH))
         after = stroke.tangents_at(stroke.parameters_at_lengths(s[v[-1]] + 4 * WIDTH))
         assert float(np.dot(before, after)) > np.cos(np.radians(15))
+
+
+def test_a_long_spike_on_a_closed_loop_is_drawn_once_from_its_tip():
+    # A loop (942 px) with a spike of 60 px out of it: ending the line at the spike's base
+    # (a junction, a poor end) costs less than drawing 6 % of the drawing twice, so the line
+    # starts at the tip and goes round to the base: the shortest line over the ink.
+    centre, radius = np.array([180.0, 200.0]), 150.0
+    t = np.linspace(0, 2 * np.pi, 240)
+    loop = centre + radius * np.c_[np.cos(t), np.sin(t)]
+    tip = loop[0] + [60.0, 0.0]
+    result = vectorize_image(render_polylines([loop, [loop[0], tip]], width=WIDTH), OPTIONS)
+    assert result.report.strokes == 1
+    stroke = result.drawing.strokes[0]
+    assert stroke.length == pytest.approx(2 * np.pi * radius + 60, abs=6 * WIDTH)
+    assert min(np.linalg.norm(stroke.start - tip), np.linalg.norm(stroke.end - tip)) < 2 * WIDTH

@@ -283,6 +283,10 @@ def _order(graph: MedialGraph, ink, options: VectorizeOptions, ends: int, clock:
 # Cost (in stroke widths) of the pen starting or ending at a junction that is not a line
 # ending on another line: a whole spike of up to this length is retraced rather.
 JUNCTION_END = 20.0
+# ... but never more than this share of the whole line per end: avoiding a poor end is not
+# worth drawing more than 1 % of the drawing twice (a long spike on a closed loop then starts
+# at its tip and ends at its base, the shortest line over the ink).
+END_SHARE = 0.01
 
 
 def _junction_end_cost(graph: MedialGraph, node: int, dirs: np.ndarray, w: float) -> float:
@@ -313,6 +317,8 @@ def _single_route(graph: MedialGraph, simple: Simplified, ranked: dict, costs: d
               if n not in simple.retraced}
     end_cost = {n: 3.0 * w for n in v_tips}
     end_cost.update({n: _junction_end_cost(graph, n, dirs[n], w) for n in dirs})
+    most = END_SHARE * sum(b.length for b in graph.branches.values())
+    end_cost = {n: min(cost, most) for n, cost in end_cost.items()}
     end_cost.update(start_at or {})
     routes = plan_routes(graph, {**simple.through, **pairing}, stroke_width=w, directions=dirs, end_cost=end_cost,
                          weight=weight)
