@@ -15,13 +15,17 @@ from functools import lru_cache
 from pathlib import Path
 
 from onestroke.errors import InputError
-from onestroke.ranges import Range
+from onestroke.ranges import Range, check_ranges, ranged
 from onestroke.units import parse_positive_length, parse_size_pair
 
 PROFILE_PATH = Path(__file__).with_name("profiles") / "embroidery.toml"
 # A machine's sewing speed, stitches per minute (home machines 350-1000, industrial ones
 # up to about 1500; 3000 leaves room).
 SPM = Range(100.0, 3000.0, name="--spm")
+# A sewing field's side: home machines sew up to about 400 mm, commercial single heads up to
+# about 500 mm, large-field multi-head frames about 1,200 mm; 1,500 mm leaves room and keeps
+# the densest stitching a request can ask for bounded (the studio answers it within 2 s).
+HOOP_SIDE = Range(0.0, 1500.0, unit="mm", name="--hoop side", low_open=True)
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -29,9 +33,12 @@ class Hoop:
     """A sewing field `width` x `height` in mm, centred on (0, 0)."""
 
     name: str
-    width: float
-    height: float
+    width: float = ranged(100.0, HOOP_SIDE)
+    height: float = ranged(100.0, HOOP_SIDE)
     aliases: tuple[str, ...] = ()
+
+    def __post_init__(self) -> None:
+        check_ranges(self)
 
     def contains(self, bounds: tuple[float, float, float, float], *, slack: float = 1e-9) -> bool:
         """True when the box (xmin, ymin, xmax, ymax) in mm lies inside the field."""

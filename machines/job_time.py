@@ -79,15 +79,34 @@ class JobTime:
         return "bound by GRBL's planner"
 
 
+@dataclass(frozen=True)
+class LinkSchedule:
+    """A job streamed by character counting, in seconds from the first byte sent.
+
+    Per program line (n,): ack (its `ok` is back), arrived (its last byte reached the
+    controller), head (the line the sender waited for before sending it: line i goes out
+    once line head[i] - 1 is answered). Per segment (B,): block_end (it finished moving),
+    planned (it entered the planner), exit_speed (mm/s, leaving it); 0 for segments of
+    zero steps. Everything a line or block after a point reads of the lines and blocks
+    before it is among these (see `machines.job_repeat`).
+    """
+
+    ack: np.ndarray
+    arrived: np.ndarray
+    head: np.ndarray
+    block_end: np.ndarray
+    planned: np.ndarray
+    exit_speed: np.ndarray
+
+
 def link_schedule(program: Program, stats: ProgramStats, kin: Kinematics, *, baud: int, rx_buffer: int,
-                  parse_time: float, latency: float = USB_LATENCY) -> tuple[np.ndarray, np.ndarray]:
+                  parse_time: float, latency: float = USB_LATENCY) -> LinkSchedule:
     """When each line is acknowledged and each block ends, streamed by character counting.
 
     Two interleaved passes: the parser side (each line's arrival over the wire, its parse,
     a free planner block for each of its moves) and the motion side (each block runs when
     the previous one ended and it is planned, with the look-ahead of the blocks planned
     by then: a starved planner must be able to stop after its last block, as GRBL's).
-    Returns (ack (len(program),), block_end (B,)) in seconds from the first byte sent.
     """
     byte_time = BITS_PER_BYTE / float(baud)
     ok_time = latency + OK_BYTES * byte_time
@@ -98,7 +117,8 @@ def link_schedule(program: Program, stats: ProgramStats, kin: Kinematics, *, bau
     # character counting: line i goes out once every line before `head[i]` is answered,
     # the first one from which the unanswered bytes plus line i fit the RX buffer (the
     # answers come in order, so waiting for the newest of them is waiting for all)
-    head = np.minimum(np.searchsorted(total, total[1:] - rx_buffer, side="left"), np.arange(n)).tolist()
+    heads = np.minimum(np.searchsorted(total, total[1:] - rx_buffer, side="left"), np.arange(n))
+    head = heads.tolist()
     wire = (sizes * byte_time).tolist()
     table = block_table(seg.start, seg.end, seg.feed, seg.rapid, seg.stop_before, kin)
     moving = np.flatnonzero(table.keep)
@@ -111,6 +131,8 @@ def link_schedule(program: Program, stats: ProgramStats, kin: Kinematics, *, bau
     planned = [math.inf] * blocks  # when each block entered the planner
     ends = [0.0] * blocks  # when each block finished moving
     ack = [0.0] * n
+    arrival = [0.0] * n
+    exits = [0.0] * blocks
     done_blocks = [0]  # how many blocks have their end time
 
     def parser_side():
@@ -125,7 +147,7 @@ def link_schedule(program: Program, stats: ProgramStats, kin: Kinematics, *, bau
             if arrived < wire_free:
                 arrived = wire_free
             arrived += wire[i]
-            wire_free = arrived
+            wire_free = arrival[i] = arrived
             done = (arrived if arrived >= parser_free else parser_free) + parse_time
             if syncs[i]:  # M3/M4/M5, M8/M9, G4, S without motion: the planner drains first
                 while done_blocks[0] < first[i]:
@@ -161,13 +183,14 @@ def link_schedule(program: Program, stats: ProgramStats, kin: Kinematics, *, bau
             if more > seen:  # blocks planned while this one runs raise its exit speed (GRBL re-plans)
                 profile = _block_profile(b, more, v, length, accel, nominal, max_entry, reach)
         previous_end = ends[b] = start + profile.duration
-        v = profile.v_exit
+        v = exits[b] = profile.v_exit
         done_blocks[0] = b + 1
     for _ in parser:  # lines after the last block (and any left if there are no blocks)
         pass
-    block_end = np.zeros(len(seg))
-    block_end[moving] = ends
-    return np.array(ack), block_end
+    block_end, entered, exit_speed = np.zeros(len(seg)), np.zeros(len(seg)), np.zeros(len(seg))
+    block_end[moving], entered[moving], exit_speed[moving] = ends, planned, exits
+    return LinkSchedule(ack=np.array(ack), arrived=np.array(arrival), head=heads, block_end=block_end,
+                        planned=entered, exit_speed=exit_speed)
 
 
 def _block_profile(b: int, seen: int, v0: float, length, accel, nominal, max_entry, reach):
@@ -192,22 +215,40 @@ def estimate_program_time(program: Program, profile: LaserProfile, *, stats: Pro
         stats = analyze_program(program, settings=settings_from_profile(profile),
                                 planner_blocks=profile.planner_blocks, allow_settings=allow_settings,
                                 progress=progress)
+    schedule = None
+    if link and len(program):
+        schedule = link_schedule(program, stats, profile_kinematics(profile), baud=profile.baud,
+                                 rx_buffer=profile.rx_buffer, parse_time=profile.parse_time)
+    numbers = np.fromiter((n - 1 for n, _ in program.lines), dtype=int, count=len(program))
+    n_lines = max(program.n_lines, max((n for n, _ in program.lines), default=0))
+    return job_time_of(stats, profile, numbers=numbers, n_lines=n_lines,
+                       ack=None if schedule is None else schedule.ack,
+                       block_end=None if schedule is None else schedule.block_end)
+
+
+def profile_kinematics(profile: LaserProfile) -> Kinematics:
+    """The planner model's limits of the machine `profile` describes."""
+    return Kinematics.from_settings(settings_from_profile(profile), planner_blocks=profile.planner_blocks)
+
+
+def job_time_of(stats: ProgramStats, profile: LaserProfile, *, numbers: np.ndarray, n_lines: int,
+                ack: np.ndarray | None, block_end: np.ndarray | None) -> JobTime:
+    """`JobTime` from a program's reading and its link schedule (None: the planner alone).
+
+    numbers (len(program),): 0-based file line of each program line; n_lines: lines in the
+    file; ack (len(program),), block_end (B,): `LinkSchedule.ack`, `.block_end`.
+    """
     seg, moves = stats.segments, stats.moves
     seconds = seg.seconds
     planner = stats.total_seconds
-    n_lines = max(program.n_lines, max((n for n, _ in program.lines), default=0))
-    if link and len(program):
-        kin = Kinematics.from_settings(settings_from_profile(profile), planner_blocks=profile.planner_blocks)
-        ack, block_end = link_schedule(program, stats, kin, baud=profile.baud, rx_buffer=profile.rx_buffer,
-                                       parse_time=profile.parse_time)
+    if ack is not None:
         link_total = float(ack[-1])
         total = max(float(block_end.max()) if len(block_end) else 0.0, link_total, planner)
-        line_done = np.maximum(ack, np.maximum.accumulate(_line_ends(stats, block_end, len(program))))
+        line_done = np.maximum(ack, np.maximum.accumulate(_line_ends(stats, block_end, len(ack))))
     else:
         link_total, total = 0.0, planner
         line_done = stats.line_seconds
     line_seconds = np.zeros(n_lines)
-    numbers = np.fromiter((n - 1 for n, _ in program.lines), dtype=int, count=len(program))
     if len(numbers):
         line_seconds[numbers] = line_done
         line_seconds = np.maximum.accumulate(line_seconds)

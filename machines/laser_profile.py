@@ -18,10 +18,24 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from onestroke.errors import InputError
+from onestroke.ranges import Range, check_ranges, ranged
 from onestroke.textfile import read_text
 from onestroke.units import parse_positive_length, parse_size_pair, parse_speed
 
 DEFAULT_PROFILE_PATH = Path(__file__).with_name("profiles") / "laser-default.toml"
+
+# What GRBL-family controllers and their machines have; beyond these no machine goes, and
+# each bounds the work of one job's estimate and preview (the studio answers within 2 s):
+# a bed side (diode lasers 300-1,000 mm; GRBL routers with a laser up to a 4 x 8 ft sheet,
+# 1,220 x 2,440 mm);
+BED_SIDE = Range(0.0, 2500.0, unit="mm", name="bed side", low_open=True)
+# $12, the arc tolerance GRBL cuts G2/G3 into chords within (default 0.002 mm; chords per
+# arc grow as 1 / sqrt of it);
+ARC_TOLERANCE = Range(0.001, 1.0, unit="mm", name="arc_tolerance ($12)")
+# the serial receive buffer (GRBL on an ATmega328: 128 bytes; grblHAL: 1,024) and the
+# planner's look-ahead (GRBL: 15 usable blocks, grbl-Mega 35, grblHAL boards up to 256).
+RX_BUFFER = Range(16, 4096, unit="bytes", name="rx_buffer", integer=True)
+PLANNER_BLOCKS = Range(2, 256, name="planner_blocks", integer=True)
 
 _ACCEL = re.compile(r"^\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*(?:(mm|in|m)\s*/\s*(s|sec|min)\s*(?:\^?\s*2|²))?\s*$")
 
@@ -34,8 +48,8 @@ class LaserProfile:
     """
 
     name: str = "GRBL laser"
-    bed_width: float = 400.0
-    bed_height: float = 400.0
+    bed_width: float = ranged(400.0, BED_SIDE.named("bed width"))
+    bed_height: float = ranged(400.0, BED_SIDE.named("bed height"))
     max_power: float = 1000.0
     laser_mode: bool = True
     air_assist: bool = False
@@ -44,11 +58,11 @@ class LaserProfile:
     acceleration_x: float = 500.0
     acceleration_y: float = 500.0
     junction_deviation: float = 0.01
-    arc_tolerance: float = 0.002
+    arc_tolerance: float = ranged(0.002, ARC_TOLERANCE)
     steps_per_mm_x: float = 80.0
     steps_per_mm_y: float = 80.0
-    rx_buffer: int = 128
-    planner_blocks: int = 15
+    rx_buffer: int = ranged(128, RX_BUFFER)
+    planner_blocks: int = ranged(15, PLANNER_BLOCKS)
     baud: int = 115200
     parse_time: float = 0.002
 
@@ -59,15 +73,14 @@ class LaserProfile:
             value = getattr(self, name)
             if not (isinstance(value, (int, float)) and value > 0 and value < float("inf")):
                 raise InputError(f"laser profile {self.name!r}: {name} {value!r} must be a positive number")
-        if not (isinstance(self.rx_buffer, int) and self.rx_buffer >= 16):
-            raise InputError(f"laser profile {self.name!r}: rx_buffer {self.rx_buffer!r} must be an integer >= 16")
         if not (isinstance(self.baud, int) and self.baud > 0):
             raise InputError(f"laser profile {self.name!r}: baud {self.baud!r} must be a positive integer")
         if not (isinstance(self.parse_time, (int, float)) and 0 <= self.parse_time < 1):
             raise InputError(f"laser profile {self.name!r}: parse_time {self.parse_time!r} must be seconds in [0, 1)")
-        if not (isinstance(self.planner_blocks, int) and 2 <= self.planner_blocks <= 1000):
-            raise InputError(f"laser profile {self.name!r}: planner_blocks {self.planner_blocks!r} "
-                             "must be an integer in 2..1000")
+        try:
+            check_ranges(self)
+        except InputError as error:
+            raise InputError(f"laser profile {self.name!r}: {error}") from None
 
     @property
     def rapid_rate(self) -> float:

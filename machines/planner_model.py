@@ -300,18 +300,20 @@ def window_limits(table: BlockTable, window: int) -> np.ndarray:
 
 
 def plan_times(start: np.ndarray, end: np.ndarray, feed: np.ndarray, rapid: np.ndarray,
-               stop_before: np.ndarray, kin: Kinematics) -> np.ndarray:
+               stop_before: np.ndarray, kin: Kinematics, *, exits: bool = False):
     """Batch driver: seconds of each straight move when the planner is never starved.
 
     Arguments as `block_table`. Same rules as the incremental driver (`BlockBuilder`,
     `exit_speed`, `trapezoid`): each block may leave at most at the speed from which the
     next planner_blocks - 1 blocks can still brake to rest; it enters at the speed the
-    previous one left with. Returns (M,) seconds (0 for moves of zero steps).
+    previous one left with. Returns (M,) seconds (0 for moves of zero steps); with
+    `exits`, also (M,) the squared speed leaving each move ((mm/s)^2, 0 for those).
     """
     table = block_table(start, end, feed, rapid, stop_before, kin)
     out = np.zeros(len(table.keep))
+    leaving = np.zeros(len(table.keep))
     if not len(table.length):
-        return out
+        return (out, leaving) if exits else out
     length, accel, nominal, max_entry, reach = (table.length, table.accel, table.nominal, table.max_entry,
                                                 table.reach)
     limit = window_limits(table, kin.planner_blocks)
@@ -328,4 +330,5 @@ def plan_times(start: np.ndarray, end: np.ndarray, feed: np.ndarray, rapid: np.n
     ramp = (peak_sq - entry_sq) / (2 * accel) + (peak_sq - exit_sq) / (2 * accel)
     cruise = np.maximum(length - ramp, 0.0)
     out[table.keep] = (vp - v0) / accel + (vp - v1) / accel + cruise / vp
-    return out
+    leaving[table.keep] = exit_sq
+    return (out, leaving) if exits else out

@@ -20,6 +20,14 @@ def check_baud(rate, *, name: str = "--baud", shown: str | None = None) -> int:
     return int(rate)
 
 
+def parse_baud(value, *, name: str = "--baud") -> int:
+    """A baud rate as the user gave it (text such as "115200", or a whole number): read with
+    the one number grammar (`onestroke.units.parse_integer`), then `check_baud`."""
+    from onestroke.units import parse_integer
+
+    return check_baud(parse_integer(value, what=name), name=name, shown=str(value).strip())
+
+
 # Appended to every job: its `ok` only comes once the planner has drained, so the end of
 # the job is known even when status reports carry no buffer counts ($10 without Bf).
 DRAIN_LINE = "G4P0"

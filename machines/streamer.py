@@ -311,8 +311,8 @@ class GrblStreamer(StreamConnect, StreamStops):
             # planner is empty and the machine Idle: the job is done.
             if self._alarm_locked:
                 raise stop("the machine went into ALARM at the end of the job")
-        except KeyboardInterrupt:
-            raise stop("stopped by Ctrl-C", cls=StreamInterrupted, since=time.monotonic()) from None
+        except KeyboardInterrupt as signal:  # Ctrl-C; SIGTERM and SIGHUP come as onestroke.errors.Interrupted
+            raise stop(f"stopped by {str(signal) or 'Ctrl-C'}", cls=StreamInterrupted, since=time.monotonic()) from None
         except MachineError as error:
             if isinstance(error, StreamError):
                 raise

@@ -95,9 +95,9 @@ TABLE = [
     ("3", ["vectorize", "{in}/d.svg", "-o", "{out}/a.svg", "--blur", "1e9"], 2, "--blur"),
     ("3", ["laser", "{in}/d.svg", "-o", "{out}/a.gcode", "--feed", "0.0001mm/min"], 2, "--feed"),
     ("3", ["laser", "{in}/noise.png", "-o", "{out}/a.gcode"], 2, "--blur"),
-    # 4. OS errors: one line
-    ("4", ["vectorize", "{in}/d.svg", "-o", "/proc/onestroke-test.svg"], 1, "cannot write"),
-    ("4", ["vectorize", "{in}/d.svg", "-o", "/sys/onestroke-test.svg"], 1, "cannot write"),
+    # 4. OS errors: one line; a folder that cannot take files is found before any work (issue 28: exit 2)
+    ("4", ["vectorize", "{in}/d.svg", "-o", "/proc/onestroke-test.svg"], 2, "cannot write"),
+    ("4", ["vectorize", "{in}/d.svg", "-o", "/sys/onestroke-test.svg"], 2, "cannot write"),
     # 5. messages name the real problem and an option the command has
     ("5", ["embroider", "{in}/dir.pes", "-o", "{out}/a.pes"], 2, "is a directory"),
     ("5", ["preview", "{in}/dir.pes", "-o", "{out}/a.png"], 2, "is a directory"),

@@ -94,3 +94,21 @@ def test_machines_does_not_import_fabrication():
     modules = {n.module for n in ast.walk(tree) if isinstance(n, ast.ImportFrom)}
     modules |= {a.name for n in ast.walk(tree) if isinstance(n, ast.Import) for a in n.names}
     assert not any(m.split(".")[0] in ("fabrication", "vectorize") for m in modules if m)
+
+
+@pytest.mark.parametrize("text,message", [
+    ("[bed]\nsize = '3000x400mm'\n", "bed width 3000 must be above 0 mm to 2500 mm"),
+    ("[bed]\nheight = '2.6m'\n", "bed height 2600 must be above 0 mm to 2500 mm"),
+    ("[motion]\narc_tolerance = '0.0001mm'\n", "arc_tolerance ($12) 0.0001 must be from 0.001 mm to 1 mm"),
+    ("[controller]\nrx_buffer = 100000\n", "rx_buffer 100000 must be from 16 bytes to 4096 bytes"),
+    ("[controller]\nplanner_blocks = 1000\n", "planner_blocks 1000 must be from 2 to 256"),
+])
+def test_profile_values_beyond_any_machine_are_refused(text, message):
+    """The declared ranges (machines.laser_profile): a bed, an arc tolerance, a buffer or a
+    look-ahead beyond any GRBL machine's would make one job's estimate and preview grow
+    without bound (an uploaded profile in the studio)."""
+    with pytest.raises(InputError) as refused:
+        laser_profile_from_text("name = 'big'\n" + text, source="big.toml")
+    assert str(refused.value) == f"laser profile 'big': {message}"
+    assert "\n" not in str(refused.value)
+    LaserProfile(bed_width=2500.0, bed_height=1220.0, arc_tolerance=0.001, rx_buffer=4096, planner_blocks=256)

@@ -110,6 +110,9 @@ SAME_LINE = [
      lambda: embroidery_settings(output="a.pes", min_stitch="0.05mm")),
     (["embroider", "-o", "{out}/a.pes", "--stitch-length", "0.2mm"],
      lambda: embroidery_settings(output="a.pes", stitch_length="0.2mm")),
+    (["embroider", "-o", "{out}/a.pes", "--hoop", "11000x11000", "--size", "10000mm"],
+     lambda: embroidery_settings(output="a.pes", hoop="11000x11000", size="10000mm")),
+    (["embroider", "-o", "{out}/a.pes", "--hoop", "100x1.6m"], lambda: embroidery_settings(output="a.pes", hoop="100x1.6m")),
 ]
 
 

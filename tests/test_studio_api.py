@@ -196,6 +196,30 @@ def test_send_to_the_emulator(client):
     assert status["acked"] == status["total"] > 10
 
 
+def test_send_reads_the_baud_rate_as_the_command_line_does(drawing):
+    """One number grammar and one check: a text "9600" is 9600 (as `--baud 9600`); 0, a
+    fraction, a flag or other digits than 0-9 are refused in the CLI's words, not read by
+    int() nor replaced by the default."""
+    from machines.stream_types import parse_baud
+    from onestroke.errors import InputError
+
+    session = StudioSession(drawing, edits_path=drawing.with_name("baud.edits.json"))
+    with TestClient(create_app(session, token=TOKEN, hosts={HOST}), base_url=f"http://{HOST}",
+                    headers={"X-Studio-Token": TOKEN}) as client:
+        for bad in (0, "0", 9600.5, True, "9600.0", "\u0669\u0666\u0660\u0660", "1e5", 57601, [9600]):
+            answer = client.post("/api/send", json={"options": {"size": "20mm"}, "port": "sim://", "baud": bad})
+            with pytest.raises(InputError) as refused:
+                parse_baud(bad)
+            assert answer.status_code == 400 and answer.json()["error"] == str(refused.value), (bad, answer.text)
+            assert session.sender is None
+        started = client.post("/api/send", json={"options": {"size": "20mm"}, "port": "sim://?speed=200",
+                                                 "baud": " 9600 "})
+        assert started.status_code == 200, started.text
+        assert session.sender.baud == 9600
+        session.sender.wait(30)
+        assert client.get("/api/send").json()["state"] == "done"
+
+
 def test_send_pause_resume_abort(client):
     state = client.get("/api/state").json()
     started = client.post("/api/send", json={"edits": state["edits"], "options": {"size": "60mm", "passes": "3"},

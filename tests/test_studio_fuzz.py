@@ -56,10 +56,20 @@ SAME_LINE = [
      ["laser", "-o", "{out}/a.gcode", "--tolerance", "0.001mm"]),
     ("embroidery", {"options": {"rotate": 400}}, ["embroider", "-o", "{out}/a.pes", "--rotate", "400"]),
     ("embroidery", {"options": {"spm": "50"}}, ["embroider", "-o", "{out}/a.pes", "--spm", "50"]),
+    ("embroidery", {"options": {"hoop": "11000x11000", "size": "10000mm", "style": "zigzag", "spacing": "0.1mm"}},
+     ["embroider", "-o", "{out}/a.pes", "--hoop", "11000x11000", "--size", "10000mm", "--style", "zigzag",
+      "--spacing", "0.1mm"]),
     ("export/pes", {"options": {"style": "zigzag", "spacing": "0.01mm"}},
      ["embroider", "-o", "{out}/a.pes", "--style", "zigzag", "--spacing", "0.01mm"]),
     ("export/dst", {"options": {"stitch_length": "0.2mm"}},
      ["embroider", "-o", "{out}/a.dst", "--stitch-length", "0.2mm"]),
+    # the baud rate: the CLI's number grammar and check (it used to be int() of the value)
+    ("send", {"port": "sim://", "baud": "1234"}, ["laser", "-o", "{out}/a.gcode", "--port", "sim://", "--baud", "1234"]),
+    ("send", {"port": "sim://", "baud": "0"}, ["laser", "-o", "{out}/a.gcode", "--port", "sim://", "--baud", "0"]),
+    ("send", {"port": "sim://", "baud": "fast"}, ["laser", "-o", "{out}/a.gcode", "--port", "sim://", "--baud", "fast"]),
+    ("send", {"port": "sim://", "baud": "115200.0"},
+     ["laser", "-o", "{out}/a.gcode", "--port", "sim://", "--baud", "115200.0"]),
+    ("send", {"port": "sim://", "baud": "1e5"}, ["laser", "-o", "{out}/a.gcode", "--port", "sim://", "--baud", "1e5"]),
     ("state", {"edits": dict(EDITS, blur=1e9)}, ["vectorize", "-o", "{out}/a.svg", "--blur", "1e+09"]),
     ("state", {"edits": dict(EDITS, threshold=1.5)}, ["vectorize", "-o", "{out}/a.svg", "--threshold", "1.5"]),
     ("export/svg", {"edits": dict(EDITS, blur=-1)}, ["vectorize", "-o", "{out}/a.svg", "--blur", "-1"]),
@@ -270,3 +280,39 @@ def test_the_fuzz_figures(server):
           f"wall s median {wall[len(wall) // 2]:.3f} max {wall[-1]:.3f}; peak {server.peak_mb():.0f} MB; "
           f"slowest: {max(server.cpu_seconds)[1][:200]}")
     print("answers:", ", ".join(f"{what} {code}: {n}" for (what, code), n in sorted(server.answers.items())))
+
+
+# -- the heaviest requests in range (benchmarks/studio_worst.py times them) --------------------
+
+LASER_WORST = {"size": "400mm", "tolerance": "0.005mm", "passes": "100"}  # 202,311 lines on loops.png
+HOOP_WORST = {"size": "1500mm", "hoop": "1500x1500", "fit": True}  # the largest hoop HOOP_SIDE takes
+HEAVIEST = [
+    ("laser", {"options": LASER_WORST}),
+    ("laser", {"options": dict(LASER_WORST, arcs=True)}),
+    ("export/gcode", {"options": LASER_WORST}),
+    ("laser", {"options": dict(LASER_WORST, size="2500mm", profile="@big")}),  # the largest bed a profile takes
+    ("export/gcode", {"options": dict(LASER_WORST, size="2500mm", profile="@big")}),
+    ("embroidery", {"options": dict(HOOP_WORST, style="zigzag", spacing="0.1mm")}),
+    ("export/pes", {"options": dict(HOOP_WORST, style="zigzag", spacing="0.1mm")}),
+    ("embroidery", {"options": dict(HOOP_WORST, style="triple", stitch_length="0.1mm", min_stitch="0.1mm",
+                                    repeats="5")}),
+]
+
+
+@pytest.mark.parametrize("endpoint,body", HEAVIEST, ids=[f"{e} {json.dumps(b)[12:90]}" for e, b in HEAVIEST])
+def test_the_heaviest_requests_in_range_stay_within_500_mb(server, endpoint, body):
+    """Each answered (200), the server process's peak memory during the request (VmHWM,
+    reset before it) under 500 MB. The CPU seconds are printed; timing is the benchmark's."""
+    body = json.loads(json.dumps(body))
+    if body["options"].get("profile") == "@big":
+        text = 'name = "largest bed"\n[bed]\nsize = "2500x2500mm"\n'
+        uploaded = server.client.post("/api/profiles", json={"name": "big.toml", "text": text})
+        assert uploaded.status_code == 200, uploaded.text
+        body["options"]["profile"] = uploaded.json()["id"]
+    Path(f"/proc/{server.process.pid}/clear_refs").write_text("5")  # its peak := its memory now
+    answer = server.request("POST", f"/api/{endpoint}", json.dumps(body).encode())
+    assert answer.status_code == 200, answer.text[:300]
+    cpu, _ = server.cpu_seconds[-1]
+    print(f"\n{endpoint} {body['options']}: CPU {cpu:.2f} s, wall {server.wall_seconds[-1]:.2f} s, "
+          f"peak {server.peak_mb():.0f} MB")
+    assert server.peak_mb() < 500, server.peak_mb()

@@ -10,7 +10,7 @@ from pathlib import Path
 import numpy as np
 from PIL import Image, ImageDraw
 
-from onestroke.atomic import atomic_open
+from onestroke.atomic import atomic_open, make_folder
 from vectorize.options import VectorizeResult
 
 # The files write_debug_images may write, in stage order (the CLI refuses a --debug folder
@@ -50,8 +50,7 @@ def _draw_graph(draw: ImageDraw.ImageDraw, graph, *, degrees: bool) -> None:
 def write_debug_images(result: VectorizeResult, folder: str | os.PathLike) -> list[Path]:
     """Write the stage overlays of a result made with `keep_stages=True`; returns the paths."""
     stages = result.stages or {}
-    folder = Path(folder)
-    folder.mkdir(parents=True, exist_ok=True)
+    folder = make_folder(folder)
     written: list[Path] = []
     if "ink" not in stages:
         return written

@@ -118,28 +118,66 @@ def chains(graph: MedialGraph, pairings: dict) -> list[Chain]:
 
 def pieces(graph: MedialGraph, pairings: dict) -> int:
     """How many separate lines the graph falls into when decided junctions are through-paths."""
-    partner = _partners(pairings)
-    ids: dict[tuple[int, int], int] = {}
+    return PieceCount(graph, pairings)({})
 
-    def vertex(node: int, slot: int) -> int:
-        if node in partner:
-            key = (node, min(slot, partner[node][slot]))
-        else:
-            key = (node, -1)
-        return ids.setdefault(key, len(ids))
 
-    rows, cols = [], []
-    for node in graph.incident:
-        for slot, (bid, end) in enumerate(slots(graph, node)):
-            if end == "a":
-                branch = graph.branches[bid]
-                far_slot = slots(graph, branch.b).index((bid, "b"))
-                rows.append(vertex(node, slot))
-                cols.append(vertex(branch.b, far_slot))
-    if not ids:
-        return 0
-    links = coo_matrix((np.ones(len(rows)), (rows, cols)), shape=(len(ids), len(ids)))
-    return int(connected_components(links, directed=False)[0])
+class PieceCount:
+    """`pieces` for one graph whose `variable` nodes take many pairings in turn (the search in
+    `connect_pairings` asks hundreds of times): the graph's pieces with those nodes' branch
+    ends all apart are found once; a count then joins each variable node's pairs of ends (all
+    its ends when it is undecided), a union per pair.
+
+    A branch end is a vertex of its own where its node's pairing joins it to its partner (the
+    pair shares one vertex); the whole node is one vertex where it is undecided. `fixed`:
+    pairings of the nodes that are not variable.
+    """
+
+    def __init__(self, graph: MedialGraph, fixed: dict, variable=()) -> None:
+        self.variable = tuple(variable)
+        apart = set(self.variable)
+        partner = _partners({n: p for n, p in fixed.items() if n not in apart})
+        ids: dict[tuple[int, int], int] = {}
+
+        def vertex(node: int, slot: int) -> int:
+            if node in apart:
+                key = (node, slot)
+            elif node in partner:
+                key = (node, min(slot, partner[node][slot]))
+            else:
+                key = (node, -1)
+            return ids.setdefault(key, len(ids))
+
+        rows, cols = [], []
+        for node in graph.incident:
+            for slot, (bid, end) in enumerate(slots(graph, node)):
+                if end == "a":
+                    far = graph.branches[bid].b
+                    rows.append(vertex(node, slot))
+                    cols.append(vertex(far, slots(graph, far).index((bid, "b"))))
+        links = coo_matrix((np.ones(len(rows)), (rows, cols)), shape=(len(ids), len(ids)))
+        self.count, label = connected_components(links, directed=False) if ids else (0, np.zeros(0, int))
+        self.ends = {n: [int(label[ids[n, slot]]) for slot in range(graph.degree(n))] for n in self.variable}
+
+    def __call__(self, choice: dict) -> int:
+        """Pieces when each variable node takes choice[node] (slot pairs), or is undecided
+        where `choice` leaves it out."""
+        parent: dict[int, int] = {}
+
+        def root(x: int) -> int:
+            while parent.get(x, x) != x:
+                x = parent[x]
+            return x
+
+        joined = 0
+        for node in self.variable:
+            ends = self.ends[node]
+            pairs = choice[node] if node in choice else tuple(zip(range(len(ends) - 1), range(1, len(ends))))
+            for a, b in pairs:
+                ra, rb = root(ends[a]), root(ends[b])
+                if ra != rb:
+                    parent[ra] = rb
+                    joined += 1
+        return int(self.count) - joined
 
 
 class _Multigraph:
@@ -378,14 +416,15 @@ def connect_pairings(graph: MedialGraph, ranked: dict, costs: dict, *, fixed: di
         return {**fixed, **{n: ranked[n][r] for n, r in zip(nodes, ranks)}}
 
     start = tuple(0 for _ in nodes)
-    best_key, best_ranks = (pieces(graph, assign(start)), 0.0), start
+    pieces = PieceCount(graph, fixed, nodes)  # counts under the ranked nodes' pairings (fixed ones stay)
+    best_key, best_ranks = (pieces(assign(start)), 0.0), start
     tried = 1
     heap = [(0.0, start, 0)]
     seen = {start}
     while best_key[0] > 1 and heap and tried < max_tries:
         cost, ranks, last = heapq.heappop(heap)
         if ranks != start:
-            key = (pieces(graph, assign(ranks)), cost)
+            key = (pieces(assign(ranks)), cost)
             tried += 1
             if key < best_key:
                 best_key, best_ranks = key, ranks
@@ -409,7 +448,7 @@ def connect_pairings(graph: MedialGraph, ranked: dict, costs: dict, *, fixed: di
         # A pairing the user fixed (its only choice) stays, even if the line then falls apart.
         for node in sorted((n for n in nodes if len(ranked[n]) > 1), key=lambda n: (costs[n][1], n)):
             trial = {n: p for n, p in pairing.items() if n != node}
-            now = pieces(graph, {**fixed, **trial})
+            now = pieces({**fixed, **trial})
             if now < count:
                 pairing, count = trial, now
             if count <= 1:

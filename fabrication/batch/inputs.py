@@ -29,6 +29,10 @@ class BatchItem:
         return dict(self.outputs)[extension]
 
 
+# The drawings a run still has to make, each with the extensions of its outputs not current.
+Todo = list[tuple[BatchItem, tuple[str, ...]]]
+
+
 def _walk(folder: Path, skip: Path) -> list[Path]:
     found = []
     for root, dirs, files in os.walk(folder, followlinks=False):

@@ -9,9 +9,11 @@ import os
 from dataclasses import asdict, dataclass
 from pathlib import Path
 
-from onestroke.atomic import atomic_write_text
+from onestroke.atomic import atomic_write_text, os_reason
+from onestroke.errors import OutputError
 
 REPORT_NAME = "onestroke-batch-report"
+RESERVE_NAME = ".onestroke-batch-reserve"
 COLUMNS = ("input", "status", "outputs", "strokes", "intersections", "warnings", "stitches",
            "sew_seconds", "laser_seconds", "seconds", "error")
 
@@ -34,8 +36,8 @@ class FileStats:
 @dataclass(frozen=True, kw_only=True)
 class FileRecord:
     """One report row. status: "ok", "failed", "skipped" (outputs current) or "not run"
-    (the batch was stopped first); outputs: paths relative to the output folder;
-    stats: None when the input was not processed in this run."""
+    (the batch was stopped first; error: why); outputs: paths relative to the output folder;
+    stats: the figures of this run, or for a skipped input those of the run that made it."""
 
     input: str
     status: str
@@ -53,7 +55,8 @@ class FileRecord:
 class BatchSummary:
     """Counts and times of one run: total inputs, ran (processed in this run), ok, failed
     (in this run or unchanged since an earlier one), skipped (current), not_run (stopped
-    first); workers: processes or Dask workers used (0: none needed)."""
+    first); workers: processes or Dask workers used (0: none needed); stopped: why the
+    batch stopped before the end (None: it did not)."""
 
     total: int
     ran: int
@@ -66,6 +69,7 @@ class BatchSummary:
     scheduler: str | None
     report_csv: str
     report_json: str
+    stopped: str | None = None
 
     @property
     def per_second(self) -> float:
@@ -101,3 +105,36 @@ def write_report(out_dir: str | os.PathLike, records: list[FileRecord], summary:
     atomic_write_text(csv_path, buffer.getvalue())
     payload = {"summary": summary, "files": [r.row() for r in rows]}
     atomic_write_text(json_path, json.dumps(payload, indent=1) + "\n")
+
+
+class ReportRoom:
+    """Room on the disk held for the report and the manifest while a batch runs: a file of
+    their likely size (`posix_fallocate`), removed just before they are written, so that a
+    disk filled by the outputs still takes the report that says so.
+
+    `OutputError` if the room is not there at the start (nothing has been made yet).
+    """
+
+    def __init__(self, out_dir: str | os.PathLike, inputs: int, targets: int) -> None:
+        self.path = Path(out_dir) / RESERVE_NAME
+        # measured: about 1.2 kB per input (CSV, JSON and manifest rows) and 150 B per output
+        size = 8192 + inputs * (2048 + 256 * targets)
+        try:
+            fd = os.open(self.path, os.O_WRONLY | os.O_CREAT | os.O_TRUNC, 0o600)
+            try:
+                if hasattr(os, "posix_fallocate"):
+                    os.posix_fallocate(fd, 0, size)
+                else:  # macOS, Windows: written out
+                    os.write(fd, bytes(size))
+            finally:
+                os.close(fd)
+        except OSError as error:
+            self.release()
+            raise OutputError(f"cannot keep {size / 1024:.0f} kB for the batch's report in {str(out_dir)!r}: "
+                              f"{os_reason(error)}", errno=error.errno) from None
+
+    def release(self) -> None:
+        try:
+            os.unlink(self.path)
+        except OSError:
+            pass

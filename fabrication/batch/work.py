@@ -82,31 +82,55 @@ class BatchJob:
 @dataclass(frozen=True, kw_only=True)
 class FileResult:
     """What became of one input: name (its path relative to its folder, posix), outputs
-    ((extension, file content) per target made), stats, error (one line; None if it worked)."""
+    ((extension, file content) per target made), stats, error (one line; None if it worked);
+    worker_lost: the error is the worker's death, not the input's (a rerun tries it again)."""
 
     name: str
     outputs: tuple[tuple[str, bytes], ...] = ()
     stats: FileStats = FileStats()
     error: str | None = None
+    worker_lost: bool = False
 
 
-def warm_up(job: BatchJob, *, ignore_interrupt: bool = True) -> None:
+def die_with_parent(parent: int) -> None:
+    """Have the kernel kill this process when `parent` ends, however it ends (SIGKILL
+    included): Linux's PR_SET_PDEATHSIG. Elsewhere nothing is set up."""
+    import ctypes
+    import ctypes.util
+    import sys
+
+    if not sys.platform.startswith("linux"):
+        return
+    libc = ctypes.CDLL(ctypes.util.find_library("c") or None, use_errno=True)
+    PR_SET_PDEATHSIG = 1  # <linux/prctl.h>
+    libc.prctl(PR_SET_PDEATHSIG, signal.SIGKILL, 0, 0, 0)
+    if os.getppid() != parent:  # the parent ended before the line above: nobody to work for
+        os._exit(1)
+
+
+def warm_up(job: BatchJob, *, ignore_interrupt: bool = True, parent: int | None = None) -> None:
     """Load the imports and the classifier model once per worker process (an initializer).
 
     ignore_interrupt: leave Ctrl-C to the client, which stops handing out files; a worker
-    interrupted halfway would only lose its file.
+    interrupted halfway would only lose its file. parent: the batch's process id; the worker
+    ends with it (`die_with_parent`), so a killed batch leaves no worker behind.
     """
+    if parent is not None:
+        die_with_parent(parent)
     if ignore_interrupt:
         signal.signal(signal.SIGINT, signal.SIG_IGN)
-    import fabrication.embroidery.export  # noqa: F401  (pyembroidery and the stitch planner)
-    import fabrication.embroidery.pipeline  # noqa: F401
-    import fabrication.laser.program  # noqa: F401
-    import vectorize.vectorizer  # noqa: F401
+    try:
+        import fabrication.embroidery.export  # noqa: F401  (pyembroidery and the stitch planner)
+        import fabrication.embroidery.pipeline  # noqa: F401
+        import fabrication.laser.program  # noqa: F401
+        import vectorize.vectorizer  # noqa: F401
 
-    if job.vectorize.classifier == "cnn":
-        from vectorize.cnn_classifier import CnnClassifier
+        if job.vectorize.classifier == "cnn":
+            from vectorize.cnn_classifier import CnnClassifier
 
-        CnnClassifier().session  # noqa: B018  (creates the cached onnxruntime session)
+            CnnClassifier().session  # noqa: B018  (creates the cached onnxruntime session)
+    except Exception:  # noqa: BLE001 - only a head start: each drawing's own run reports the error
+        pass
 
 
 def process_file(name: str, job: BatchJob, *, path: str | None = None, data: bytes | None = None,

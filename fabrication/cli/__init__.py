@@ -2,13 +2,15 @@
 
 Each command lives in its own module (`vectorize_cmd.py`, `embroider_cmd.py`, ...) and is
 registered below; shared options live in `options.py`. Every failure becomes a one-line
-message and an exit code: 2 for bad input (`InputError`, a bad option), 1 for any other
-failure (a machine, the disk, memory), 130 for Ctrl-C; never a traceback.
+message and the exit code its class carries (`onestroke.errors`): 2 when the request was
+wrong before any work (`InputError`, a bad option), 1 when the work failed (the disk, a
+machine, memory), 130 when interrupted (Ctrl-C, SIGTERM, SIGHUP); never a traceback.
 """
 
 # Ctrl-C while Python imports click, numpy and the rest would print a traceback: until the
-# command runs, an interrupt just says so and exits (nothing has been written yet).
-# `_signal` is the built-in C module (`signal` itself spends ~10 ms building enums).
+# command runs, an interrupt (Ctrl-C, SIGTERM, SIGHUP) just says so and exits 130 (nothing
+# has been written yet). `_signal` is the built-in C module (`signal` itself spends ~10 ms
+# building enums).
 import _signal
 import os
 
@@ -20,6 +22,9 @@ def _interrupted_early(signum, frame) -> None:
 
 if _signal.getsignal(_signal.SIGINT) is _signal.default_int_handler:  # keep SIG_IGN of background jobs
     _signal.signal(_signal.SIGINT, _interrupted_early)
+for _signum in (_signal.SIGTERM, _signal.SIGHUP):
+    if _signal.getsignal(_signum) == _signal.SIG_DFL:  # keep SIG_IGN (nohup)
+        _signal.signal(_signum, _interrupted_early)
 
 import errno  # noqa: E402 - after the Ctrl-C handler on purpose
 import signal  # noqa: E402
@@ -28,7 +33,7 @@ import warnings  # noqa: E402
 
 import click  # noqa: E402
 
-from onestroke.errors import OnestrokeError  # noqa: E402
+from onestroke.errors import EXIT_BAD_REQUEST, EXIT_FAILED, EXIT_INTERRUPTED, Interrupted, OnestrokeError  # noqa: E402
 
 MAX_MESSAGE = 500  # characters: a message quoting a huge value is cut in the middle
 
@@ -61,25 +66,47 @@ def describe_os_error(error: OSError) -> str:
     return f"{reason}: {name!s}" if name is not None else reason
 
 
-def _caused_by_ctrl_c(error: BaseException) -> bool:
-    """True if a KeyboardInterrupt is in `error`'s chain of causes (a Ctrl-C landing while
+def _interrupt(signum, frame) -> None:
+    """Ctrl-C, SIGTERM, SIGHUP: raise `KeyboardInterrupt` (`Interrupted` naming the signal)."""
+    code = getattr(frame, "f_code", None)
+    if code is not None and (code.co_filename.startswith("<frozen importlib") or code.co_name == "__del__"):
+        # raised in importlib's module-lock callback or a finalizer, the exception would be
+        # printed and dropped, and the work go on: the same signal again in a moment
+        import threading
+
+        threading.Timer(0.02, os.kill, (os.getpid(), signum)).start()
+        return
+    if signum == signal.SIGINT:
+        raise KeyboardInterrupt
+    raise Interrupted(signal.Signals(signum).name)
+
+
+def _caused_by_ctrl_c(error: BaseException) -> KeyboardInterrupt | None:
+    """The KeyboardInterrupt in `error`'s chain of causes, if any (a Ctrl-C landing while
     numpy defines a class comes out as "RuntimeError: Error calling __set_name__")."""
     seen = set()
     while error is not None and id(error) not in seen:
         if isinstance(error, KeyboardInterrupt):
-            return True
+            return error
         seen.add(id(error))
         error = error.__cause__ or error.__context__
-    return False
+    return None
 
 
 class OnestrokeGroup(click.Group):
     """A click group that turns every error into a one-line message and an exit code."""
 
     def invoke(self, ctx: click.Context):
-        if signal.getsignal(signal.SIGINT) is _interrupted_early:
-            # From here on Ctrl-C raises KeyboardInterrupt, so atomic writes clean up.
-            signal.signal(signal.SIGINT, signal.default_int_handler)
+        # From here on Ctrl-C raises KeyboardInterrupt, so atomic writes clean up; a kill or a
+        # closed terminal does the same (temporary files removed, a batch's workers stopped and
+        # its report written); SIG_IGN (background jobs, nohup) is kept
+        taken = {}
+        for signum in (signal.SIGINT, signal.SIGTERM, signal.SIGHUP):
+            if signal.getsignal(signum) in (signal.SIG_DFL, signal.default_int_handler, _interrupted_early):
+                try:
+                    taken[signum] = signal.signal(signum, _interrupt)
+                except ValueError:  # invoked outside the main thread (a test): leave them
+                    break
         warnings.simplefilter("ignore", RuntimeWarning)  # numpy's overflow/divide chatter
         try:
             return super().invoke(ctx)
@@ -87,24 +114,30 @@ class OnestrokeGroup(click.Group):
             self._fail(str(error), error.exit_code)
         except click.exceptions.UsageError as error:
             name = error.ctx.command_path if error.ctx is not None else "onestroke"
-            self._fail(f"{error.format_message()} (see '{name} --help')", 2)
+            self._fail(f"{error.format_message()} (see '{name} --help')", EXIT_BAD_REQUEST)
         except (click.exceptions.Exit, click.exceptions.Abort, SystemExit):
             raise
-        except KeyboardInterrupt:
-            click.echo("interrupted", err=True)
-            sys.exit(130)
+        except KeyboardInterrupt as error:
+            click.echo(f"interrupted{f' ({error})' if isinstance(error, Interrupted) else ''}", err=True)
+            sys.exit(EXIT_INTERRUPTED)
         except MemoryError:
-            self._fail("out of memory; try a smaller image or design", 1)
+            self._fail("out of memory; try a smaller image or design", EXIT_FAILED)
         except OSError as error:
-            self._fail(describe_os_error(error), 1)
+            self._fail(describe_os_error(error), EXIT_FAILED)
         except RecursionError:
-            self._fail("the input is nested too deeply to read", 2)
+            self._fail("the input is nested too deeply to read", EXIT_BAD_REQUEST)
         except Exception as error:  # noqa: BLE001 - a bug still gets one line, and a way to report it
-            if _caused_by_ctrl_c(error):  # Python wraps an interrupt in a class body (an import) in RuntimeError
-                click.echo("interrupted", err=True)
-                sys.exit(130)
+            interrupt = _caused_by_ctrl_c(error)
+            if interrupt is not None:  # Python wraps an interrupt in a class body (an import) in RuntimeError
+                click.echo(f"interrupted{f' ({interrupt})' if isinstance(interrupt, Interrupted) else ''}", err=True)
+                sys.exit(EXIT_INTERRUPTED)
             self._fail(f"internal error ({type(error).__name__}: {error}); please report this with the "
-                       "command line and input", 1)
+                       "command line and input", EXIT_FAILED)
+        finally:  # Python's own handling again (a program that invoked the group goes on)
+            for signum, previous in taken.items():
+                if previous is _interrupted_early:
+                    previous = signal.default_int_handler if signum == signal.SIGINT else signal.SIG_DFL
+                signal.signal(signum, previous)
 
     @staticmethod
     def _fail(message: str, code: int) -> None:

@@ -12,7 +12,8 @@ from fabrication.job_options import embroidery_settings, laser_settings
 from fabrication.cli.laser_cmd import laser
 from fabrication.batch.runner import JOBS
 from fabrication.cli.options import Integer, drawing_input_options, placement_options
-from onestroke.errors import InputError
+from onestroke.atomic import check_folder
+from onestroke.errors import EXIT_INTERRUPTED, InputError, Interrupted
 
 
 def batch_job(to: str, *, multi: bool, threshold: float | None, blur: float, classifier: str,
@@ -88,6 +89,15 @@ def _shared_options(command: click.Command, settings, what: str, renamed: dict |
 PLACEMENT = ("size", "width", "height", "rotate")
 
 
+def _quiet_dask_logs() -> None:
+    """Dask logs a lost scheduler as tracebacks on stderr; the batch says it in one line."""
+    import logging
+
+    for name in ["distributed", *logging.root.manager.loggerDict]:
+        if name.startswith("distributed"):
+            logging.getLogger(name).setLevel(logging.CRITICAL + 1)
+
+
 @click.command()
 @click.argument("inputs", nargs=-1, required=True, type=click.Path(path_type=str))
 @click.option("-o", "--output-dir", "out_dir", required=True, type=click.Path(file_okay=False, path_type=str),
@@ -107,7 +117,8 @@ def batch(inputs: tuple[str, ...], out_dir: str, to: str, jobs: int | None, sche
 
     Outputs mirror the input folders under OUT_DIR, with a per-file report
     (onestroke-batch-report.csv/.json). A second run skips outputs that are newer than their
-    input and were made with the same options. Exit code 1 if any drawing failed.
+    input and were made with the same options. Exit code 1 if any drawing failed or the
+    batch stopped (disk full, scheduler lost; the report says why).
     """
     import os
 
@@ -128,9 +139,16 @@ def batch(inputs: tuple[str, ...], out_dir: str, to: str, jobs: int | None, sche
         warnings += (f"--jobs {jobs} has no effect with --scheduler: the cluster's workers run the drawings",)
     if os.path.exists(out_dir) and not os.path.isdir(out_dir):
         raise InputError(f"output folder {out_dir!r} is a file")
+    check_folder(out_dir, what="output folder")
     items = find_inputs(inputs, out_dir, tuple(t.extension for t in job.targets), INPUT_EXTENSIONS)
     if not items:
         raise InputError(f"no drawings ({', '.join(INPUT_EXTENSIONS)}) found in {', '.join(inputs)}")
+    if scheduler is not None:  # the extra and the scheduler, before anything is said or made
+        from fabrication.batch.cluster import probe_scheduler, require_dask
+
+        require_dask()
+        probe_scheduler(scheduler)
+        _quiet_dask_logs()
     for message in warnings:
         warn(message)
 
@@ -162,9 +180,10 @@ def batch(inputs: tuple[str, ...], out_dir: str, to: str, jobs: int | None, sche
         else:
             summary = run_batch(items, job, out_dir, jobs=jobs, scheduler=scheduler, retry_failed=retry_failed,
                                 on_start=on_start, on_file=on_file)
-    except KeyboardInterrupt:
-        click.echo("interrupted: finished outputs are kept; run the same command again to go on", err=True)
-        sys.exit(130)
+    except KeyboardInterrupt as stop:
+        how = f" ({stop})" if isinstance(stop, Interrupted) else ""
+        click.echo(f"interrupted{how}: finished outputs are kept; run the same command again to go on", err=True)
+        sys.exit(EXIT_INTERRUPTED)
     where = f"on {scheduler}" if scheduler else f"{summary.workers} worker{'s' * (summary.workers != 1)}"
     done(f"{summary.total} drawings: {summary.ok} made, {summary.skipped} skipped, {summary.failed} failed "
          f"({summary.seconds:.1f} s, {summary.per_second:.2f} drawings/s, {where}); "

@@ -20,6 +20,7 @@ from fabrication.embroidery.satin import (MAX_WIDTH, MIN_WIDTH, PULL_PERCENT, RA
 from fabrication.embroidery.triple import REPEATS
 from fabrication.embroidery.zigzag import PULL_COMPENSATION, SPACING, STITCH_WIDTH
 from machines.hoops import SPM
+from onestroke.atomic import all_or_nothing
 from onestroke.errors import InputError
 from onestroke.paths import check_distinct
 
@@ -182,12 +183,13 @@ def embroider(source: str, output: str, style: str, size: float | None, width: f
                                    classifier=classifier, edits=edits, progress=progress)
     with step("planning the stitches") as progress:
         result = embroider_drawing(drawing, job, progress=progress)
-    with step(f"writing {os.path.basename(output)}"):
-        write_embroidery(result.plan, output, pes_version=pes_version)
-    if preview_path is not None:
-        with step("drawing the preview"):
-            render_stitch_preview(result.plan, preview_path, hoop=the_hoop, stats=result.stats,
-                                  options=preview_options)
+    with all_or_nothing():  # the file and its preview appear together, or neither does
+        with step(f"writing {os.path.basename(output)}"):
+            write_embroidery(result.plan, output, pes_version=pes_version)
+        if preview_path is not None:
+            with step("drawing the preview"):
+                render_stitch_preview(result.plan, preview_path, hoop=the_hoop, stats=result.stats,
+                                      options=preview_options)
 
     for message in result.warnings:
         warn(message)

@@ -7,6 +7,7 @@ import sys
 import click
 
 from fabrication.cli.common import done
+from onestroke.atomic import all_or_nothing, check_folder
 from onestroke.errors import InputError
 
 
@@ -25,8 +26,12 @@ def install(user: bool, folder: str | None) -> None:
 
     if user and folder is not None:
         raise InputError("give --user or --dir, not both")
-    installed = install_extension(folder if folder is not None else user_extensions_folder(),
-                                  python=sys.executable)
+    target = folder if folder is not None else user_extensions_folder()
+    # tried before any work; Inkscape's own folder may not exist yet on a fresh install
+    check_folder(target, what="--dir" if folder is not None else "Inkscape's extensions folder",
+                 parents=folder is None)
+    with all_or_nothing():  # the extension's files appear together, or none does
+        installed = install_extension(target, python=sys.executable)
     for path in installed.files:
         click.echo(str(path))
     done(f"Inkscape extension installed in {installed.folder} (runs onestroke with {installed.python}); "

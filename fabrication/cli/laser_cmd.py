@@ -15,7 +15,7 @@ from fabrication.laser.gcode_write import FEED, PASSES, POWER
 from fabrication.laser.raster_time import INTERVAL, RASTER_FEED
 from fabrication.laser.toolpath import TOLERANCE
 from machines.framing import FRAME_POWER
-from onestroke.atomic import check_writable
+from onestroke.atomic import all_or_nothing, check_writable
 from onestroke.paths import check_distinct
 
 
@@ -100,14 +100,19 @@ def laser(source: str, output: str, size: float | None, width: float | None, hei
                                 max_s=profile.max_power) if frame_file else None
     # everything that can refuse the input runs before the first file is written
     raster = raster_time(toolpath, profile, interval=interval, feed=raster_feed_mm)
-    write_gcode(output, lines)
-    if frame_file:
-        write_gcode(frame_file, frame_lines)
-    if preview_path is not None:
-        from fabrication.laser.preview import render_gcode_preview
+    with all_or_nothing():  # the job, its frame file and its preview appear together, or none does
+        write_gcode(output, lines)
+        if frame_file:
+            write_gcode(frame_file, frame_lines)
+        if preview_path is not None:
+            from fabrication.laser.gcode_write import gcode_text
+            from fabrication.laser.preview import render_gcode_preview
+            from machines.gcode_program import program_from_text
 
-        with step("drawing the preview") as progress:
-            render_gcode_preview(output, preview_path, profile=profile, progress=progress)
+            with step("drawing the preview") as progress:
+                # the preview reads the job as written (the file itself appears only at the end)
+                render_gcode_preview(program_from_text(gcode_text(lines), source=output), preview_path,
+                                     profile=profile, progress=progress)
 
     if toolpath.dropped:
         warn(f"{toolpath.dropped} stroke(s) of zero length left out")

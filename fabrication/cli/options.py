@@ -176,9 +176,9 @@ class BaudRate(Integer):
     name = "baud"
 
     def convert(self, value, param, ctx):
-        from machines.stream_types import check_baud
+        from machines.stream_types import parse_baud
 
-        return check_baud(super().convert(value, param, ctx), name=_flag(param), shown=str(value))
+        return parse_baud(value, name=_flag(param))
 
 
 # -- decorators ---------------------------------------------------------------------------------

@@ -9,6 +9,8 @@ import click
 
 from fabrication.cli.common import console, done
 from fabrication.cli.options import Integer
+from onestroke.atomic import check_writable
+from onestroke.errors import InputError
 from onestroke.paths import check_distinct
 from onestroke.ranges import Range
 
@@ -37,6 +39,10 @@ def studio(source: str, port: int, no_browser: bool, edits_path: str | None, pro
     check_distinct(inputs=[("input", source), ("--profile", profile_path)], outputs=[("--edits file", edits_path)])
     session = StudioSession(source, edits_path=edits_path, profile=profile_path, classifier=classifier,
                             precompute=True)
+    try:  # the page saves every edit there: a folder that cannot take it is refused now
+        check_writable(session.edits_path)
+    except InputError as error:
+        raise InputError(f"{error}; the studio saves its edits there (give --edits FILE elsewhere)") from None
     if profile_path is not None:
         from machines.laser_profile import load_laser_profile
 

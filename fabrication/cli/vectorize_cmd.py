@@ -9,6 +9,7 @@ import click
 
 from fabrication.cli.common import console, done, edits_option, step, warn
 from fabrication.cli.options import drawing_input_options, input_argument, output_option, placement_options
+from onestroke.atomic import all_or_nothing, check_folder
 from onestroke.errors import InputError
 from onestroke.paths import check_distinct
 
@@ -34,6 +35,8 @@ def vectorize(source: str, output: str, multi: bool, threshold: float | None, bl
         raise InputError(f"--inkstitch writes an SVG; {output!r} is not a .svg file")
     if debug_dir is not None and os.path.exists(debug_dir) and not os.path.isdir(debug_dir):
         raise InputError(f"--debug {debug_dir!r} is a file; give a folder for the stage images")
+    if debug_dir is not None:
+        check_folder(debug_dir, what="--debug")
     stage_images = []
     if debug_dir:  # the overlay module is imported only when --debug asks for it
         from vectorize.debug_overlay import STAGE_IMAGES
@@ -62,19 +65,21 @@ def vectorize(source: str, output: str, multi: bool, threshold: float | None, bl
         from fabrication.placement import place_on_page
 
         drawing = place_on_page(drawing, placement)
-    if inkstitch is not None:
-        from fabrication.bridges.inkstitch import inkstitch_svg
-        from onestroke.atomic import atomic_write_text
+    written = []
+    with all_or_nothing():  # the drawing and its stage images appear together, or none does
+        if inkstitch is not None:
+            from fabrication.bridges.inkstitch import inkstitch_svg
+            from onestroke.atomic import atomic_write_text
 
-        atomic_write_text(output, inkstitch_svg(drawing, inkstitch))
-    else:
-        write_drawing(drawing, output)
-    if debug_dir is not None:
-        from vectorize.debug_overlay import write_debug_images
+            atomic_write_text(output, inkstitch_svg(drawing, inkstitch))
+        else:
+            write_drawing(drawing, output)
+        if debug_dir is not None:
+            from vectorize.debug_overlay import write_debug_images
 
-        written = write_debug_images(result, debug_dir)
-        if written:
-            console.print(f"debug: {len(written)} stage images in {debug_dir}")
+            written = write_debug_images(result, debug_dir)
+    if written:
+        console.print(f"debug: {len(written)} stage images in {debug_dir}")
     report = result.report
     done(f"{output}: {report.strokes} stroke{'s' * (report.strokes != 1)}, "
          f"{report.intersections} intersection{'s' * (report.intersections != 1)}, "

@@ -105,31 +105,80 @@ def _path_lines(path: BurnPath, position: tuple[str, str], first_words: str) -> 
     return lines, (xs[-1], ys[-1])
 
 
+@dataclass(frozen=True)
+class GcodeParts:
+    """A program as written: head (units, mode, beam), one list of lines per pass, tail
+    (beam off, home). Passes that start from the same place in the same direction are the
+    same list object: pass k + 2 repeats pass k from the third pass on."""
+
+    head: list[str]
+    passes: list[list[str]]
+    tail: list[str]
+
+    def lines(self) -> list[str]:
+        """Every line, in order."""
+        out = list(self.head)
+        for lines in self.passes:
+            out.extend(lines)
+        return out + self.tail
+
+    def repeated(self) -> tuple[list[str], list[str], int, list[str]]:
+        """(head, body, count, tail) with `lines()` == head + body x count + tail: the body is
+        the longest run of passes that repeats as a pair (one forward, one backward)."""
+        passes = self.passes
+        first = 1  # the first pass starts from an unknown place (its G0): never repeated
+        if not all(passes[k] is passes[k - 2] for k in range(first + 2, len(passes))):
+            first = len(passes)
+        count = (len(passes) - first) // 2
+        head = list(self.head)
+        for lines in passes[:first]:
+            head.extend(lines)
+        body = passes[first] + passes[first + 1] if count else []
+        tail = [line for lines in passes[first + 2 * count:] for line in lines] + self.tail
+        return head, body, count, tail
+
+
+def gcode_parts(toolpath: Toolpath, profile: LaserProfile, options: GcodeOptions = GcodeOptions(), *,
+                comments: tuple[str, ...] = (), progress: ProgressCallback | None = None) -> GcodeParts:
+    """The program (`gcode_lines`) in its parts. progress: an
+    `onestroke.progress.ProgressCallback` (strokes written, over all passes)."""
+    air = profile.air_assist if options.air_assist is None else options.air_assist
+    s_value = fmt(options.power * profile.max_power)
+    first_words = f"S{s_value}F{fmt(options.feed)}"
+    head = [comment_line(c) for c in comments]
+    head += ["G21", "G90", "M4S0" if options.dynamic else "M3S0"]
+    if air:
+        head.append("M8")
+    # the head's position is unknown before the job: the first stroke always gets its G0
+    position = ("", "")
+    report = Stage(progress, "writing G-code", options.passes * len(toolpath.paths), "strokes")
+    # a pass is a function of its direction and where the head starts: written once each
+    written: dict[tuple[int, tuple[str, str]], tuple[list[str], tuple[str, str]]] = {}
+    passes = []
+    for index in range(options.passes):
+        key = (index % 2, position)
+        if key not in written:
+            paths = toolpath.paths if index % 2 == 0 else tuple(p.reversed() for p in toolpath.paths[::-1])
+            lines, end = [], position
+            for path in paths:
+                more, end = _path_lines(path, end, first_words)
+                lines.extend(more)
+            written[key] = (lines, end)
+        lines, position = written[key]
+        passes.append(lines)
+        report.advance(len(toolpath.paths))
+    report.finish()
+    tail = ["M5", "M9"]
+    if options.return_home and position != ("0", "0"):
+        tail.append("G0X0Y0")
+    return GcodeParts(head, passes, tail)
+
+
 def gcode_lines(toolpath: Toolpath, profile: LaserProfile, options: GcodeOptions = GcodeOptions(), *,
                 comments: tuple[str, ...] = (), progress: ProgressCallback | None = None) -> list[str]:
     """The whole program as lines without line endings (each <= 80 characters).
     progress: an `onestroke.progress.ProgressCallback` (strokes written, over all passes)."""
-    air = profile.air_assist if options.air_assist is None else options.air_assist
-    s_value = fmt(options.power * profile.max_power)
-    first_words = f"S{s_value}F{fmt(options.feed)}"
-    lines = [comment_line(c) for c in comments]
-    lines += ["G21", "G90", "M4S0" if options.dynamic else "M3S0"]
-    if air:
-        lines.append("M8")
-    # the head's position is unknown before the job: the first stroke always gets its G0
-    position = ("", "")
-    report = Stage(progress, "writing G-code", options.passes * len(toolpath.paths), "strokes")
-    for index in range(options.passes):
-        paths = toolpath.paths if index % 2 == 0 else tuple(p.reversed() for p in toolpath.paths[::-1])
-        for path in paths:
-            more, position = _path_lines(path, position, first_words)
-            lines.extend(more)
-            report.advance()
-    report.finish()
-    lines += ["M5", "M9"]
-    if options.return_home and position != ("0", "0"):
-        lines.append("G0X0Y0")
-    return lines
+    return gcode_parts(toolpath, profile, options, comments=comments, progress=progress).lines()
 
 
 def gcode_text(lines: list[str]) -> str:

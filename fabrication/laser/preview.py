@@ -18,7 +18,7 @@ from pathlib import Path
 import numpy as np
 from PIL import Image, ImageDraw, ImageFont
 
-from machines.gcode_program import ProgramStats, analyze_program, load_program
+from machines.gcode_program import Program, ProgramStats, analyze_program, load_program
 from machines.grbl_settings import settings_from_profile
 from machines.job_time import JobTime, estimate_program_time, format_duration
 from machines.laser_profile import LaserProfile, load_laser_profile
@@ -266,9 +266,10 @@ def _render_svg(scene: _Scene, path: Path) -> None:
     atomic_write_text(path, "\n".join(out) + "\n")
 
 
-def render_gcode_preview(gcode_path: str | os.PathLike, out_path: str | os.PathLike, *,
+def render_gcode_preview(gcode: str | os.PathLike | Program, out_path: str | os.PathLike, *,
                          profile: LaserProfile | None = None, progress=None) -> JobTime:
-    """Draw `gcode_path` into `out_path` (.png or .svg) and return its `JobTime`.
+    """Draw `gcode` (a G-code file, or a `Program` read already) into `out_path` (.png or
+    .svg) and return its `JobTime`.
 
     profile: the machine (bed outline, time model); None uses the default profile.
     progress: an `onestroke.progress.ProgressCallback` (G-code lines read).
@@ -279,12 +280,12 @@ def render_gcode_preview(gcode_path: str | os.PathLike, out_path: str | os.PathL
         raise InputError(f"preview {str(out_path)!r} must end in {' or '.join(FORMATS)}")
     check_writable(out_path)
     profile = profile or load_laser_profile()
-    program = load_program(gcode_path)
+    program = gcode if isinstance(gcode, Program) else load_program(gcode)
     stats = analyze_program(program, settings=settings_from_profile(profile), planner_blocks=profile.planner_blocks,
                              progress=progress)
     if len(stats.moves) == 0:
-        raise InputError(f"G-code file {str(gcode_path)!r} holds no moves to preview")
+        raise InputError(f"G-code file {program.source!r} holds no moves to preview")
     job = estimate_program_time(program, profile, stats=stats)
-    scene = _scene(stats, job, profile, Path(gcode_path).name, program.n_lines)
+    scene = _scene(stats, job, profile, Path(program.source).name, program.n_lines)
     (_render_png if suffix == ".png" else _render_svg)(scene, out_path)
     return job

@@ -8,11 +8,11 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from fabrication.laser.gcode_write import GcodeOptions, comment_line, gcode_lines, gcode_text
+from fabrication.laser.gcode_write import GcodeOptions, comment_line, gcode_parts, gcode_text
 from fabrication.laser.toolpath import Toolpath, ToolpathOptions, plan_toolpath
-from machines.gcode_program import Program, ProgramStats, analyze_program, program_from_lines
-from machines.grbl_settings import settings_from_profile
-from machines.job_time import JobTime, estimate_program_time, format_duration
+from machines.gcode_program import ProgramStats
+from machines.job_repeat import RepeatedLines, read_repeated
+from machines.job_time import JobTime, format_duration
 from onestroke.errors import OnestrokeError
 from vectorize.drawing import Drawing
 
@@ -23,15 +23,15 @@ HEADER_LINES = 5  # comment lines before the G-code: name, size, settings, time,
 @dataclass(frozen=True, kw_only=True, eq=False)
 class LaserProgram:
     """toolpath: the planned burn (mm, machine frame); lines: the program without line
-    endings, header comments first; time: `machines.job_time` estimate of `lines`;
-    program, stats: `lines` as GRBL reads them (what the estimate and a preview use, read
-    once)."""
+    endings, header comments first; time: `machines.job_time` estimate of `lines`; stats:
+    `lines` as GRBL reads them (what the estimate and a preview use, read once); sent: the
+    lines a sender streams (the header's comments are not sent)."""
 
     toolpath: Toolpath
     lines: tuple[str, ...]
     time: JobTime
-    program: Program
     stats: ProgramStats
+    sent: int
 
     @property
     def text(self) -> str:
@@ -45,15 +45,15 @@ def laser_program(drawing: Drawing, profile, toolpath_options: ToolpathOptions,
     name) goes into the header comment. progress: an `onestroke.progress.ProgressCallback`
     (strokes planned, then G-code lines read back for the time estimate)."""
     toolpath = plan_toolpath(drawing, profile, toolpath_options, progress=progress)
-    lines = gcode_lines(toolpath, profile, gcode_options, progress=progress)
+    parts = gcode_parts(toolpath, profile, gcode_options, progress=progress)
     # machines/ reads the G-code as GRBL will, numbered as in the file: after the header's
     # comment lines, which GRBL never sees (so they change no time, only line numbers).
-    body = program_from_lines(lines)
-    program = Program(body.source, tuple((n + HEADER_LINES, text) for n, text in body.lines),
-                      body.n_lines + HEADER_LINES)
-    stats = analyze_program(program, settings=settings_from_profile(profile), planner_blocks=profile.planner_blocks,
-                            allow_settings=False, progress=progress)
-    job = estimate_program_time(program, profile, stats=stats)
+    # Passes repeat: it reads two of the repeated pair and extends (machines.job_repeat).
+    head, body, count, tail = parts.repeated()
+    reading = read_repeated(RepeatedLines(head=tuple(head), body=tuple(body), count=count, tail=tuple(tail),
+                                          first_line=HEADER_LINES + 1), profile, allow_settings=False,
+                            progress=progress)
+    job = reading.time
     if job.errors:  # the writer's bug, not the user's input: say so before writing anything
         line, text = job.errors[0]
         raise OnestrokeError(f"internal error: GRBL would refuse generated line {line}: {text}")
@@ -66,5 +66,5 @@ def laser_program(drawing: Drawing, profile, toolpath_options: ToolpathOptions,
         f"estimated time {format_duration(job.total_seconds)} ({job.bound_text(profile)})",
         f"profile: {profile.name}",
     )
-    return LaserProgram(toolpath=toolpath, lines=tuple(comment_line(c) for c in comments) + tuple(lines),
-                        time=job, program=program, stats=stats)
+    return LaserProgram(toolpath=toolpath, lines=tuple(comment_line(c) for c in comments) + tuple(parts.lines()),
+                        time=job, stats=reading.stats, sent=reading.sent)

@@ -35,18 +35,21 @@ def gcode_player_data(lines, *, title: str = "G-code",
 def laser_program_player_data(program, *, title: str, profile: LaserProfile) -> PlayerData:
     """`PlayerData` of a `fabrication.laser.program.LaserProgram` made for `profile`: the
     same as `gcode_player_data(program.lines)`, from the reading its estimate made."""
-    return _player_data(program.program, title, profile, stats=program.stats, job=program.time)
+    return _timed_player_data(program.stats, program.time, title, profile)
 
 
-def _player_data(program, title: str, profile: LaserProfile | None, *, stats=None, job=None) -> PlayerData:
+def _player_data(program, title: str, profile: LaserProfile | None) -> PlayerData:
     profile = profile or load_laser_profile()
-    if stats is None:
-        stats = analyze_program(program, settings=settings_from_profile(profile), planner_blocks=profile.planner_blocks)
+    stats = analyze_program(program, settings=settings_from_profile(profile), planner_blocks=profile.planner_blocks)
+    if len(stats.moves) == 0 or len(stats.segments) == 0:
+        raise InputError(f"G-code {title!r} holds no moves to play")
+    return _timed_player_data(stats, estimate_program_time(program, profile, stats=stats), title, profile)
+
+
+def _timed_player_data(stats, job, title: str, profile: LaserProfile) -> PlayerData:
     moves, seg = stats.moves, stats.segments
     if len(moves) == 0 or len(seg) == 0:
         raise InputError(f"G-code {title!r} holds no moves to play")
-    if job is None:
-        job = estimate_program_time(program, profile, stats=stats)
     n_lines = len(job.line_seconds)
     segments = np.stack([seg.start[:, :2], seg.end[:, :2]], axis=1)
     owner = seg.move

@@ -263,7 +263,7 @@ def create_app(session: StudioSession, *, token: str, hosts: set[str]) -> Guard:
 
     async def send(request: Request):
         from fabrication.studio.sender import LaserSender
-        from machines.stream_types import check_baud
+        from machines.stream_types import parse_baud
 
         if request.method == "GET":
             return JSONResponse(session.sender.status() if session.sender else {"state": "idle"})
@@ -271,7 +271,8 @@ def create_app(session: StudioSession, *, token: str, hosts: set[str]) -> Guard:
         if session.sender is not None and session.sender.running:
             raise InputError("a job is already being sent; abort it first")
         port = checked_port(str(data.get("port") or ""))
-        baud = check_baud(data.get("baud") or 115200, name="baud rate")
+        # the CLI's grammar and check (a text "115200" as a number; 0 refused, not the default)
+        baud = 115200 if data.get("baud") in (None, "") else parse_baud(data["baud"], name="--baud")
         name, _, content = await run_in_threadpool(session.export, "gcode", edits, options)
         session.sender = LaserSender(content.decode(), port=port, baud=baud, name=name).start()
         return JSONResponse(session.sender.status())

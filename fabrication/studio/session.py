@@ -361,7 +361,7 @@ class StudioSession:
         return {"player": data.to_dict(), "seconds": time.total_seconds,
                 "time": format_duration(time.total_seconds), "naive": format_duration(time.naive_seconds),
                 "burn_length": round(float(time.burn_length), 1), "travel_length": round(float(time.travel_length), 1),
-                "lines": len(program.program), "profile": settings.profile.name,  # the lines Send streams
+                "lines": program.sent, "profile": settings.profile.name,  # the lines Send streams
                 "warnings": list(settings.warnings)}
 
     def export(self, kind: str, edits: Edits, values: dict) -> tuple[str, str, bytes]:

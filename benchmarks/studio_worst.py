@@ -1,0 +1,156 @@
+"""Benchmark: the studio's heaviest in-range request per endpoint (issue 25: no request may
+take the server over 2 s or 500 MB, but a real job that is sent).
+
+Each case is one request the page (or any client holding the token) can make with option
+values inside their declared ranges (`onestroke.ranges`): the most passes at the finest
+tolerance on the largest bed, the densest stitches on the largest hoop, the vectorizer's
+extreme settings, the largest bodies. The session is made and its drawing vectorized
+first (not timed); then each case runs --repeats times through Starlette's test client and
+the script prints, per case, the median wall and CPU seconds (this process, all threads:
+on a loaded machine the wall time includes waiting for a core) and the peak memory of the
+process during the request (VmHWM, reset before each request through /proc/self/clear_refs),
+and per endpoint its worst case. The load average is printed with them.
+
+Run from the repo root: `python benchmarks/studio_worst.py [--repeats 3] [--only laser,embroidery]`.
+`--root DIR` imports onestroke from another checkout (e.g. to measure main before a change)
+while the cases stay these.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import re
+import sys
+import time
+import warnings
+from pathlib import Path
+from statistics import median
+
+ROOT = Path(__file__).resolve().parents[1]
+
+# An uploaded laser profile with the largest bed the profile ranges take (machines/laser_profile.py).
+BIG_BED = """name = "largest bed"
+[bed]
+size = "{side}x{side}mm"
+"""
+EDITS = {"format": "onestroke-edits", "version": 1, "edits": []}
+
+
+def cases(bed: float, hoop: float) -> list[tuple[str, str, str, object]]:
+    """(endpoint, label, method, body or query) of the heaviest requests found."""
+    laser_worst = {"size": "400mm", "tolerance": "0.005mm", "passes": "100"}
+    big = {"size": f"{bed:g}mm", "tolerance": "0.005mm", "passes": "100", "profile": "@big"}
+    field = {"size": f"{hoop:g}mm", "hoop": f"{hoop:g}x{hoop:g}", "fit": True}  # shrunk into the hoop
+    zigzag = dict(field, style="zigzag", spacing="0.1mm")
+    satin = dict(field, style="satin", spacing="0.1mm")
+    running = dict(field, style="running", stitch_length="0.1mm", min_stitch="0.1mm")
+    triple = dict(field, style="triple", stitch_length="0.1mm", min_stitch="0.1mm", repeats="5")
+    arrows = dict(field, style="arrows", arrow_size="0.1mm", spacing="0.2mm", min_stitch="0.1mm")
+    many = {"format": "onestroke-edits", "version": 1,
+            "edits": [{"kind": "reverse", "at": [float(i % 997), float(i % 599)]} for i in range(9000)]}
+    profile_text = BIG_BED.format(side=bed) + "# " + "x" * (60 * 1024) + "\n"
+    return [
+        ("state", "threshold 0.95", "POST", {"edits": dict(EDITS, threshold=0.95)}),
+        ("state", "blur 25 px", "POST", {"edits": dict(EDITS, blur=25)}),
+        ("state", "multi-stroke, threshold 0.05", "POST", {"edits": dict(EDITS, multi=True, threshold=0.05)}),
+        ("state", "threshold 0.05", "POST", {"edits": dict(EDITS, threshold=0.05)}),
+        ("state", "9,000 reverse edits", "POST", {"edits": many}),
+        ("mask", "threshold 0.05, blur 25", "GET", "threshold=0.05&blur=25"),
+        ("laser", "400 mm, 0.005 mm, 100 passes", "POST", {"options": laser_worst}),
+        ("laser", "same with arcs", "POST", {"options": dict(laser_worst, arcs=True)}),
+        ("laser", f"uploaded {bed:g} mm bed, {bed:g} mm, 0.005 mm, 100 passes", "POST", {"options": big}),
+        ("export/gcode", "400 mm, 0.005 mm, 100 passes", "POST", {"options": laser_worst}),
+        ("export/gcode", f"uploaded {bed:g} mm bed, 100 passes", "POST", {"options": big}),
+        ("embroidery", f"zigzag 0.1 mm spacing, {hoop:g} mm hoop", "POST", {"options": zigzag}),
+        ("embroidery", f"running 0.1 mm, {hoop:g} mm hoop", "POST", {"options": running}),
+        ("embroidery", f"triple x5 0.1 mm, {hoop:g} mm hoop", "POST", {"options": triple}),
+        ("embroidery", f"arrows 0.1 mm, {hoop:g} mm hoop", "POST", {"options": arrows}),
+        ("embroidery", f"satin 0.1 mm spacing, {hoop:g} mm hoop", "POST", {"options": satin}),
+        ("export/pes", f"zigzag 0.1 mm spacing, {hoop:g} mm hoop", "POST", {"options": zigzag}),
+        ("export/dst", f"zigzag 0.1 mm spacing, {hoop:g} mm hoop", "POST", {"options": zigzag}),
+        ("export/jef", f"zigzag 0.1 mm spacing, {hoop:g} mm hoop", "POST", {"options": zigzag}),
+        ("export/exp", f"zigzag 0.1 mm spacing, {hoop:g} mm hoop", "POST", {"options": zigzag}),
+        ("export/vp3", f"zigzag 0.1 mm spacing, {hoop:g} mm hoop", "POST", {"options": zigzag}),
+        ("export/svg", "the drawing", "POST", {}),
+        ("export/json", "the drawing", "POST", {}),
+        ("edits", "save 9,000 edits", "POST", {"edits": many}),
+        ("profiles", "a 61 kB profile", "POST", {"name": "big.toml", "text": profile_text}),
+        ("image", "the drawing", "GET", ""),
+        ("ports", "list", "GET", ""),
+    ]
+
+
+def _status(key: str) -> float:
+    return int(re.search(key + r":\s+(\d+)", Path("/proc/self/status").read_text()).group(1)) / 1024
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("drawing", nargs="?", default=str(ROOT / "examples" / "loops.png"))
+    parser.add_argument("--repeats", type=int, default=3)
+    parser.add_argument("--only", default="", help="comma-separated endpoints (default: all)")
+    parser.add_argument("--root", default=str(ROOT), help="the checkout to import onestroke from")
+    parser.add_argument("--bed", type=float, default=None, help="bed side of the uploaded profile (mm)")
+    parser.add_argument("--hoop", type=float, default=None, help="custom hoop side (mm)")
+    args = parser.parse_args()
+    sys.path.insert(0, args.root)
+    warnings.filterwarnings("ignore")
+    from starlette.testclient import TestClient
+
+    from fabrication.studio.app import create_app
+    from fabrication.studio.session import StudioSession
+
+    bed, hoop = args.bed, args.hoop
+    if bed is None or hoop is None:  # the largest the declarations take
+        try:
+            from machines.hoops import HOOP_SIDE
+            from machines.laser_profile import BED_SIDE
+            bed, hoop = bed or BED_SIDE.high, hoop or HOOP_SIDE.high
+        except ImportError:  # a checkout without them: no limit was declared
+            bed, hoop = bed or 10_000.0, hoop or 11_000.0
+    session = StudioSession(args.drawing, edits_path=Path(os.devnull), precompute=False)
+    session.warm()
+    host = "127.0.0.1:1"
+    client = TestClient(create_app(session, token="t", hosts={host}), base_url=f"http://{host}")
+    client.headers["X-Studio-Token"] = "t"
+    client.get("/api/state")
+    only = set(filter(None, args.only.split(",")))
+    print(f"{Path(args.drawing).name}, from {args.root}; load average {os.getloadavg()[0]:.1f}; "
+          f"rss after the first state {_status('VmRSS'):.0f} MB")
+    worst: dict[str, tuple[float, float, float, str]] = {}
+    for endpoint, label, method, body in cases(bed, hoop):
+        if only and endpoint not in only:
+            continue
+        body = json.loads(json.dumps(body))
+        if isinstance(body, dict) and (body.get("options") or {}).get("profile") == "@big":
+            uploaded = client.post("/api/profiles", json={"name": "big.toml", "text": BIG_BED.format(side=bed)})
+            if uploaded.status_code != 200:
+                print(f"{endpoint:13} {label}: the profile was refused: {uploaded.json()['error']}")
+                continue
+            body["options"]["profile"] = uploaded.json()["id"]
+        walls, cpus, peaks = [], [], []
+        for _ in range(args.repeats):
+            Path("/proc/self/clear_refs").write_text("5")  # VmHWM := VmRSS
+            started, cpu = time.perf_counter(), time.process_time()
+            if method == "GET":
+                answer = client.get(f"/api/{endpoint}" + (f"?{body}" if body else ""))
+            else:
+                answer = client.post(f"/api/{endpoint}", json=body)
+            cpus.append(time.process_time() - cpu)
+            walls.append(time.perf_counter() - started)
+            peaks.append(_status("VmHWM"))
+        said = answer.json().get("error", "") if answer.status_code != 200 else ""
+        row = (median(walls), median(cpus), max(peaks), label)
+        print(f"{endpoint:13} {label:50} {answer.status_code} wall {row[0]:6.2f} s  cpu {row[1]:6.2f} s  "
+              f"peak {row[2]:5.0f} MB  {len(answer.content) / 1e6:5.1f} MB {said[:80]}", flush=True)
+        if answer.status_code == 200 and (endpoint not in worst or row[1] > worst[endpoint][1]):
+            worst[endpoint] = row
+    print(f"\nworst case per endpoint (median of {args.repeats}; load average {os.getloadavg()[0]:.1f}):")
+    for endpoint, (wall, cpu, peak, label) in worst.items():
+        print(f"  {endpoint:13} wall {wall:6.2f} s  cpu {cpu:6.2f} s  peak {peak:5.0f} MB  ({label})")
+
+
+if __name__ == "__main__":
+    main()
