@@ -85,9 +85,10 @@ def _pruned(n: int, rows: np.ndarray, cols: np.ndarray, w: np.ndarray) -> list[t
     # The bound holds for any y; a slightly infeasible one (r < 0 by rounding) only widens it.
     slack = n / 2 * max(0.0, -float(reduced.min())) + 1.0
     weight = {(int(u), int(v)): int(x) for u, v, x in zip(rows, cols, w)}
-    # A first perfect matching from the tight edges and each vertex's cheapest few by reduced
-    # cost; its cost U bounds which edges the optimum may use.
-    keep = (reduced <= 1.0) | _cheapest_at(n, rows, cols, reduced, 3)
+    # A first perfect matching from the tightest edges (about 3 per vertex) and each vertex's
+    # 3 cheapest by reduced cost; its cost U bounds which edges the optimum may use (on the
+    # cursive set's lines the first is usually the last).
+    keep = (reduced <= max(1.0, float(np.sort(reduced)[min(k - 1, 3 * n)]))) | _cheapest_at(n, rows, cols, reduced, 3)
     while True:
         mate = _blossom(rows[keep], cols[keep], w[keep])
         if 2 * len(mate) == n or keep.all():

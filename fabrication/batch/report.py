@@ -117,7 +117,8 @@ class ReportRoom:
 
     def __init__(self, out_dir: str | os.PathLike, inputs: int, targets: int) -> None:
         self.path = Path(out_dir) / RESERVE_NAME
-        # measured: about 1.2 kB per input (CSV, JSON and manifest rows) and 150 B per output
+        # measured: 20 inputs to svg, pes and gcode wrote a 10.6 kB manifest, a 3.1 kB CSV and an
+        # 8.2 kB JSON (1.1 kB per input); about twice that, for long names and error messages
         size = 8192 + inputs * (2048 + 256 * targets)
         try:
             fd = os.open(self.path, os.O_WRONLY | os.O_CREAT | os.O_TRUNC, 0o600)

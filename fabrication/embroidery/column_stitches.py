@@ -174,21 +174,26 @@ def _keep_holes_apart(points, rows: Rows, side, offset, step, width, min_gap) ->
     todo = np.flatnonzero(near)
     if not len(todo):
         return points
-    points = points.copy()
-    # Python scalars: the loop touches single points.
+    # Python floats: the loop touches single points (the same operations as on numpy's
+    # scalars: np.hypot of the differences, centre + normal x offset per coordinate).
+    out = points.tolist()
+    centre, normal = rows.centre.tolist(), rows.normal.tolist()
+    offset, side, step, width = (np.asarray(v, dtype=float).tolist() for v in (offset, side, step, width))
+    hypot = np.hypot
     for i in todo.tolist():
         if i < 2 or i == n - 1:
             continue
-        back = [points[i - 2]] + ([points[i - 4]] if i >= 4 else [])
-        here = offset[i]
-        limit = MAX_INSET * width[i]
+        (ax, ay), (bx, by) = out[i - 2], out[i - 4] if i >= 4 else out[i - 2]
+        here, stride, limit = offset[i], step[i], MAX_INSET * width[i]
         inset = 0.0
-        p = points[i]
-        while min(np.hypot(*(p - q)) for q in back) < min_gap and inset + step[i] <= limit + 1e-9 and step[i] > 0:
-            inset += step[i]
-            p = rows.centre[i] + rows.normal[i] * (here - side[i] * inset)
-        points[i] = p
-    return points
+        px, py = out[i]
+        while min(hypot(px - ax, py - ay), hypot(px - bx, py - by)) < min_gap and inset + stride <= limit + 1e-9 \
+                and stride > 0:
+            inset += stride
+            k = here - side[i] * inset
+            px, py = centre[i][0] + normal[i][0] * k, centre[i][1] + normal[i][1] * k
+        out[i] = [px, py]
+    return np.array(out, dtype=float)
 
 
 def split_long(points: np.ndarray, t: np.ndarray, max_length: float,

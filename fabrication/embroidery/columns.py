@@ -23,6 +23,7 @@ next one alone.
 from __future__ import annotations
 
 import bisect
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -405,23 +406,32 @@ def _thin_crowded(rows: list[Rows], spacing: float) -> None:
     count = np.bincount(pairs.ravel(), minlength=len(ends))
     if count.max(initial=0) <= 2 * CROWDED:
         return
-    alive = np.ones(row_of.max() + 1, dtype=bool)
-    column_of = np.repeat(np.arange(len(sizes)), sizes)
     suspects = np.unique(row_of[count > 2 * CROWDED]).tolist()
+    # Each point's neighbours of other rows (the pairs both ways, by point) and how many of
+    # them belong to rows still kept (updated as rows go): a suspect's check is a look-up
+    # (it used to search the tree per point, and each row's points among all of them).
+    source = np.concatenate([pairs[:, 0], pairs[:, 1]])
+    order = np.argsort(source, kind="stable")
+    near = np.concatenate([pairs[:, 1], pairs[:, 0]])[order].astype(np.int32)
+    first = np.searchsorted(source[order], np.arange(len(ends) + 1))
+    del pairs, source, order  # millions of pairs on the densest columns: not kept through the loop
+    kept_near = count.copy()
+    points_of = np.argsort(row_of, kind="stable").reshape(-1, 2).tolist()  # each row's left, right point
+    alive = [True] * (int(row_of.max()) + 1)
+    column_of = np.repeat(np.arange(len(sizes)), sizes).tolist()
+    rails = ends.tolist()
     for row in suspects:
-        mine = np.flatnonzero(row_of == row)
-        crowded = False
-        for point in mine.tolist():
-            near = tree.query_ball_point(ends[point], DENSITY_RADIUS)
-            others = row_of[near]
-            if int(np.count_nonzero(alive[others] & (others != row))) > 2 * CROWDED:
-                crowded = True
-                break
+        left, right = points_of[row]
         # A row narrower than the density circle lies in it whole: there only the spacing
         # itself bounds the gap.
-        narrow = float(np.linalg.norm(ends[mine[0]] - ends[mine[1]])) < 2.0 * DENSITY_RADIUS
-        if crowded and _gap_closed(ends, row_of, column_of, alive, row, (1.0 if narrow else THIN_GAP) * spacing):
+        dx, dy = rails[left][0] - rails[right][0], rails[left][1] - rails[right][1]
+        narrow = math.sqrt(dx * dx + dy * dy) < 2.0 * DENSITY_RADIUS
+        if (kept_near[left] > 2 * CROWDED or kept_near[right] > 2 * CROWDED) and \
+                _gap_closed(rails, points_of, column_of, alive, row, (1.0 if narrow else THIN_GAP) * spacing):
             alive[row] = False
+            for point in (left, right):
+                kept_near[near[first[point]:first[point + 1]]] -= 1
+    alive = np.array(alive, dtype=bool)
     base = 0
     for j, n in enumerate(sizes):
         if n:
@@ -431,10 +441,10 @@ def _thin_crowded(rows: list[Rows], spacing: float) -> None:
             base += n
 
 
-def _gap_closed(ends: np.ndarray, row_of: np.ndarray, column_of: np.ndarray, alive: np.ndarray, row: int,
-                spacing: float) -> bool:
-    """Whether the rows kept before and after `row` in its column lie within `spacing` mm of
-    each other on both rails (`ends`: every row's left then right rail point, by `row_of`)."""
+def _gap_closed(ends: list, points_of: list, column_of: list, alive: list, row: int, spacing: float) -> bool:
+    """Whether the rows kept (`alive`) before and after `row` in its column lie within
+    `spacing` mm of each other on both rails (`ends`: the rail points, `points_of` each row's
+    left and right one; Python lists: one row at a time)."""
     before, after = row - 1, row + 1
     while before >= 0 and column_of[before] == column_of[row] and not alive[before]:
         before -= 1
@@ -442,8 +452,12 @@ def _gap_closed(ends: np.ndarray, row_of: np.ndarray, column_of: np.ndarray, ali
         after += 1
     if before < 0 or after >= len(alive) or column_of[before] != column_of[row] or column_of[after] != column_of[row]:
         return False  # a column's first and last rows stay
-    a, b = ends[row_of == before], ends[row_of == after]
-    return bool(np.max(np.linalg.norm(a - b, axis=1)) <= spacing + 1e-9)
+    # the same operations as numpy's norm of the differences: sqrt(dx * dx + dy * dy)
+    far = 0.0
+    for a, b in zip(points_of[before], points_of[after]):
+        dx, dy = ends[a][0] - ends[b][0], ends[a][1] - ends[b][1]
+        far = max(far, math.sqrt(dx * dx + dy * dy))
+    return far <= spacing + 1e-9
 
 
 def _within(rows: Rows, point: np.ndarray, reach: float) -> Rows:
