@@ -118,24 +118,30 @@ def _relieve_density(points, keep, roles, inward, side, sides, max_gap, max_top_
     def over() -> np.ndarray:
         return alive & (count > limit)
 
-    # 1. underlay points, the most crowded first, while one of their neighbours is over.
-    while True:
-        o = over()
-        if not o.any():
-            break
-        crowding = (near & o[None, :]).sum(axis=1) * (underlay & alive)
-        choice = int(np.argmax(crowding))
-        if crowding[choice] == 0 or not _gap_ok(points, keep, int(local[choice]), roles, max_gap):
+    def leave_out(candidates: np.ndarray, gap: float) -> None:
+        """Leave out `candidates` (a mask over `local`, cleared as tried), the most crowding
+        first, while a point around them is over the limit and the stitch that replaces
+        their two stays within `gap` mm."""
+        nonlocal count
+        while True:
+            o = over()
+            if not o.any():
+                return
+            crowding = (near & o[None, :]).sum(axis=1) * (candidates & alive)
+            choice = int(np.argmax(crowding))
             if crowding[choice] == 0:
-                break
-            underlay[choice] = False  # its walk would take too long a stitch: try the others
-            continue
-        alive[choice] = False
-        keep[local[choice]] = False
-        count -= near[:, choice]
-        near[choice, :] = False
-        near[:, choice] = False
-        underlay[choice] = False
+                return
+            candidates[choice] = False
+            if not _gap_ok(points, keep, int(local[choice]), roles, gap):
+                continue  # it would leave too long a stitch: try the others
+            alive[choice] = False
+            keep[local[choice]] = False
+            count = count - near[:, choice]
+            near[choice, :] = False
+            near[:, choice] = False
+
+    # 1. underlay points, the most crowded first, while one of their neighbours is over.
+    leave_out(underlay, max_gap)
 
     # 2. top points inset towards their row's centre.
     tried = np.zeros(len(local), dtype=bool)
@@ -173,23 +179,7 @@ def _relieve_density(points, keep, roles, inward, side, sides, max_gap, max_top_
     # 3. where the line comes back over itself (a crossing, a closed line's ends), the
     # first pass's top points there, which the later pass covers, are left out.
     later = np.array([np.any(local[near[i]] > local[i] + AGAIN) for i in range(len(local))])
-    top = (roles[local] == BODY) & (local > 0) & (local < len(points) - 1) & later
-    while True:
-        o = over()
-        if not o.any():
-            break
-        crowding = (near & o[None, :]).sum(axis=1) * (top & alive)
-        choice = int(np.argmax(crowding))
-        if crowding[choice] == 0:
-            break
-        top[choice] = False
-        if not _gap_ok(points, keep, int(local[choice]), roles, max_top_gap):
-            continue
-        alive[choice] = False
-        keep[local[choice]] = False
-        count -= near[:, choice]
-        near[choice, :] = False
-        near[:, choice] = False
+    leave_out((roles[local] == BODY) & (local > 0) & (local < len(points) - 1) & later, max_top_gap)
 
 
 def _clear_holes(points, keep, roles, inward, side, sides, max_gap) -> None:
