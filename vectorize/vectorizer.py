@@ -26,8 +26,9 @@ from vectorize.options import InputFrame, VectorizeOptions, VectorizeReport, Vec
 from vectorize.preload import preload, wait
 from vectorize.pruning import prune, trim_free_ends
 from vectorize.retraces import Twin, foot_is_retraced, twin_spans
+from vectorize.route_ends import end_costs
 from vectorize.route_inspection import connect_pairings, plan_routes
-from vectorize.simplify import Simplified, is_t_shape, directions, simplify, slots
+from vectorize.simplify import Simplified, directions, simplify, slots
 from vectorize.stroke import Stroke
 from vectorize.traversal import Ordering, order_strokes
 
@@ -280,30 +281,6 @@ def _order(graph: MedialGraph, ink, options: VectorizeOptions, ends: int, clock:
     return _Solution(graph, simple, junctions, verdicts, ordering, tried)
 
 
-# Cost (in stroke widths) of the pen starting or ending at a junction that is not a line
-# ending on another line: a whole spike of up to this length is retraced rather.
-JUNCTION_END = 20.0
-# ... but never more than this share of the whole line per end: avoiding a poor end is not
-# worth drawing more than 1 % of the drawing twice (a long spike on a closed loop then starts
-# at its tip and ends at its base, the shortest line over the ink).
-END_SHARE = 0.01
-
-
-def _junction_end_cost(graph: MedialGraph, node: int, dirs: np.ndarray, w: float) -> float:
-    """How poor a place `node` is for the pen to start or end (px).
-
-    Plausible only where a line comes in and stops on another (a T whose stem is not a
-    free branch: the tail of a 6 closing its loop). A junction where a stub or spike
-    leaves a line is not: the pen would have drawn the stub first from its far end.
-    """
-    if len(dirs) == 3 and is_t_shape(dirs):
-        cos = [(float(np.dot(dirs[i], dirs[j])), k) for i, j, k in ((0, 1, 2), (0, 2, 1), (1, 2, 0))]
-        stem = min(cos)[1]
-        if graph.degree(graph.branches[slots(graph, node)[stem][0]].other(node)) != 1:
-            return 0.1 * w
-    return JUNCTION_END * w
-
-
 def _single_route(graph: MedialGraph, simple: Simplified, ranked: dict, costs: dict,
                   w: float, start_at: dict | None = None, weight: dict | None = None) -> tuple[Ordering, int]:
     """Single-line mode: one stroke over the whole (connected) graph, retracing the least.
@@ -311,15 +288,7 @@ def _single_route(graph: MedialGraph, simple: Simplified, ranked: dict, costs: d
     branch id -> factor on its retrace cost (a user's twice / once edits)."""
     pairing, tried = connect_pairings(graph, ranked, costs, fixed=simple.through)
     dirs = {n: directions(graph, n, 2.5 * w) for n in graph.incident if graph.degree(n) >= 3}
-    # The tip of a sharp corner's spur is not where a pen starts; a junction is a poorer
-    # place than a free end, all else equal.
-    v_tips = {graph.branches[slots(graph, n)[f][0]].other(n) for n, f in simple.y_feet.items()
-              if n not in simple.retraced}
-    end_cost = {n: 3.0 * w for n in v_tips}
-    end_cost.update({n: _junction_end_cost(graph, n, dirs[n], w) for n in dirs})
-    most = END_SHARE * sum(b.length for b in graph.branches.values())
-    end_cost = {n: min(cost, most) for n, cost in end_cost.items()}
-    end_cost.update(start_at or {})
+    end_cost = {**end_costs(graph, simple, dirs, w), **(start_at or {})}
     routes = plan_routes(graph, {**simple.through, **pairing}, stroke_width=w, directions=dirs, end_cost=end_cost,
                          weight=weight)
     choice = tuple(pairing.get(n, ranked[n][0]) for n in simple.crossings)
