@@ -28,6 +28,7 @@ from dataclasses import dataclass
 
 import numpy as np
 import shapely
+from scipy.sparse import coo_matrix
 from scipy.spatial import cKDTree
 
 from fabrication.embroidery.quality import DENSITY_RADIUS
@@ -401,20 +402,20 @@ def _thin_crowded(rows: list[Rows], spacing: float) -> None:
                              zip([n for n in sizes if n], np.cumsum([0] + [n for n in sizes if n])[:-1])])
     tree = cKDTree(ends)
     pairs = tree.query_pairs(DENSITY_RADIUS, output_type="ndarray")
-    pairs = pairs[row_of[pairs[:, 0]] != row_of[pairs[:, 1]]]
+    pairs = pairs[row_of[pairs[:, 0]] != row_of[pairs[:, 1]]].astype(np.int32)
+    # Each point's neighbours of other rows, both ways (a sparse graph: millions of pairs on
+    # the densest columns, kept as int32), and how many of them belong to rows still kept
+    # (updated as rows go): a suspect's check is a look-up (it used to search the tree per
+    # point, and each row's points among all of them).
+    graph = coo_matrix((np.ones(len(pairs), dtype=np.int8), (pairs[:, 0], pairs[:, 1])), shape=(len(ends),) * 2)
+    del pairs
+    graph = (graph + graph.T).tocsr()
+    first, near = graph.indptr, graph.indices
     # Each row has both ends but sews one (the sides alternate): two ends per needle point.
-    count = np.bincount(pairs.ravel(), minlength=len(ends))
+    count = np.diff(first)
     if count.max(initial=0) <= 2 * CROWDED:
         return
     suspects = np.unique(row_of[count > 2 * CROWDED]).tolist()
-    # Each point's neighbours of other rows (the pairs both ways, by point) and how many of
-    # them belong to rows still kept (updated as rows go): a suspect's check is a look-up
-    # (it used to search the tree per point, and each row's points among all of them).
-    source = np.concatenate([pairs[:, 0], pairs[:, 1]])
-    order = np.argsort(source, kind="stable")
-    near = np.concatenate([pairs[:, 1], pairs[:, 0]])[order].astype(np.int32)
-    first = np.searchsorted(source[order], np.arange(len(ends) + 1))
-    del pairs, source, order  # millions of pairs on the densest columns: not kept through the loop
     kept_near = count.copy()
     points_of = np.argsort(row_of, kind="stable").reshape(-1, 2).tolist()  # each row's left, right point
     alive = [True] * (int(row_of.max()) + 1)
