@@ -28,6 +28,7 @@ from dataclasses import dataclass
 
 import numpy as np
 import shapely
+from scipy.sparse import coo_matrix
 from scipy.spatial import cKDTree
 
 from fabrication.embroidery.quality import DENSITY_RADIUS
@@ -51,6 +52,9 @@ CLUSTER = 4.0
 # A rail point with more rail points of other rows than this within DENSITY_RADIUS (the
 # rails alone: underlay, tacks and locks may add one or two) has a row too many.
 CROWDED = 4
+# ... and one is left out only where the rows either side of it lie within this share of
+# the spacing of each other on both rails (the threads either side then still cover it).
+THIN_GAP = 0.75
 
 
 @dataclass(frozen=True, eq=False)
@@ -387,8 +391,8 @@ def _thin_crowded(rows: list[Rows], spacing: float) -> None:
     """In place: rows whose rail points crowd (more than CROWDED needle points of other rows
     within DENSITY_RADIUS mm: the inside of a tight bend, the ground where corners meet) are
     left out, in sewing order, while they still crowd, and only where the rows kept either
-    side of one lie within `spacing` mm of each other on both rails (the outside of the
-    bend stays covered: no slit there). Whole rows go, so the sides still alternate; only
+    side of one lie within THIN_GAP x `spacing` mm of each other on both rails (the outside
+    of the bend stays covered: no slit there). Whole rows go, so the sides still alternate; only
     the rows whose points crowd at first are visited."""
     sizes = [len(r) for r in rows]
     if sum(sizes) < 2:
@@ -398,20 +402,20 @@ def _thin_crowded(rows: list[Rows], spacing: float) -> None:
                              zip([n for n in sizes if n], np.cumsum([0] + [n for n in sizes if n])[:-1])])
     tree = cKDTree(ends)
     pairs = tree.query_pairs(DENSITY_RADIUS, output_type="ndarray")
-    pairs = pairs[row_of[pairs[:, 0]] != row_of[pairs[:, 1]]]
+    pairs = pairs[row_of[pairs[:, 0]] != row_of[pairs[:, 1]]].astype(np.int32)
+    # Each point's neighbours of other rows, both ways (a sparse graph: millions of pairs on
+    # the densest columns, kept as int32), and how many of them belong to rows still kept
+    # (updated as rows go): a suspect's check is a look-up (it used to search the tree per
+    # point, and each row's points among all of them).
+    graph = coo_matrix((np.ones(len(pairs), dtype=np.int8), (pairs[:, 0], pairs[:, 1])), shape=(len(ends),) * 2)
+    del pairs
+    graph = (graph + graph.T).tocsr()
+    first, near = graph.indptr, graph.indices
     # Each row has both ends but sews one (the sides alternate): two ends per needle point.
-    count = np.bincount(pairs.ravel(), minlength=len(ends))
+    count = np.diff(first)
     if count.max(initial=0) <= 2 * CROWDED:
         return
     suspects = np.unique(row_of[count > 2 * CROWDED]).tolist()
-    # Each point's neighbours of other rows (the pairs both ways, by point) and how many of
-    # them belong to rows still kept (updated as rows go): a suspect's check is a look-up
-    # (it used to search the tree per point, and each row's points among all of them).
-    source = np.concatenate([pairs[:, 0], pairs[:, 1]])
-    order = np.argsort(source, kind="stable")
-    near = np.concatenate([pairs[:, 1], pairs[:, 0]])[order].astype(np.int32)
-    first = np.searchsorted(source[order], np.arange(len(ends) + 1))
-    del pairs, source, order  # millions of pairs on the densest columns: not kept through the loop
     kept_near = count.copy()
     points_of = np.argsort(row_of, kind="stable").reshape(-1, 2).tolist()  # each row's left, right point
     alive = [True] * (int(row_of.max()) + 1)
@@ -419,8 +423,12 @@ def _thin_crowded(rows: list[Rows], spacing: float) -> None:
     rails = ends.tolist()
     for row in suspects:
         left, right = points_of[row]
+        # A row narrower than the density circle lies in it whole: there only the spacing
+        # itself bounds the gap.
+        dx, dy = rails[left][0] - rails[right][0], rails[left][1] - rails[right][1]
+        narrow = math.sqrt(dx * dx + dy * dy) < 2.0 * DENSITY_RADIUS
         if (kept_near[left] > 2 * CROWDED or kept_near[right] > 2 * CROWDED) and \
-                _gap_closed(rails, points_of, column_of, alive, row, spacing):
+                _gap_closed(rails, points_of, column_of, alive, row, (1.0 if narrow else THIN_GAP) * spacing):
             alive[row] = False
             for point in (left, right):
                 kept_near[near[first[point]:first[point + 1]]] -= 1

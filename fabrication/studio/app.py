@@ -159,6 +159,29 @@ def checked_port(port: str) -> str:
     raise InputError(f"port {text!r}: give a serial device (/dev/ttyUSB0, COM3) or sim:// for a dry run")
 
 
+def _malloc_trim():
+    """glibc's malloc_trim, or None (another C library): see `release_memory`."""
+    import ctypes
+    import ctypes.util
+
+    try:
+        return ctypes.CDLL(ctypes.util.find_library("c") or "libc.so.6").malloc_trim
+    except (OSError, AttributeError):
+        return None
+
+
+MALLOC_TRIM = _malloc_trim()
+
+
+def release_memory() -> None:
+    """Give the memory a request freed back to the system. glibc keeps freed blocks in the
+    arena of the thread that used them (each request runs in a pool thread), so without this
+    a session's resident memory crept from 180 to 365 MB over eight of the heaviest requests
+    (and the next one peaked from there); with it, it stays near 180 MB. A few ms."""
+    if MALLOC_TRIM is not None:
+        MALLOC_TRIM(0)
+
+
 def _error(error: Exception) -> JSONResponse:
     status = 413 if isinstance(error, TooLarge) else 400 if isinstance(error, InputError) else 500
     return JSONResponse({"error": str(error)}, status_code=status)
@@ -187,6 +210,9 @@ def create_app(session: StudioSession, *, token: str, hosts: set[str]) -> Guard:
                 return _error(error)
             except Exception as error:  # noqa: BLE001 - the page shows one line, never a bare "500"
                 return JSONResponse({"error": f"internal error: {type(error).__name__}: {error}"}, status_code=500)
+            finally:
+                if request.method == "POST":  # the requests that make G-code, stitches or a state
+                    release_memory()
         return endpoint
 
     async def index(request: Request):
