@@ -28,9 +28,14 @@ runs two kinds of fresh process, alternately:
 
 The figures are medians over the runs. On a machine shared with other work the wall time
 includes waiting for a core; compare CPU time between versions (the load is printed).
-PYTHONDONTWRITEBYTECODE=1 in the environment makes every process compile the project's own
-modules from source (an installed package has them compiled); the line "bytecode" says
-which was measured, and --pycache DIR lets the children keep compiled modules in DIR.
+
+What is measured is what a user runs: this working tree installed the regular way (`pip
+install .`, modules compiled by pip) into a new virtual environment in a temporary folder,
+its dependencies from this interpreter's (`user_install.py`). `--editable` measures the
+working tree through PYTHONPATH instead, as the tests run it: with PYTHONDONTWRITEBYTECODE=1
+in the environment every process then compiles the project's own modules from source; the
+line "bytecode" says which was measured, and --pycache DIR lets the children keep compiled
+modules in DIR.
 """
 
 from __future__ import annotations
@@ -105,8 +110,10 @@ def child_cpu_seconds() -> float:
     return usage.ru_utime + usage.ru_stime
 
 
-def bytecode_note(env) -> str:
+def bytecode_note(env, installed: bool = False) -> str:
     """Whether processes with environment `env` keep the project's compiled modules."""
+    if installed:
+        return "the project's modules compiled at install (a regular `pip install .`, what a user runs)"
     if env.get("PYTHONDONTWRITEBYTECODE"):
         return ("not written (PYTHONDONTWRITEBYTECODE is set: each process compiles the project's own modules "
                 "from source; an installed package has them compiled)")
@@ -129,16 +136,12 @@ def main(argv: list[str] | None = None) -> int:
     import argparse
     import os
     import shutil
-    import statistics
     import tempfile
     from pathlib import Path
 
     root = Path(__file__).resolve().parents[1]
     if str(root) not in sys.path:
         sys.path.insert(0, str(root))
-    from PIL import Image
-
-    from benchmarks.render import render, to_uint8
     from benchmarks.vectorize_bench import DEFAULT_COUNTS, SETS, build_set
 
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[1])
@@ -148,56 +151,81 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--timeout", type=float, default=120.0)
     ap.add_argument("--pairs", type=int, default=None, metavar="N",
                     help="instead: N pairs of the command and a bare process importing the same libraries")
+    ap.add_argument("--editable", action="store_true",
+                    help="measure the working tree through PYTHONPATH (as the tests run it) instead of a regular "
+                         "install of it")
     ap.add_argument("--pycache", type=Path, default=None, metavar="DIR",
-                    help="let the children write and read compiled modules in DIR (PYTHONPYCACHEPREFIX), "
-                         "as an installed package has them; one unmeasured run first fills it")
+                    help="with --editable: let the children write and read compiled modules in DIR "
+                         "(PYTHONPYCACHEPREFIX); one unmeasured run first fills it")
     args = ap.parse_args(argv)
 
     tasks = [gt for name in SETS for gt in build_set(name, DEFAULT_COUNTS[name], args.seed)]
     count = args.pairs or args.count
     picks = tasks[:: max(1, len(tasks) // count)][:count]
-    env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(root), os.environ.get("PYTHONPATH", "")]).rstrip(os.pathsep)}
-    if args.pycache is not None:
-        env.pop("PYTHONDONTWRITEBYTECODE", None)
-        env["PYTHONPYCACHEPREFIX"] = str(args.pycache.resolve())
-    exe = shutil.which("onestroke")
-    command = [exe] if exe else [sys.executable, "-m", "fabrication.cli"]
-    if args.pairs:
-        from benchmarks.startup_ratio import ratio_pairs
+    with tempfile.TemporaryDirectory(prefix="onestroke-startup-") as tmp:
+        if args.editable:
+            env = {**os.environ,
+                   "PYTHONPATH": os.pathsep.join([str(root), os.environ.get("PYTHONPATH", "")]).rstrip(os.pathsep)}
+            if args.pycache is not None:
+                env.pop("PYTHONDONTWRITEBYTECODE", None)
+                env["PYTHONPYCACHEPREFIX"] = str(args.pycache.resolve())
+            python, exe = sys.executable, shutil.which("onestroke")
+            command = [exe] if exe else [sys.executable, "-m", "fabrication.cli"]
+        else:
+            from benchmarks.user_install import regular_install
 
-        return ratio_pairs(picks, command, env, args.timeout)
+            env = dict(os.environ)
+            bin_dir = regular_install(Path(tmp) / "venv", root)
+            python, command = str(bin_dir / "python"), [str(bin_dir / "onestroke")]
+        note = bytecode_note(env, installed=not args.editable)
+        if args.pairs:
+            from benchmarks.startup_ratio import ratio_pairs
+
+            print(f"bytecode: {note}")
+            return ratio_pairs(picks, command, python, env, args.timeout)
+        return _parts(picks, command, python, env, note, args.repeat, args.timeout, Path(tmp),
+                      fill_cache=args.pycache is not None and args.editable)
+
+
+def _parts(picks: list, command: list[str], python: str, env: dict, note: str, repeat: int, timeout: float,
+           tmp: Path, fill_cache: bool) -> int:
+    """Run the command and the step-by-step process on each drawing; print the parts' medians."""
+    import os
+    import statistics
+
+    from PIL import Image
+
+    from benchmarks.render import render, to_uint8
 
     whole_wall, whole_cpu, parts = [], [], {}
-    with tempfile.TemporaryDirectory(prefix="onestroke-startup-") as tmp:
+    for gt in picks:
+        src, out = tmp / f"{gt.name}.png", tmp / f"{gt.name}.svg"
+        Image.fromarray(to_uint8(render(gt.drawing))).save(src)
+    if fill_cache:  # fill the cache: not measured
+        _timed(command + ["vectorize", str(src), "-o", str(out)], env, timeout)
+    for _ in range(repeat):
         for gt in picks:
-            src, out = Path(tmp) / f"{gt.name}.png", Path(tmp) / f"{gt.name}.svg"
-            Image.fromarray(to_uint8(render(gt.drawing))).save(src)
-        if args.pycache is not None:  # fill the cache: not measured
-            _timed(command + ["vectorize", str(src), "-o", str(out)], env, args.timeout)
-        for _ in range(args.repeat):
-            for gt in picks:
-                src, out = Path(tmp) / f"{gt.name}.png", Path(tmp) / f"{gt.name}.svg"
-                wall, cpu, _ = _timed(command + ["vectorize", str(src), "-o", str(out)], env, args.timeout)
-                whole_wall.append(wall)
-                whole_cpu.append(cpu)
-                wall, cpu, stdout = _timed([sys.executable, __file__, CHILD_FLAG, str(src), str(out)], env,
-                                           args.timeout)
-                measured = json.loads(stdout.strip().splitlines()[-1])
-                inside = sum(p["wall"] for name, p in measured.items() if p["wall"] is not None)
-                measured["interpreter"]["wall"] = wall - inside
-                for name, p in measured.items():
-                    parts.setdefault(name, {"wall": [], "cpu": []})
-                    parts[name]["wall"].append(p["wall"])
-                    parts[name]["cpu"].append(p["cpu"])
-                warm = measured["vectorize again (warm)"]  # not part of what the command does
-                parts.setdefault("(process total)", {"wall": [], "cpu": []})
-                parts["(process total)"]["wall"].append(wall - warm["wall"])
-                parts["(process total)"]["cpu"].append(cpu - warm["cpu"])
+            src, out = tmp / f"{gt.name}.png", tmp / f"{gt.name}.svg"
+            wall, cpu, _ = _timed(command + ["vectorize", str(src), "-o", str(out)], env, timeout)
+            whole_wall.append(wall)
+            whole_cpu.append(cpu)
+            wall, cpu, stdout = _timed([python, __file__, CHILD_FLAG, str(src), str(out)], env, timeout)
+            measured = json.loads(stdout.strip().splitlines()[-1])
+            inside = sum(p["wall"] for name, p in measured.items() if p["wall"] is not None)
+            measured["interpreter"]["wall"] = wall - inside
+            for name, p in measured.items():
+                parts.setdefault(name, {"wall": [], "cpu": []})
+                parts[name]["wall"].append(p["wall"])
+                parts[name]["cpu"].append(p["cpu"])
+            warm = measured["vectorize again (warm)"]  # not part of what the command does
+            parts.setdefault("(process total)", {"wall": [], "cpu": []})
+            parts["(process total)"]["wall"].append(wall - warm["wall"])
+            parts["(process total)"]["cpu"].append(cpu - warm["cpu"])
 
     load = " ".join(f"{x:.1f}" for x in os.getloadavg())
-    print(f"start-up cost of `onestroke vectorize IN.png -o OUT.svg`: {len(picks)} drawings x {args.repeat} runs, "
+    print(f"start-up cost of `onestroke vectorize IN.png -o OUT.svg`: {len(picks)} drawings x {repeat} runs, "
           f"{os.cpu_count()} CPUs, load average {load}")
-    print(f"bytecode: {bytecode_note(env)}")
+    print(f"bytecode: {note}")
     print(f"the command:   wall median {statistics.median(whole_wall):.3f} s, max {max(whole_wall):.3f} s;  "
           f"CPU (user+sys) median {statistics.median(whole_cpu):.3f} s")
     print("its parts (a process doing the same steps), medians:")

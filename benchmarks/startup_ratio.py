@@ -15,7 +15,6 @@ import json
 import os
 import statistics
 import subprocess
-import sys
 import sysconfig
 import tempfile
 import time
@@ -54,16 +53,18 @@ for name in json.load(open(sys.argv[1])):
 
 
 def third_party_roots() -> list[str]:
-    """Folders third-party packages are installed in (site-packages of this interpreter)."""
+    """Folders third-party packages are installed in (site-packages of this interpreter; a
+    regular install of the project reads them from there too, `user_install.py`)."""
     paths = sysconfig.get_paths()
     return sorted({paths["purelib"], paths["platlib"]})
 
 
-def _run(cmd: list[str], env: dict, timeout: float) -> tuple[float, float]:
+def _run(cmd: list[str], env: dict, timeout: float, cwd: str) -> tuple[float, float]:
     """(wall s, CPU s) of one child process run to the end (CPU: user + sys, all threads)."""
     before = os.times()
     start = time.perf_counter()
-    done = subprocess.run(cmd, capture_output=True, text=True, env=env, timeout=timeout)
+    # in `cwd` (not the working tree, which `python -c` would put first on sys.path)
+    done = subprocess.run(cmd, capture_output=True, text=True, env=env, timeout=timeout, cwd=cwd)
     wall = time.perf_counter() - start
     after = os.times()
     if done.returncode != 0:
@@ -71,25 +72,26 @@ def _run(cmd: list[str], env: dict, timeout: float) -> tuple[float, float]:
     return wall, (after.children_user - before.children_user) + (after.children_system - before.children_system)
 
 
-def ratio_pairs(picks: list, command: list[str], env: dict, timeout: float) -> int:
-    """Run each drawing as the command and as the bare import floor (module doc); print the
-    pairs and the median ratios."""
+def ratio_pairs(picks: list, command: list[str], python: str, env: dict, timeout: float) -> int:
+    """Run each drawing as the command and as the bare import floor (module doc), both with
+    the interpreter `python` the command runs on; print the pairs and the median ratios."""
     from PIL import Image
 
     from benchmarks.render import render, to_uint8
 
     child = LIST_CHILD.format(roots=repr(third_party_roots()), project=repr(PROJECT))
+    print(f"load average at the start {' '.join(f'{x:.1f}' for x in os.getloadavg())}", flush=True)
     rows = []
     with tempfile.TemporaryDirectory(prefix="onestroke-ratio-") as tmp:
         for k, gt in enumerate(picks):
             src, out, listing = (Path(tmp) / f"{k}.{ext}" for ext in ("png", "svg", "json"))
             Image.fromarray(to_uint8(render(gt.drawing))).save(src)
-            subprocess.run([sys.executable, "-c", child, str(listing), "vectorize", str(src), "-o", str(out)],
-                           capture_output=True, text=True, env=env, timeout=timeout, check=True)
+            subprocess.run([python, "-c", child, str(listing), "vectorize", str(src), "-o", str(out)],
+                           capture_output=True, text=True, env=env, timeout=timeout, check=True, cwd=tmp)
             runs = {"command": command + ["vectorize", str(src), "-o", str(out)],
-                    "bare": [sys.executable, "-c", BARE_CHILD, str(listing)]}
+                    "bare": [python, "-c", BARE_CHILD, str(listing)]}
             order = ("command", "bare") if k % 2 == 0 else ("bare", "command")
-            times = {kind: _run(runs[kind], env, timeout) for kind in order}
+            times = {kind: _run(runs[kind], env, timeout, cwd=tmp) for kind in order}
             modules = json.loads(listing.read_text())
             rows.append((gt.name, len(modules), any(m.split(".")[0] == "networkx" for m in modules), times))
             (cw, cc), (bw, bc) = times["command"], times["bare"]

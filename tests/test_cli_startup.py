@@ -32,9 +32,11 @@ with open(listing, "w") as fh:
 """
 
 # Not on the path of a plain `onestroke vectorize IN.png -o OUT.svg` with stderr in a pipe.
+# (xml.sax's saxutils would bring urllib.request, http.client and ssl; edits only with --edits.)
 NOT_IMPORTED = ("rich", "vectorize.debug_overlay", "vectorize.refine", "vectorize.pass_choices", "skimage.transform._warps", "skimage.filters._gaussian",
                 "fabrication.embroidery", "fabrication.laser", "fabrication.studio", "machines",
-                "pyembroidery", "svgelements", "torch")
+                "pyembroidery", "svgelements", "torch", "xml.sax", "urllib.request", "http.client", "ssl",
+                "vectorize.edits")
 
 
 def _run(tmp_path: Path, *args: str) -> tuple[dict, subprocess.CompletedProcess]:

@@ -11,7 +11,6 @@ import numpy as np
 from onestroke.errors import InputError
 from vectorize.binarize import downscaled_gray, ink_image, ink_threshold, paper_gray
 from vectorize.drawing import Drawing
-from vectorize.edits import Edits
 from vectorize.gaps import bridge_gaps, keep_largest_piece
 from vectorize.graph import MedialGraph, lengths
 from vectorize.ink_guard import InkGuard, guard_margin
@@ -33,6 +32,7 @@ from vectorize.stroke import Stroke
 from vectorize.traversal import Ordering, order_strokes
 
 if TYPE_CHECKING:  # the studio's refinement is imported where edits or a session ask for it
+    from vectorize.edits import Edits
     from vectorize.fitting import TracedPoints
     from vectorize.refine import Refinement, StageCache
 
@@ -424,6 +424,7 @@ def run_pipeline(image: np.ndarray, options: VectorizeOptions, *,
     refining = edits is not None or cache is not None
     if refining:
         # Only the studio and --edits refine: a plain run never imports (or compiles) it.
+        from vectorize.edits import Edits
         from vectorize.refine import Refinement, StageCache
 
         edits = edits if edits is not None else Edits()

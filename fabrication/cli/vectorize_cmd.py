@@ -44,7 +44,6 @@ def vectorize(source: str, output: str, multi: bool, threshold: float | None, bl
         stage_images = [("--debug image", os.path.join(debug_dir, name)) for name in STAGE_IMAGES]
     check_distinct(inputs=[("input", source), ("--edits file", edits)], outputs=[("output", output), *stage_images])
     from vectorize import VectorizeOptions, vectorize_file
-    from vectorize.edits import read_edits
     from vectorize.svg_write import write_drawing
 
     placement = None  # the page at the design's size; None: the input's own page (in mm with --inkstitch)
@@ -52,7 +51,11 @@ def vectorize(source: str, output: str, multi: bool, threshold: float | None, bl
         from fabrication.placement import PlacementOptions
 
         placement = PlacementOptions(size=size, width=width, height=height, rotate=rotate)
-    replay = read_edits(edits) if edits is not None else None
+    replay = None
+    if edits is not None:  # the edits module only when there are edits to replay
+        from vectorize.edits import read_edits
+
+        replay = read_edits(edits)
     started = time.perf_counter()
     options = VectorizeOptions(multi=multi, threshold=threshold, blur=blur, classifier=classifier,
                                keep_stages=debug_dir is not None)
