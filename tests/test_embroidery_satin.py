@@ -181,3 +181,67 @@ def test_the_command_line_sews_a_brush_drawing_as_wide_as_it_is_drawn(tmp_path):
     result = CliRunner().invoke(main, ["embroider", str(tmp_path / "brush.png"), "-o", str(tmp_path / "c.pes"),
                                        "--style", "satin", "--min-width", "3mm", "--max-width", "2mm"])
     assert result.exit_code == 2 and "--min-width" in result.output
+
+
+@pytest.mark.parametrize("name, stroke, width", [
+    ("tight spiral", spiral(0, 0, 2.0, 9.0, 3.0, n=48), 2.0),
+    ("loops of a narrow line", Stroke.from_polyline(np.c_[8.0 * np.linspace(0, 3, 600) + 6.0 * np.cos(
+        np.linspace(0, 6 * np.pi, 600)), -9.0 * np.sin(np.linspace(0, 6 * np.pi, 600))]), 0.6),
+    ("swelling brush line", Stroke(spiral(0, 0, 3.0, 12.0, 1.5).control, None,
+                                   np.array([[0.0, 1.0], [0.5, 4.0], [1.0, 1.5]])), 2.0),
+])
+def test_tight_bends_and_narrow_columns_keep_the_density_limit_and_pierce_no_hole_twice(name, stroke, width):
+    from embroidery_fixtures import worst_density
+
+    plan = plan_of(stroke, width=width)
+    assert worst_density(plan) <= 6, name  # every needle point counted, tacks and locks too
+    assert len(repeated_holes(plan)) == 0, name
+    if width < 1.0:  # a walk down the middle of so narrow a column only crowds it
+        assert not (plan.roles == UNDERLAY).any()
+
+
+def test_crowding_is_relieved_underlay_first_then_by_insetting_top_points():
+    from fabrication.embroidery.crowding import relieve_crowding
+
+    # A straight column's rail points 0.2 mm apart on one side (7 within 0.5 mm of the
+    # middle one), then an underlay walk through them.
+    rail = np.c_[np.arange(9) * 0.2, np.ones(9)]
+    walk = np.c_[np.arange(0.0, 1.7, 0.4), np.full(5, 0.8)]
+    points = np.vstack([walk, rail])
+    roles = np.r_[np.full(5, UNDERLAY), np.full(9, BODY)]
+    inward = np.r_[np.zeros((5, 2)), np.tile([0.0, -1.0], (9, 1))]  # each top point may go 1 mm in
+
+    def sides(rows, at):
+        return np.sign(np.round(at[:, 1] - 0.4, 6)).astype(int)
+
+    relieved, keep = relieve_crowding(points, roles, inward, sides, max_gap=6.0)
+    assert needle_density(relieved[keep]).maximum <= 6
+    assert not keep[5:].all() or (relieved[5:, 1] < 1.0).any()  # top points kept, some inset
+    assert keep[5:].all()  # top points are never left out for density
+    assert not keep[1:4].all()  # underlay went first
+    moved = np.linalg.norm(relieved - points, axis=1) > 0
+    assert np.all(relieved[moved, 0] == points[moved, 0])  # inset straight towards the centre
+
+
+def test_a_split_corner_ends_the_first_column_at_the_corner_and_caps_the_second():
+    plan = plan_embroidery(Drawing((corner(30.0),), 30, 30, "mm", 2.0), PlanOptions(style=SatinOptions(width=2.0)))
+    top = (plan.kinds == STITCH) & (plan.roles == BODY)
+    first = top & (plan.params < 0.5 - 1e-6)
+    # nothing of the first leg (along +x) beyond the corner but its overlap under the second
+    assert plan.points[first, 0].max() <= plan.sewn.strokes[0].points_at(0.5)[0] + 0.3 + 0.1
+    second = top & (plan.params >= 0.5)
+    tip = plan.sewn.strokes[0].points_at(0.5)
+    beyond = plan.points[second][plan.points[second, 0] > tip[0] + 0.3]
+    assert len(beyond) >= 3  # the cap over the corner's outside
+    assert np.linalg.norm(beyond - tip, axis=1).max() <= 1.0 + 0.15  # within the round pen's tip
+
+
+def test_warnings_name_every_place_or_how_many_there_are():
+    from fabrication.embroidery.quality import Place, where
+
+    three = tuple(Place(x=float(i), y=0.0, count=7) for i in range(3))
+    assert where(three) == "at (0.0, 0.0) mm (7), (1.0, 0.0) mm (7), (2.0, 0.0) mm (7)"
+    many = tuple(Place(x=float(i), y=0.0, count=7) for i in range(15))
+    text = where(many)
+    assert text.startswith("at 15 places, the first 12: (0.0, 0.0) mm (7)") and "(11.0, 0.0)" in text
+    assert "(12.0, 0.0)" not in text

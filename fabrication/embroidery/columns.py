@@ -52,6 +52,9 @@ CLUSTER = 4.0
 # A rail point with more rail points of other rows than this within DENSITY_RADIUS (the
 # rails alone: underlay, tacks and locks may add one or two) has a row too many.
 CROWDED = 4
+# ... and one is left out only where the rows either side of it lie within this share of
+# the spacing of each other on both rails (the threads either side then still cover it).
+THIN_GAP = 0.75
 
 
 @dataclass(frozen=True, eq=False)
@@ -388,8 +391,8 @@ def _thin_crowded(rows: list[Rows], spacing: float) -> None:
     """In place: rows whose rail points crowd (more than CROWDED needle points of other rows
     within DENSITY_RADIUS mm: the inside of a tight bend, the ground where corners meet) are
     left out, in sewing order, while they still crowd, and only where the rows kept either
-    side of one lie within `spacing` mm of each other on both rails (the outside of the
-    bend stays covered: no slit there). Whole rows go, so the sides still alternate; only
+    side of one lie within THIN_GAP x `spacing` mm of each other on both rails (the outside
+    of the bend stays covered: no slit there). Whole rows go, so the sides still alternate; only
     the rows whose points crowd at first are visited."""
     sizes = [len(r) for r in rows]
     if sum(sizes) < 2:
@@ -420,8 +423,12 @@ def _thin_crowded(rows: list[Rows], spacing: float) -> None:
     rails = ends.tolist()
     for row in suspects:
         left, right = points_of[row]
+        # A row narrower than the density circle lies in it whole: there only the spacing
+        # itself bounds the gap.
+        dx, dy = rails[left][0] - rails[right][0], rails[left][1] - rails[right][1]
+        narrow = math.sqrt(dx * dx + dy * dy) < 2.0 * DENSITY_RADIUS
         if (kept_near[left] > 2 * CROWDED or kept_near[right] > 2 * CROWDED) and \
-                _gap_closed(rails, points_of, column_of, alive, row, spacing):
+                _gap_closed(rails, points_of, column_of, alive, row, (1.0 if narrow else THIN_GAP) * spacing):
             alive[row] = False
             for point in (left, right):
                 kept_near[near[first[point]:first[point + 1]]] -= 1

@@ -8,7 +8,10 @@ columns meeting at a corner), the points there are relieved, cheapest first:
    `max_gap` mm, which the top stitches cover);
 2. top points are inset towards the row's centre (Ink/Stitch's short stitches made deeper),
    a quarter of their room at a time, to where no point around exceeds the limit and the
-   needle stays clear of its last and next holes on that side.
+   needle stays clear of its last and next holes on that side;
+3. where the line comes back over a place (a crossing, a closed line's ends), top points of
+   the first pass there, which the later pass covers, are left out while the stitch that
+   replaces their two stays within `max_top_gap` mm.
 
 What cannot be relieved so is left to the stats' warning, which names the place. Only
 the neighbourhoods of dense points are visited (a tree query finds them), so a stroke
@@ -20,13 +23,12 @@ from __future__ import annotations
 import numpy as np
 from scipy.spatial import cKDTree
 
-from fabrication.embroidery.needles import BODY, SNAP_ALLOWANCE, UNDERLAY
+from fabrication.embroidery.needles import BODY, GRID, SNAP_ALLOWANCE, UNDERLAY
 from fabrication.embroidery.quality import DENSITY_LIMIT, DENSITY_RADIUS, HOLE_GAP, HOLE_WINDOW
 
-# Points are counted with this margin over the radius: snapping to the files' grid may
-# bring two points closer by up to twice SNAP_ALLOWANCE; half of that is kept in reserve
-# (the whole would thin columns that are sound as written).
-MARGIN = SNAP_ALLOWANCE
+# A point with another within the radius sewn more than this many needle points later
+# lies where the line comes back (a crossing, a closed line's ends).
+AGAIN = 12
 # Inset steps tried, as shares of a point's room towards its row's centre.
 STEPS = (0.25, 0.5, 0.75, 1.0)
 # An inset needle keeps this far (mm) from the holes around it on its side of the line;
@@ -36,13 +38,13 @@ REENTER = HOLE_GAP + SNAP_ALLOWANCE
 
 
 def relieve_crowding(points: np.ndarray, roles: np.ndarray, inward: np.ndarray, sides, *,
-                     max_gap: float, limit: int = DENSITY_LIMIT,
+                     max_gap: float, max_top_gap: float = 0.0, limit: int = DENSITY_LIMIT,
                      radius: float = DENSITY_RADIUS) -> tuple[np.ndarray, np.ndarray]:
     """(points (N, 2) mm, keep (N,) bool) with the crowding relieved (module doc).
 
     points (N, 2) mm in sewing order; roles (N,) (UNDERLAY points may be left out: not the
     first or last point, and only while the stitch that replaces their two stays within
-    `max_gap` mm); inward (N, 2) mm: how far each point may move towards its
+    `max_gap` mm; BODY points only as step 3 says, within `max_top_gap` mm); inward (N, 2) mm: how far each point may move towards its
     row's centre (zeros: it stays); sides: (rows (M,), points (M, 2)) -> (M,) the side of
     the line each is on (+1 / -1, 0 on the line: `quality.stroke_sides`), for the clearance
     from its last and next holes on that side.
@@ -55,7 +57,7 @@ def relieve_crowding(points: np.ndarray, roles: np.ndarray, inward: np.ndarray, 
     if not len(points):
         return points, keep
     side = _Sides(points, sides)
-    _relieve_density(points, keep, roles, inward, side, sides, max_gap, limit, radius + MARGIN)
+    _relieve_density(points, keep, roles, inward, side, sides, max_gap, max_top_gap, limit, radius)
     _clear_holes(points, keep, roles, inward, side, sides, max_gap)
     return points, keep
 
@@ -91,20 +93,22 @@ def straight_density(spacing: float, width: float, radius: float = DENSITY_RADIU
     return int(same.sum() + other.sum())
 
 
-def _relieve_density(points, keep, roles, inward, side, sides, max_gap, limit, reach) -> None:
-    """In place: steps 1 and 2 of the module doc."""
+def _relieve_density(points, keep, roles, inward, side, sides, max_gap, max_top_gap, limit, reach) -> None:
+    """In place: steps 1 to 3 of the module doc. Points are counted where they will be
+    written: snapped to the files' grid (the plan snaps them so, in this frame)."""
+    grid = _snapped(points)
     # The limit + 1 nearest tell whether a point is dense (as `quality.needle_density`).
-    tree = cKDTree(points, balanced_tree=False, compact_nodes=False)
+    tree = cKDTree(grid, balanced_tree=False, compact_nodes=False)
     k = min(limit + 1, len(points))
-    distance, _ = tree.query(points, k=k, distance_upper_bound=reach + 1e-9)
+    distance, _ = tree.query(grid, k=k, distance_upper_bound=reach + 1e-9)
     dense = np.flatnonzero(np.isfinite(distance.reshape(len(points), -1)).sum(axis=1) > limit)
     if not len(dense):
         return
     # The points that may change: within one radius of a dense point; their neighbours
     # (within another radius) are counted with them.
-    movable = np.unique(np.concatenate(tree.query_ball_point(points[dense], reach)))
-    local = np.unique(np.concatenate(tree.query_ball_point(points[movable], 2.0 * reach)))
-    pts = points[local]
+    movable = np.unique(np.concatenate(tree.query_ball_point(grid[dense], reach + 1e-9)))
+    local = np.unique(np.concatenate(tree.query_ball_point(grid[movable], 2.0 * reach + 1e-9)))
+    pts = grid[local]
     alive = np.ones(len(local), dtype=bool)
     near = _within(pts, pts, reach)
     count = near.sum(axis=1)
@@ -114,24 +118,30 @@ def _relieve_density(points, keep, roles, inward, side, sides, max_gap, limit, r
     def over() -> np.ndarray:
         return alive & (count > limit)
 
-    # 1. underlay points, the most crowded first, while one of their neighbours is over.
-    while True:
-        o = over()
-        if not o.any():
-            break
-        crowding = (near & o[None, :]).sum(axis=1) * (underlay & alive)
-        choice = int(np.argmax(crowding))
-        if crowding[choice] == 0 or not _gap_ok(points, keep, int(local[choice]), roles, max_gap):
+    def leave_out(candidates: np.ndarray, gap: float) -> None:
+        """Leave out `candidates` (a mask over `local`, cleared as tried), the most crowding
+        first, while a point around them is over the limit and the stitch that replaces
+        their two stays within `gap` mm."""
+        nonlocal count
+        while True:
+            o = over()
+            if not o.any():
+                return
+            crowding = (near & o[None, :]).sum(axis=1) * (candidates & alive)
+            choice = int(np.argmax(crowding))
             if crowding[choice] == 0:
-                break
-            underlay[choice] = False  # its walk would take too long a stitch: try the others
-            continue
-        alive[choice] = False
-        keep[local[choice]] = False
-        count -= near[:, choice]
-        near[choice, :] = False
-        near[:, choice] = False
-        underlay[choice] = False
+                return
+            candidates[choice] = False
+            if not _gap_ok(points, keep, int(local[choice]), roles, gap):
+                continue  # it would leave too long a stitch: try the others
+            alive[choice] = False
+            keep[local[choice]] = False
+            count = count - near[:, choice]
+            near[choice, :] = False
+            near[:, choice] = False
+
+    # 1. underlay points, the most crowded first, while one of their neighbours is over.
+    leave_out(underlay, max_gap)
 
     # 2. top points inset towards their row's centre.
     tried = np.zeros(len(local), dtype=bool)
@@ -152,7 +162,7 @@ def _relieve_density(points, keep, roles, inward, side, sides, max_gap, limit, r
             q_side = int(sides(np.array([g]), q[None, :])[0])
             if not _clear(points, keep, side, g, q, q_side):
                 continue
-            new_near = _within(q[None, :], pts, reach)[0] & alive
+            new_near = _within(_snapped(q[None, :]), pts, reach)[0] & alive
             new_near[choice] = True
             new_count = count - near[choice].astype(int) + new_near.astype(int)
             new_count[choice] = int(new_near.sum())
@@ -160,11 +170,16 @@ def _relieve_density(points, keep, roles, inward, side, sides, max_gap, limit, r
             if excess < before and not np.any(alive & (new_count > limit) & ~o):
                 points[g] = q
                 side[g] = q_side
-                pts[choice] = q
+                pts[choice] = _snapped(q[None, :])[0]
                 count = new_count
                 near[choice, :] = new_near
                 near[:, choice] = new_near
                 break
+
+    # 3. where the line comes back over itself (a crossing, a closed line's ends), the
+    # first pass's top points there, which the later pass covers, are left out.
+    later = np.array([np.any(local[near[i]] > local[i] + AGAIN) for i in range(len(local))])
+    leave_out((roles[local] == BODY) & (local > 0) & (local < len(points) - 1) & later, max_top_gap)
 
 
 def _clear_holes(points, keep, roles, inward, side, sides, max_gap) -> None:
@@ -198,6 +213,11 @@ def _reentering(points: np.ndarray, keep: np.ndarray, side: np.ndarray) -> np.nd
             later, earlier = rows[close + lag], rows[close]
             found.append(later[side[later] == side[earlier]])
     return np.unique(np.concatenate(found)) if found else np.zeros(0, dtype=np.int64)
+
+
+def _snapped(points: np.ndarray) -> np.ndarray:
+    """`points` (N, 2) mm on the files' GRID, as the planner writes them."""
+    return np.rint(points / GRID) * GRID
 
 
 def _within(a: np.ndarray, b: np.ndarray, reach: float) -> np.ndarray:

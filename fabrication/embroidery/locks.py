@@ -129,8 +129,9 @@ def crowding_ties(points: np.ndarray, kinds: np.ndarray, ties: np.ndarray,
     (N, 2) mm and `kinds` (N,) of a plan's rows, `ties` (N,) the tie of each row (2 c: the
     tack of chain c, 2 c + 1: its lock, -1: none), `levels` the ties' levels so far. They are the ties that make a place too dense: needle points
     within the density radius of a needle point with more than the density limit around it
-    (every needle point counted) that would be within the limit without the ties' points.
-    Where the stitches alone are too dense, the ties stay (the warning names the place)."""
+    (every needle point counted) that would be within the limit without the ties' points,
+    or that is a tie's own point. Where the stitches alone are too dense, the ties stay (the
+    warning names the place)."""
     needle = kinds == STITCH
     pts, tie = points[needle], ties[needle]
     at_tie = tie >= 0
@@ -143,9 +144,11 @@ def crowding_ties(points: np.ndarray, kinds: np.ndarray, ties: np.ndarray,
     for found in tree.query_ball_point(pts[at_tie], reach):
         near[found] = True
     crowding: set[int] = set()
-    for found in tree.query_ball_point(pts[near], reach):
+    centres = np.flatnonzero(near)
+    for centre, found in zip(centres.tolist(), tree.query_ball_point(pts[centres], reach)):
         ours = tie[found]
-        if len(found) > DENSITY_LIMIT and len(found) - int((ours >= 0).sum()) <= DENSITY_LIMIT:
+        # A place centred on a tie's own needle point goes with the tie.
+        if len(found) > DENSITY_LIMIT and (tie[centre] >= 0 or len(found) - int((ours >= 0).sum()) <= DENSITY_LIMIT):
             ours = set(ours[ours >= 0].tolist())
             tacks = {t for t in ours if t % 2 == 0 and levels.get(t, 0) < TIE_LEVELS - 1}
             # A lock holds the thread against the trim after it: tacks give way first.

@@ -3,18 +3,26 @@
 Centre points every spacing/2 along the curve (an even number of them), each pushed
 perpendicular to the local direction by width/2 + pull_compensation/2, alternating sides.
 The direction is the chord over +-reach around the point: the tangent on straight parts
-and arcs, a fan round a sharp corner.
+and arcs, a fan round a bend.
 On tight inner curves the inside points crowd: every other inner point is inset
 (Ink/Stitch's short stitches; 30 % where points on the rail come closer than 0.35 mm,
 deep enough that the inset holes stay 0.35 mm from their rail neighbours), the inside
 reach is capped below the curve radius, and a rail point still closer than `min_gap` to
-one of the last few on its rail is dropped (the outside fans round a shared inner point):
-no needle goes into a hole next to one it made a moment before. Zigs longer than `max_stitch` are split at
-staggered points. Underlay (sewn first, there and back so the zigzag starts where the
-stroke does), as satin columns use: 'center' a walk along the curve (back between the
-holes of the way out), 'edge' a walk along each rail inset from the edge, 'zigzag' a
-sparse zigzag inset from the edges, out and back in opposite phase; by default a centre
-walk once the zigzag is wider than `underlay_min_width`.
+one of the last few on its rail is inset deeper, and left out only when that cannot clear
+it (a point left out bares its side between its neighbours: a slit). Where needle points
+still crowd past the density limit or re-enter a hole, they are relieved as a satin's are
+(`fabrication.embroidery.crowding`). Zigs longer than `max_stitch` are split at staggered
+points. Underlay (sewn first, there and back so the zigzag starts where the stroke does):
+'center' a walk along the curve (back between the holes of the way out), 'edge' a walk
+along each rail inset from the edge, 'zigzag' a sparse zigzag inset from the edges, out
+and back in opposite phase; by default a centre walk once the zigzag is wider than
+`underlay_min_width`, none on a stroke no longer than one underlay stitch.
+
+A stroke with kinks (a turn sharper than `corner_angle` within KINK mm: the wave drawing's
+fold, a polyline's corners) is sewn by satin's column engine at the zigzag's width
+(`fabrication.embroidery.columns`): corners mitred, or split into two columns that overlap
+by `overlap` mm where the mitre would reach past `mitre_limit` half widths, so a corner is
+covered once: no spur of loose stitches, no pile-up, no slit.
 """
 
 from __future__ import annotations
@@ -50,6 +58,8 @@ ZIG_MAX_STITCH = Range(1.0, None, unit="mm", name="zigzag max stitch", low_open=
 # The inside reach stays below this fraction of the curve radius, so inner points never
 # pass the centre of curvature (they would sew loops and run backwards).
 MAX_INNER_REACH = 0.75
+# A turn sharper than the corner angle within this many mm either side is a kink.
+KINK = 0.25
 # A crowded point is inset towards the curve by at most this share of its reach.
 MAX_INSET = 0.5
 UNDERLAYS = ("center", "edge", "zigzag", "none")
@@ -161,9 +171,11 @@ def _inset_crowded(points: np.ndarray, centre: np.ndarray, min_gap: float, inner
 
 def zigzag_stitch(stroke: Stroke, options: ZigzagOptions = ZigzagOptions()) -> NeedlePoints:
     """Zigzag along `stroke` (mm), preceded by a there-and-back centre walk when wide; a
-    stroke with corners is sewn as satin's columns are (module doc)."""
+    stroke with kinks is sewn as satin's columns are, corners mitred or split (module doc)."""
     curve = dense_curve(stroke, DENSE_TOLERANCE)
-    if find_corners(stroke, curve, np.full(len(curve.s), options.reach), options.corner_angle):
+    # A kink (a turn sharper than the corner angle within KINK mm, not a tight arc, which
+    # the zigzag's own rows follow) makes a stroke one of columns with corners.
+    if find_corners(stroke, curve, np.full(len(curve.s), KINK), options.corner_angle):
         return _cornered(stroke, curve, options)
     length = curve.length
     steps = max(1, int(round(2.0 * length / options.spacing)))
@@ -211,7 +223,7 @@ def zigzag_stitch(stroke: Stroke, options: ZigzagOptions = ZigzagOptions()) -> N
     if straight_density(options.spacing, 2.0 * options.reach) <= DENSITY_LIMIT:
         points, keep = relieve_crowding(zig.points, zig.roles, room,
                                         lambda rows, at: stroke_sides(stroke, at, zig.t[rows]),
-                                        max_gap=2.0 * options.underlay_stitch_length)
+                                        max_gap=2.0 * options.underlay_stitch_length, max_top_gap=2.0 * options.spacing)
         zig = NeedlePoints(points, zig.t, zig.roles).take(keep)
     return split_body(zig, options.max_stitch - 2 * SNAP_ALLOWANCE)
 
