@@ -50,6 +50,9 @@ def cases(bed: float, hoop: float) -> list[tuple[str, str, str, object]]:
     arrows = dict(field, style="arrows", arrow_size="0.1mm", spacing="0.2mm", min_stitch="0.1mm")
     many = {"format": "onestroke-edits", "version": 1,
             "edits": [{"kind": "reverse", "at": [float(i % 997), float(i % 599)]} for i in range(9000)]}
+    spots = [[float((i * 37) % 997), float((i * 13) % 599)] for i in range(12000)]  # a 1 MiB body holds ~15,000
+    twice = dict(EDITS, edits=[{"kind": "twice", "at": at} for at in spots])
+    split = dict(EDITS, edits=[{"kind": "split", "at": at} for at in spots])
     profile_text = BIG_BED.format(side=bed) + "# " + "x" * (60 * 1024) + "\n"
     return [
         ("state", "threshold 0.95", "POST", {"edits": dict(EDITS, threshold=0.95)}),
@@ -57,6 +60,8 @@ def cases(bed: float, hoop: float) -> list[tuple[str, str, str, object]]:
         ("state", "multi-stroke, threshold 0.05", "POST", {"edits": dict(EDITS, multi=True, threshold=0.05)}),
         ("state", "threshold 0.05", "POST", {"edits": dict(EDITS, threshold=0.05)}),
         ("state", "9,000 reverse edits", "POST", {"edits": many}),
+        ("state", "12,000 twice edits", "POST", {"edits": twice}),
+        ("state", "12,000 split edits", "POST", {"edits": split}),
         ("mask", "threshold 0.05, blur 25", "GET", "threshold=0.05&blur=25"),
         ("laser", "400 mm, 0.005 mm, 100 passes", "POST", {"options": laser_worst}),
         ("laser", "same with arcs", "POST", {"options": dict(laser_worst, arcs=True)}),

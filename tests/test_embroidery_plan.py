@@ -312,3 +312,20 @@ def test_rows_after_a_jump_keep_their_own_parameter_when_long_stitches_are_split
     stitched = (plan.kinds == STITCH) & (plan.strokes >= 0)
     assert (plan.kinds == JUMP).any() and np.isfinite(plan.params[stitched]).all()
     assert np.isfinite(needle_sides(plan)).all() and len(repeated_holes(plan)) == 0
+
+
+@pytest.mark.parametrize("style", ["running", "triple", "zigzag", "satin", "arrows"])
+def test_zero_length_strokes_and_pieces_never_reach_the_checks_as_nan(style):
+    from fabrication.embroidery.quality import needle_sides, repeated_holes
+
+    dot = Stroke(np.array([[[10.0, 0.0]] * 4]))  # a zero-length stroke next to the next one
+    pieces = Stroke(np.array([[[10.5, 0.0]] * 4, [[10.5, 0.0], [14.0, 0.0], [17.0, 0.0], [20.0, 0.0]],
+                              [[20.0, 0.0]] * 4]))  # zero-length pieces at both ends
+    far = Stroke(np.array([[[40.0, 20.0]] * 4]))  # and one alone, far from the others
+    drawing = Drawing((_line([0, 0], [10, 0]), dot, pieces, far), 40, 20, "mm", 2.0)
+    plan = plan_embroidery(drawing, PlanOptions(style=style_options(style)))
+    stitched = (plan.kinds == STITCH) & (plan.strokes >= 0)
+    assert np.isfinite(plan.params[stitched]).all() and np.isfinite(plan.points).all()
+    assert np.isfinite(needle_sides(plan)).all()
+    repeated_holes(plan)  # runs on every row without NaN
+    assert any("stroke 4" in line for line in plan.dropped)  # the lone dot is left out, named

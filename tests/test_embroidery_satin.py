@@ -245,3 +245,15 @@ def test_warnings_name_every_place_or_how_many_there_are():
     text = where(many)
     assert text.startswith("at 15 places, the first 12: (0.0, 0.0) mm (7)") and "(11.0, 0.0)" in text
     assert "(12.0, 0.0)" not in text
+
+
+def test_a_columns_last_rows_stay_square_to_it_at_a_corner():
+    from fabrication.embroidery.columns import column_rows
+    from fabrication.embroidery.sampling import dense_curve
+
+    stroke = corner(30.0)  # the first leg runs along +x for 12 mm, then turns back
+    curve = dense_curve(stroke)
+    rows = column_rows(stroke, curve, lambda s: np.full(len(s), 1.0), 0.0, 12.0, 0.4)
+    # none swings round towards the next leg (the corner point's own tangent is the next leg's)
+    assert np.abs(rows.normal[:, 0]).max() < np.sin(np.radians(1.0))
+    assert rows.right_points[:, 0].max() <= 1e-6 and rows.left_points[:, 0].max() <= 1e-6

@@ -333,8 +333,9 @@ class Refinement:
         the line to go back over a branch ("twice"), large where not ("once"); the last edit
         on a branch wins."""
         weights = {}
-        for edit in self.edits.of("twice", "once"):
-            found = _nearest_branch(graph, self.to_working(edit.at), self.tol + self.w)
+        edits = self.edits.of("twice", "once")
+        nearest = _nearest_branches(graph, [self.to_working(edit.at) for edit in edits], self.tol + self.w)
+        for edit, found in zip(edits, nearest):
             if found is not None:
                 weights[found] = RETRACE_WEIGHT[edit.kind]
                 self.hits.add(self._index[id(edit)])
@@ -423,8 +424,9 @@ class Refinement:
         start chosen at that branch's tip forbids it): a click that changes nothing says why."""
         count = _pass_counts(solution)
         result = []
-        for edit in self.edits.of("once", "twice"):
-            bid = _nearest_branch(solution.graph, self.to_working(edit.at), self.tol + self.w)
+        edits = self.edits.of("once", "twice")
+        nearest = _nearest_branches(solution.graph, [self.to_working(edit.at) for edit in edits], self.tol + self.w)
+        for edit, bid in zip(edits, nearest):
             if bid is None:
                 continue
             where = f"the stretch at {edit.at[0]:.0f}, {edit.at[1]:.0f}"
@@ -523,14 +525,39 @@ def _pass_counts(solution) -> dict[int, int]:
 def _nearest_branch(graph, point: np.ndarray, tol: float, eligible=None) -> int | None:
     """The id of the branch passing nearest `point`, if within tol; eligible: None or a
     test a branch must pass to count."""
-    best = None
-    for bid, branch in graph.branches.items():
-        if eligible is not None and not eligible(branch):
-            continue
-        d = float(np.min(np.linalg.norm(branch.points - point, axis=1)))
-        if d <= tol and (best is None or d < best[0]):
-            best = (d, bid)
-    return None if best is None else best[1]
+    return _nearest_branches(graph, np.asarray(point, dtype=float).reshape(1, 2), tol, eligible)[0]
+
+
+# Candidates per point from the branches' k-d tree: more than any number of branches that
+# share one position (a junction's), so the nearest is always among them.
+NEAREST_CANDIDATES = 16
+
+
+def _nearest_branches(graph, points: np.ndarray, tol: float, eligible=None) -> list[int | None]:
+    """`_nearest_branch` of each of `points` (E, 2) working px at once (a body of 12,000
+    "twice" edits took 5.6 s one edit and one branch at a time): the nearest points found by
+    a k-d tree, their distances computed as before (numpy's norm), the first branch in the
+    graph's order on a tie."""
+    from scipy.spatial import cKDTree
+
+    points = np.asarray(points, dtype=float).reshape(-1, 2)
+    ids = [bid for bid, branch in graph.branches.items() if eligible is None or eligible(branch)]
+    if not ids or not len(points):
+        return [None] * len(points)
+    stacked = np.concatenate([graph.branches[bid].points for bid in ids])
+    owner = np.repeat(np.arange(len(ids)), [len(graph.branches[bid].points) for bid in ids])
+    finite = np.isfinite(points).all(axis=1)
+    index = np.full((len(points), min(NEAREST_CANDIDATES, len(stacked))), len(stacked))
+    # a margin past tol: the tree's distances may differ from numpy's in the last bits
+    _, index[finite] = cKDTree(stacked).query(points[finite], k=list(range(1, index.shape[1] + 1)),
+                                              distance_upper_bound=tol * (1 + 1e-9) + 1e-9)
+    found = index < len(stacked)
+    safe = np.where(found, index, 0)
+    distance = np.linalg.norm(stacked[safe] - points[:, None, :], axis=2)
+    distance = np.where(found & (distance <= tol), distance, np.inf)
+    best = distance.min(axis=1)
+    first = np.where(distance == best[:, None], owner[safe], len(ids)).min(axis=1)
+    return [ids[b] if np.isfinite(d) else None for b, d in zip(first.tolist(), best.tolist())]
 
 
 def _mergeable(graph, branch) -> bool:

@@ -43,6 +43,8 @@ OVERLAP = Range(0.0, 2.0, unit="mm", name="--corner-overlap")
 # The inside half width stays below this fraction of the bend's radius, so inner points
 # never pass the centre of curvature (they would sew loops and run backwards).
 MAX_INNER_REACH = 0.75
+# How far inside a column (mm) its end rows take their tangent.
+END_INSIDE = 1e-3
 # Fine samples per half spacing when rows are placed (the rails' lengths are measured on them).
 FINE = 4
 # A row cut back to less than this (mm) outside the column sewn over it is left out.
@@ -189,7 +191,10 @@ def _directions(stroke: Stroke, curve: DenseCurve, s: np.ndarray, reach: np.ndar
     w = np.minimum(reach, np.minimum(s - lo, hi - s))
     chord = stroke.points_at(curve.t_at(s + w)) - stroke.points_at(curve.t_at(s - w))
     norm = np.linalg.norm(chord, axis=1, keepdims=True)
-    return np.where(norm > 1e-6, chord / np.maximum(norm, 1e-12), stroke.tangents_at(curve.t_at(s)))
+    # At the ends the tangent is taken just inside the column: at a corner's own point it
+    # would be the next piece's (the last rows would swing round beyond the corner).
+    inside = np.clip(s, lo + min(END_INSIDE, (hi - lo) / 2), hi - min(END_INSIDE, (hi - lo) / 2))
+    return np.where(norm > 1e-6, chord / np.maximum(norm, 1e-12), stroke.tangents_at(curve.t_at(inside)))
 
 
 def column_rows(stroke: Stroke, curve: DenseCurve, half_at, lo: float, hi: float, spacing: float, *,
