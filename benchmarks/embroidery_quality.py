@@ -67,7 +67,7 @@ def benchmark_drawings(folder: str) -> dict[str, tuple[Drawing, float | None]]:
     drawings = {name: (vectorize_file(str(ROOT / "examples" / name), VectorizeOptions()).drawing, 90.0)
                 for name in EXAMPLES}
     svg = Path(folder) / "rgb3.svg"
-    svg.write_text(THREE_COLOURS)  # tests/test_embroidery_threads.py's drawing
+    svg.write_text(THREE_COLOURS)  # tests/embroidery/test_threads.py's drawing
     drawings["rgb3.svg"] = (vectorize_file(str(svg), VectorizeOptions()).drawing, 90.0)
     drawings["test design"] = (design(), None)
     drawings["tight spiral"] = (Drawing((spiral(0, 0, 2.0, 9.0, 3.0, n=48),), 20, 20, "mm"), None)

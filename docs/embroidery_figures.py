@@ -1,11 +1,11 @@
 """The stitch counts and densities quoted in docs/embroidery.md, computed from the code.
 
-    python docs/embroidery_figures.py           # list each figure: in the docs / from the code
-    python docs/embroidery_figures.py --write   # put the code's figures into the docs
+    python -m docs.embroidery_figures           # list each figure: in the docs / from the code
+    python -m docs.embroidery_figures --write   # put the code's figures into the docs
 
 In the docs a figure is written `<!-- figure NAME -->VALUE<!-- /figure -->` (the markers
 do not show on the rendered page). Every figure is deterministic (the same code gives the
-same value), so `tests/test_embroidery_docs.py` checks that the docs say what the code
+same value), so `tests/embroidery/test_docs.py` checks that the docs say what the code
 does: a figure cannot drift again (the ampersand's 487 stitches were 477 for a while).
 Jobs are built by `fabrication.job_options.embroidery_settings`, the same call as
 `onestroke embroider` with the flags shown in the docs.
@@ -15,13 +15,10 @@ from __future__ import annotations
 
 import argparse
 import re
-import sys
 from functools import lru_cache
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
-if str(ROOT) not in sys.path:
-    sys.path.insert(0, str(ROOT))
 
 DOC = ROOT / "docs" / "embroidery.md"
 MARK = re.compile(r"<!-- figure (?P<name>[\w.-]+) -->(?P<value>.*?)<!-- /figure -->")

@@ -1,11 +1,11 @@
 """Make docs/notes/2026-12-05/inkscape-extension.png: the Inkscape extension's output as Inkscape
 renders it, beside the input bitmap.
 
-    python docs/make_inkscape_image.py
+    python -m docs.make_inkscape_image
 
 examples/loops.png is embedded in an A5 page, turned by -8 degrees and scaled; the extension
 (installed with `onestroke inkscape install --dir`) runs on it as Inkscape 1.2 runs it
-(tests/test_bridges_inkscape.py: Debian's python3 and Inkscape's own inkex). Panels: the input
+(tests/bridges/test_inkscape.py: Debian's python3 and Inkscape's own inkex). Panels: the input
 bitmap; Inkscape's rendering (`inkscape --export-type=png`) of the output with the bitmap removed;
 and the output's path drawn red over the kept bitmap, to show they coincide.
 """
@@ -13,17 +13,15 @@ and the output's path drawn red over the kept bitmap, to show they coincide.
 from __future__ import annotations
 
 import subprocess
-import sys
 import tempfile
 from pathlib import Path
 
 from PIL import Image, ImageDraw
 
-ROOT = Path(__file__).resolve().parents[1]
-sys.path[:0] = [str(ROOT), str(ROOT / "tests")]
+from tests.bridges.readback import onestroke
+from tests.bridges.test_inkscape import INKSCAPE, SVG, embedded, run_extension
 
-from bridges_fixtures import onestroke  # noqa: E402
-from test_bridges_inkscape import INKSCAPE, SVG, embedded, run_extension  # noqa: E402
+ROOT = Path(__file__).resolve().parents[1]
 
 OUT = ROOT / "docs" / "notes" / "2026-12-05" / "inkscape-extension.png"
 SOURCE = ROOT / "examples" / "loops.png"

@@ -1,7 +1,7 @@
 """Make examples/readme.png: the bundled drawing, its vectorized curve and its stitches
 (zigzag, the embroider command's realistic preview).
 
-    python docs/make_readme_image.py
+    python -m docs.make_readme_image
 
 Runs the real commands (`onestroke vectorize`, `preview`, `embroider`) on
 examples/loops.png and puts the three pictures side by side.

@@ -1,6 +1,6 @@
 """Make docs/studio.png: the studio on a hand drawing, as the README shows it.
 
-    python docs/make_studio_image.py
+    python -m docs.make_studio_image
 
 A jittered cursive word from the benchmark's generator ("little": its l and t stems are
 drawn down and back up), with two pen gaps wiped out of the ink, opened in the studio in
@@ -10,19 +10,16 @@ and the pen played part way along.
 
 from __future__ import annotations
 
-import sys
 import tempfile
 from pathlib import Path
 
+from benchmarks.sets.hand_drawings import bench_drawing
+from fabrication.studio.server import StudioServer
+from fabrication.studio.session import StudioSession
+from tests.chromium import CHROMIUM, CHROMIUM_ARGS
+from tests.studio.browser_page import IDLE, click_at, open_page, settle
+
 ROOT = Path(__file__).resolve().parents[1]
-sys.path[:0] = [str(ROOT), str(ROOT / "tests")]
-
-from conftest import CHROMIUM, CHROMIUM_ARGS  # noqa: E402
-from studio_fixtures import IDLE, click_at, open_page, settle  # noqa: E402
-from benchmarks.sets.hand_drawings import bench_drawing  # noqa: E402
-
-from fabrication.studio.server import StudioServer  # noqa: E402
-from fabrication.studio.session import StudioSession  # noqa: E402
 
 OUT = ROOT / "docs" / "studio.png"
 

@@ -19,7 +19,7 @@ Exactness: values equal to float rounding (checked within `TIME_TOLERANCE` secon
 period, so the total is within count x that of the full reading), except where the model
 itself branches on two equal times (a block planned just as the one before ends), where a
 rounding difference could take the other branch; tests compare with the full reading to the
-millisecond (tests/test_laser_passes.py).
+millisecond (tests/laser/test_passes.py).
 """
 
 from __future__ import annotations

@@ -5,7 +5,7 @@ G-code text, JSON drawings and edits files, and option values of every command; 
 would see go wrong (a traceback or internal error, a run over its time or memory bound, an
 incomplete set of outputs).
 
-Shared by the suite's fuzz test (tests/test_cli_fuzz.py, bounded to about a minute) and the
+Shared by the suite's fuzz test (tests/cli/test_fuzz.py, bounded to about a minute) and the
 long run (benchmarks/fuzz.py, 2,000 inputs or more).
 """
 

@@ -4,7 +4,7 @@ the stitch an embroiderer picked, in Ink/Stitch's own attributes.
 Ink/Stitch (an Inkscape extension) reads `inkstitch:*` attributes on each `<path>` and sews the
 paths in document order, so the drawing order survives as it is. Our stitch options
 (`fabrication.embroidery`'s running, triple and zigzag options) are translated into the names
-and units Ink/Stitch's Params dialog shows; tests/inkstitch_params.toml lists every name we
+and units Ink/Stitch's Params dialog shows; tests/bridges/inkstitch_params.toml lists every name we
 write with the Ink/Stitch source it was read from, and the tests check each written one
 against it. Stitches:
 

@@ -1,6 +1,6 @@
 """The table of every numeric option's range, read from the declarations the commands use.
 
-docs/cli.md carries this table between its `ranges` markers (tests/test_option_ranges.py
+docs/cli.md carries this table between its `ranges` markers (tests/onestroke/test_option_ranges.py
 checks that it is the same); after changing a declaration, regenerate it with
 `python -m fabrication.cli.range_table`.
 """

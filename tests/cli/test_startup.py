@@ -1,0 +1,91 @@
+"""`onestroke vectorize` imports only what its run uses (issue 10, whole-process time): no
+debug overlay without --debug, no rich when stderr is not a terminal, no downscaling or
+blurring code for an image that needs neither, no other command's modules. Checked on the
+modules a real process has loaded when the command ends, not on a clock."""
+
+from __future__ import annotations
+
+import io
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+from vectorize.svg_read import read_svg
+from tests.children import child_env
+
+ROOT = Path(__file__).resolve().parents[2]
+DRAWING = ROOT / "examples" / "loops.png"  # 1000 x 600 px: no downscale at the default max_size
+
+# Runs the real command line in this process, then lists what it imported.
+CHILD = """
+import json, sys
+listing, argv = sys.argv[1], sys.argv[2:]
+sys.argv = ["onestroke", *argv]
+from fabrication.cli import main
+try:
+    main()
+except SystemExit as done:
+    code = done.code
+with open(listing, "w") as fh:
+    json.dump({"exit": code, "modules": sorted(sys.modules)}, fh)
+"""
+
+# Not on the path of a plain `onestroke vectorize IN.png -o OUT.svg` with stderr in a pipe.
+# (xml.sax's saxutils would bring urllib.request, http.client and ssl; edits only with --edits.)
+NOT_IMPORTED = ("rich", "vectorize.debug_overlay", "vectorize.refine", "vectorize.pass_choices", "skimage.transform._warps", "skimage.filters._gaussian",
+                "fabrication.embroidery", "fabrication.laser", "fabrication.studio", "machines",
+                "pyembroidery", "svgelements", "torch", "xml.sax", "urllib.request", "http.client", "ssl",
+                "vectorize.edits")
+
+
+def _run(tmp_path: Path, *args: str) -> tuple[dict, subprocess.CompletedProcess]:
+    listing = tmp_path / "modules.json"
+    env = {k: v for k, v in child_env().items() if k not in ("FORCE_COLOR", "TTY_COMPATIBLE")}
+    done = subprocess.run([sys.executable, "-c", CHILD, str(listing), "vectorize", str(DRAWING), *args],
+                          capture_output=True, text=True, env=env, timeout=300)
+    return json.loads(listing.read_text()), done
+
+
+def _loaded(modules: list[str], name: str) -> bool:
+    return any(m == name or m.startswith(name + ".") for m in modules)
+
+
+def test_vectorize_imports_only_what_the_run_uses(tmp_path):
+    out = tmp_path / "out.svg"
+    result, done = _run(tmp_path, "-o", str(out))
+    assert result["exit"] == 0, done.stderr
+    assert len(read_svg(str(out)).strokes) == 1
+    assert done.stdout.startswith(f"{out}: 1 stroke")
+    modules = result["modules"]
+    assert _loaded(modules, "vectorize.vectorizer") and _loaded(modules, "scipy.ndimage")  # the listing is real
+    assert [name for name in NOT_IMPORTED if _loaded(modules, name)] == []
+
+    # --debug asks for the overlay: then it is imported and its images written.
+    debug = tmp_path / "debug"
+    result, done = _run(tmp_path, "-o", str(tmp_path / "again.svg"), "--debug", str(debug))
+    assert result["exit"] == 0, done.stderr
+    assert _loaded(result["modules"], "vectorize.debug_overlay") and len(list(debug.glob("*.png"))) == 5
+    assert not _loaded(result["modules"], "rich")
+    assert done.stderr.strip() == f"debug: 5 stage images in {debug}"
+
+
+def test_plain_status_lines_read_as_rich_would_write_them(monkeypatch):
+    """Off a terminal the CLI prints status lines without rich; the text is rich's own
+    rendering there (markup tags dropped, an escaped tag kept), only never wrapped."""
+    from rich.console import Console
+
+    from fabrication.cli.common import console
+
+    for name in ("FORCE_COLOR", "TTY_COMPATIBLE"):
+        monkeypatch.delenv(name, raising=False)
+    messages = ["[yellow]warning:[/yellow] file 'a[1].png' has \\[bold] in its name",
+                "[red]failed:[/red] x.png: [0, 1] is out of range (see [link=https://x.org]here[/link])"]
+    for message in messages:
+        plain = io.StringIO()
+        monkeypatch.setattr(sys, "stderr", plain)
+        assert not console.is_terminal
+        console.print(message, soft_wrap=True)
+        reference = io.StringIO()
+        Console(file=reference, highlight=False, force_terminal=False, soft_wrap=True).print(message)
+        assert plain.getvalue() == reference.getvalue() and "[" in plain.getvalue()
