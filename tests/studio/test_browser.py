@@ -3,7 +3,7 @@ Debian's Chromium): the curve on the page, a junction clicked through its three 
 undo/redo by button and keyboard, play and the scrubber, the threshold and blur sliders
 dragged with the mouse (busy state shown, the latest value wins), multi-stroke, split,
 merge, start, reverse, and the edits file saved, loaded and opened. Exports and "send to
-laser": test_studio_browser_make.py, test_studio_browser_send.py. Screenshots go to
+laser": test_browser_make.py, test_browser_send.py. Screenshots go to
 test-artifacts/ (kept by CI as artifacts of the run)."""
 
 from __future__ import annotations
