@@ -50,7 +50,7 @@ from starlette.testclient import TestClient  # noqa: E402
 
 from fabrication.studio.app import create_app  # noqa: E402
 from fabrication.studio.session import StudioSession  # noqa: E402
-from vectorize.edits import PAIRINGS, Edits  # noqa: E402
+from vectorize.refine.edits import PAIRINGS, Edits  # noqa: E402
 
 REPEATS = 7
 # The page's default panel values (fabrication/studio/static/index.html).

@@ -16,7 +16,7 @@ from click.testing import CliRunner
 
 from fabrication.cli import main
 from onestroke.errors import InputError
-from vectorize.svg_read import read_svg
+from vectorize.svg.svg_read import read_svg
 
 ROOT = Path(__file__).resolve().parents[1]
 if str(ROOT) not in sys.path:

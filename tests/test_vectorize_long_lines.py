@@ -19,7 +19,7 @@ from benchmarks.render import render, to_uint8  # noqa: E402
 from benchmarks.tsp_art import tsp_tour  # noqa: E402
 from vectorize import VectorizeOptions, vectorize_image  # noqa: E402
 from vectorize.drawing import Drawing  # noqa: E402
-from vectorize.fitting import sharp_corners  # noqa: E402
+from vectorize.fit.fitting import sharp_corners  # noqa: E402
 from vectorize.stroke import Stroke  # noqa: E402
 
 SIDE = 700
