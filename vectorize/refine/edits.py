@@ -1,4 +1,4 @@
-"""A user's corrections to a vectorization (paper 4.4), as plain data that survives a file.
+"""A user's corrections to a vectorization (paper 4.3), as plain data that survives a file.
 
 The studio page makes them and `onestroke vectorize --edits FILE` replays them. Every edit
 names its place by position (x, y in the output frame: the input image's pixels), not by
