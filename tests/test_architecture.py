@@ -13,6 +13,7 @@ from __future__ import annotations
 import ast
 import re
 import sys
+from functools import cache
 from pathlib import Path
 
 import networkx as nx
@@ -73,8 +74,9 @@ def _resolve(name: str, modules: dict[str, Path]) -> str | None:
     return name or None
 
 
+@cache
 def module_imports() -> nx.DiGraph:
-    """Module -> module, one edge per import found in the source."""
+    """Module -> module, one edge per import found in the source (read once per run)."""
     modules = library_modules()
     graph = nx.DiGraph()
     graph.add_nodes_from(modules)
