@@ -1,9 +1,9 @@
 """Batch throughput: drawings per second on 1 and 2 worker processes and on a Dask
 LocalCluster, and the start-up time a batch saves against one process per drawing.
 
-Run from the repository root: python benchmarks/batch.py [--count 19] [--runs 3]
+Run from the repository root: python -m benchmarks.batch [--count 19] [--runs 3]
 Every figure is the wall time of a whole `onestroke` command (a fresh process, as a user
-runs it) on the drawings of benchmarks/batch_drawings.py (360 px), median over --runs, each
+runs it) on the drawings of benchmarks/sets/batch_drawings.py (360 px), median over --runs, each
 run into an empty output folder. The cluster (2 worker processes, 1 thread each) is started
 once beforehand, as an existing cluster would be.
 """
@@ -19,10 +19,9 @@ import tempfile
 import time
 from pathlib import Path
 
-ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT))
+from benchmarks.sets.batch_drawings import make_drawing_folder
 
-from benchmarks.batch_drawings import make_drawing_folder  # noqa: E402
+ROOT = Path(__file__).resolve().parents[1]
 
 TARGETS = "svg,pes,gcode"
 

@@ -1,8 +1,8 @@
 #!/usr/bin/env python
 """Cost of the intersection CNN per intersection, with its 8-fold test-time augmentation.
 
-    python benchmarks/classifier_speed.py                 # both parts
-    python benchmarks/classifier_speed.py --count 40      # drawings of the "touch" set
+    python -m benchmarks.classifier_speed                 # both parts
+    python -m benchmarks.classifier_speed --count 40      # drawings of the "touch" set
 
 Part 1 (in the pipeline): vectorizes the benchmark's "touch" drawings with the CNN and
 divides the time of the "classification" stage (crops + 8 copies + one onnxruntime call)
@@ -18,18 +18,13 @@ import argparse
 import statistics
 import sys
 import time
-from pathlib import Path
 
-ROOT = Path(__file__).resolve().parents[1]
-if str(ROOT) not in sys.path:
-    sys.path.insert(0, str(ROOT))
-
-import numpy as np  # noqa: E402
+import numpy as np
 
 
 def pipeline_part(count: int) -> None:
-    from benchmarks.drawings import generate_set
-    from benchmarks.render import render, to_uint8
+    from benchmarks.sets.drawings import generate_set
+    from benchmarks.common.render import render, to_uint8
     from vectorize import VectorizeOptions, vectorize_image
 
     drawings = generate_set("touch", count)
@@ -52,8 +47,8 @@ def pipeline_part(count: int) -> None:
 
 
 def classifier_part() -> None:
-    from benchmarks.drawings import generate_set
-    from benchmarks.render import render
+    from benchmarks.sets.drawings import generate_set
+    from benchmarks.common.render import render
     from vectorize.junctions.cnn_classifier import CnnClassifier
     from vectorize.junctions.intersections import Junction
 

@@ -1,13 +1,13 @@
 """Embroidery quality, measured on files written and read back with pyembroidery.
 
-Run from the repository root: python benchmarks/embroidery_quality.py [--only density]
+Run from the repository root: python -m benchmarks.embroidery_quality [--only density]
 Prints the numbers the acceptance criteria of issues 4 and 27 ask for: worst cases over
 the test designs, every style and format; then, on every benchmark drawing (the bundled
 examples, the test designs, a three-colour SVG, short strokes, corners of 30-170 degrees)
 and every style (satin included), the density with every needle point counted and the
 repeated holes, measured by `fabrication.embroidery.quality` (the same functions as the
 stats' warnings), whether a warning names each place over the limit, the slits of zigzag
-and satin columns (benchmarks/column_metrics.py) and needle points planned per second
+and satin columns (benchmarks/metrics/columns.py) and needle points planned per second
 (the whole job); then the satin's width on the varying-width set (benchmarks/
 satin_quality.py: --only satin).
 """
@@ -15,28 +15,26 @@ satin_quality.py: --only satin).
 from __future__ import annotations
 
 import argparse
-import sys
 import tempfile
 import time
 from pathlib import Path
 
 import numpy as np
 
-ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT))
-sys.path.insert(0, str(ROOT / "tests"))
+from benchmarks.satin_quality import CORNER_ANGLES, column_slits, corner_drawing, varying_width
+from benchmarks.sets.embroidery_designs import FORMATS, STYLE_NAMES, THREE_COLOURS, design, spiral
+from benchmarks.metrics.stitches import lock_figure_ok, stroke_rows
+from fabrication.embroidery.export import write_embroidery
+from fabrication.embroidery.needles import BODY, LOCK, TACK, UNDERLAY
+from fabrication.embroidery.plan import STITCH, PlanOptions, plan_embroidery, style_options
+from fabrication.embroidery.read import read_embroidery
+from fabrication.embroidery.stats import embroidery_stats
+from fabrication.embroidery.zigzag import ZigzagOptions
+from machines.hoops import hoop_named
+from vectorize.drawing import Drawing
+from vectorize.stroke import Stroke
 
-from benchmarks.satin_quality import CORNER_ANGLES, column_slits, corner_drawing, varying_width  # noqa: E402
-from embroidery_fixtures import FORMATS, STYLE_NAMES, THREE_COLOURS, design, lock_figure_ok, spiral, stroke_rows  # noqa: E402
-from fabrication.embroidery.export import write_embroidery  # noqa: E402
-from fabrication.embroidery.needles import BODY, LOCK, TACK, UNDERLAY  # noqa: E402
-from fabrication.embroidery.plan import STITCH, PlanOptions, plan_embroidery, style_options  # noqa: E402
-from fabrication.embroidery.read import read_embroidery  # noqa: E402
-from fabrication.embroidery.stats import embroidery_stats  # noqa: E402
-from fabrication.embroidery.zigzag import ZigzagOptions  # noqa: E402
-from machines.hoops import hoop_named  # noqa: E402
-from vectorize.drawing import Drawing  # noqa: E402
-from vectorize.stroke import Stroke  # noqa: E402
+ROOT = Path(__file__).resolve().parents[1]
 
 
 STYLES = STYLE_NAMES + ("satin",)

@@ -1,6 +1,6 @@
 """Embroidery speed: stitches generated and written to .pes, medians over repeated runs.
 
-Run from the repository root: python benchmarks/embroidery_speed.py [--runs 7]
+Run from the repository root: python -m benchmarks.embroidery_speed [--runs 7]
 The design is one long spiral (a single stroke, like the vectorizer's output) sized so
 that each style makes about 100,000 needle points.
 """
@@ -9,21 +9,18 @@ from __future__ import annotations
 
 import argparse
 import statistics
-import sys
 import tempfile
 import time
-from pathlib import Path
 
 import numpy as np
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from fabrication.embroidery.export import write_embroidery  # noqa: E402
-from fabrication.embroidery.plan import PlanOptions, plan_embroidery, style_options  # noqa: E402
-from fabrication.embroidery.preview import PreviewOptions, render_stitch_preview  # noqa: E402
-from fabrication.embroidery.stats import embroidery_stats  # noqa: E402
-from vectorize.drawing import Drawing  # noqa: E402
-from vectorize.stroke import Stroke  # noqa: E402
+from fabrication.embroidery.export import write_embroidery
+from fabrication.embroidery.plan import PlanOptions, plan_embroidery, style_options
+from fabrication.embroidery.preview import PreviewOptions, render_stitch_preview
+from fabrication.embroidery.stats import embroidery_stats
+from vectorize.drawing import Drawing
+from vectorize.stroke import Stroke
 
 
 def spiral_drawing(turns: float, r0: float = 5.0, r1: float = 95.0, per_turn: int = 8) -> Drawing:

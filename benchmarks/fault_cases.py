@@ -1,6 +1,6 @@
 """The fault cases of issue 28 (items 6-9), run for real, one line of outcome each.
 
-    python benchmarks/fault_cases.py [--src TREE] [--only 6,7] [--markdown]
+    python -m benchmarks.fault_cases [--src TREE] [--only 6,7] [--markdown]
 
 Every case runs whole `onestroke` commands in child processes (`python -m fabrication.cli`,
 with TREE first on PYTHONPATH, so a checkout of another commit can be measured with the
@@ -17,7 +17,6 @@ from __future__ import annotations
 import argparse
 import contextlib
 import csv
-import json
 import os
 import shlex
 import shutil
@@ -31,10 +30,9 @@ import time
 from collections.abc import Iterator
 from pathlib import Path
 
-ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT))
+from benchmarks.common.processes import alive, children, cpu_ticks, rss_mb, workers_of
 
-from benchmarks.processes import alive, children, cpu_ticks, rss_mb, workers_of  # noqa: E402
+ROOT = Path(__file__).resolve().parents[1]
 
 
 class Cli:
@@ -380,7 +378,7 @@ def item9(cli: Cli, work: Path) -> Iterator[tuple[str, str]]:
 
 
 def prepare(work: Path) -> None:
-    from benchmarks.batch_drawings import make_drawing_folder
+    from benchmarks.sets.batch_drawings import make_drawing_folder
 
     (work / "in").mkdir(parents=True)
     shutil.copy(ROOT / "examples" / "loops.png", work / "in" / "loops.png")

@@ -5,26 +5,21 @@ the process's peak, a high-water mark, so no case went over when the final peak 
 it). Prints how many exited 0/1/2, tracebacks and internal errors, runs over the bounds,
 incomplete output sets, the slowest case and the peak memory.
 
-    python benchmarks/fuzz.py                 # 2,100 inputs (300 per kind), seed 0
-    python benchmarks/fuzz.py --per-kind 50 --seed 3 --time-bound 30
+    python -m benchmarks.fuzz                 # 2,100 inputs (300 per kind), seed 0
+    python -m benchmarks.fuzz --per-kind 50 --seed 3 --time-bound 30
 """
 
 from __future__ import annotations
 
 import argparse
 import collections
-import sys
 import tempfile
 import time
 from pathlib import Path
 
 from hypothesis import HealthCheck, Phase, given, seed, settings
 
-ROOT = Path(__file__).resolve().parents[1]
-if str(ROOT) not in sys.path:
-    sys.path.insert(0, str(ROOT))
-
-from benchmarks.fuzz_cases import KINDS, MEMORY_BOUND_MB, fuzz_case, run_case  # noqa: E402
+from benchmarks.sets.fuzz_cases import KINDS, MEMORY_BOUND_MB, fuzz_case, run_case
 
 
 def main() -> None:

@@ -1,9 +1,9 @@
 """The hostile-input cases of issue 28 (items 1-5), each run as a user would: a fresh
 `onestroke` process, its exit code, first message line, wall time and peak memory.
 
-    python benchmarks/hostile_cases.py                  # every case, 60 s and 3 GB bound each
-    python benchmarks/hostile_cases.py --only svg- --time-bound 20
-    PYTHONPATH=/path/to/other/checkout python benchmarks/hostile_cases.py   # the same cases on other code
+    python -m benchmarks.hostile_cases                  # every case, 60 s and 3 GB bound each
+    python -m benchmarks.hostile_cases --only svg- --time-bound 20
+    PYTHONPATH=/path/to/other/checkout python -m benchmarks.hostile_cases   # the same cases on other code
 
 A case still running at the time bound, or over the memory bound, is killed (its whole
 process group) and reported as such. Prints one row per case (markdown table).

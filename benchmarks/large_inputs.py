@@ -1,6 +1,6 @@
 """Benchmark: the CLI on large SVG inputs (issue 14, "silence on long work").
 
-Run from the repo root: `python benchmarks/large_inputs.py [--paths 20000] [--segments 10000]
+Run from the repo root: `python -m benchmarks.large_inputs [--paths 20000] [--segments 10000]
 [--only embroider,laser]`. Writes two seeded SVGs to a temporary folder:
 
 - many.svg: `--paths` short cubic paths (3 segments each) scattered over 200 x 150 mm;

@@ -7,8 +7,8 @@ TIFF and a JPEG, then runs `onestroke vectorize` on each in a child process and 
 peak RSS (the child's VmHWM), CPU seconds (user + system) and exit code. The scans are written to --folder and deleted
 afterwards unless --keep; they are never committed.
 
-    python benchmarks/large_scans.py                       # 139 and 300 Mpx, every kind
-    python benchmarks/large_scans.py --mpx 139 --kinds png-l,png-rgb --keep
+    python -m benchmarks.large_scans                       # 139 and 300 Mpx, every kind
+    python -m benchmarks.large_scans --mpx 139 --kinds png-l,png-rgb --keep
 """
 
 from __future__ import annotations

@@ -16,7 +16,7 @@ the figures do not change with the load (measured at load averages 12-21), only 
 a row whose "host timeouts" exceeds 1 had a host stall that may have cost machine time.
 `--scale` only sets how fast the emulator paces its replies in wall time.
 
-    python benchmarks/laser_estimate_vs_emulator.py [--scale 2] [--repeat 1] [--only dense] [--count N] [--match TEXT]
+    python -m benchmarks.laser_estimate_vs_emulator [--scale 2] [--repeat 1] [--only dense] [--count N] [--match TEXT]
 """
 
 from __future__ import annotations
@@ -25,21 +25,15 @@ import argparse
 import multiprocessing as mp
 import os
 import statistics
-import sys
 import time
-from pathlib import Path
 
-ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT))
-sys.path.insert(0, str(ROOT / "benchmarks"))
-
-from laser_time import PROFILE, jobs  # noqa: E402
-from machines.emulator import EmulatorOptions, GrblEmulator  # noqa: E402
-from machines.gcode_program import program_from_lines  # noqa: E402
-from machines.job_time import estimate_program_time  # noqa: E402
-from machines.ports import open_port  # noqa: E402
-from machines.streamer import GrblStreamer  # noqa: E402
-from stream_bench import make_job  # noqa: E402
+from benchmarks.laser_time import PROFILE, jobs
+from machines.emulator import EmulatorOptions, GrblEmulator
+from machines.gcode_program import program_from_lines
+from machines.job_time import estimate_program_time
+from machines.ports import open_port
+from machines.streamer import GrblStreamer
+from benchmarks.stream_bench import make_job
 
 
 def dense_job(lines: int, step: float, feed: float) -> list[str]:

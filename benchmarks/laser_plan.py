@@ -1,6 +1,6 @@
 """Benchmark: planning and writing a laser job of ~100,000 G-code moves.
 
-Run from the repo root: `python benchmarks/laser_plan.py`. Prints medians of 5 runs for
+Run from the repo root: `python -m benchmarks.laser_plan`. Prints medians of 5 runs for
 each stage: placement (fabrication.placement.place, not laser code), flattening +
 simplification + ordering (plan_toolpath minus placement), G-code formatting, the atomic
 write, and the time estimate (reported separately: it is not part of writing).
@@ -8,7 +8,6 @@ write, and the time estimate (reported separately: it is not part of writing).
 
 from __future__ import annotations
 
-import sys
 import tempfile
 import time
 from pathlib import Path
@@ -16,16 +15,15 @@ from statistics import median
 
 import numpy as np
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from fabrication.laser import toolpath as toolpath_module  # noqa: E402
-from fabrication.laser.gcode_write import GcodeOptions, gcode_lines, write_gcode  # noqa: E402
-from machines.job_time import estimate_job_time as estimate_gcode_time  # noqa: E402
-from fabrication.laser.toolpath import ToolpathOptions, plan_toolpath  # noqa: E402
-from fabrication.placement import PlacementOptions, place  # noqa: E402
-from machines.laser_profile import load_laser_profile  # noqa: E402
-from vectorize.drawing import Drawing  # noqa: E402
-from vectorize.stroke import Stroke  # noqa: E402
+from fabrication.laser import toolpath as toolpath_module
+from fabrication.laser.gcode_write import GcodeOptions, gcode_lines, write_gcode
+from machines.job_time import estimate_job_time as estimate_gcode_time
+from fabrication.laser.toolpath import ToolpathOptions, plan_toolpath
+from fabrication.placement import PlacementOptions, place
+from machines.laser_profile import load_laser_profile
+from vectorize.drawing import Drawing
+from vectorize.stroke import Stroke
 
 
 def jagged_drawing(n_points: int, strokes: int, seed: int = 0) -> Drawing:
@@ -78,8 +76,7 @@ def main() -> None:
         print(f"  planning + writing, laser code              {t_own + t_lines + t_write:7.3f} s")
         print(f"  planning + writing, with place()            {t_plan + t_lines + t_write:7.3f} s")
         print(f"  time estimate (GRBL planner model)          {t_est:7.3f} s  -> job {job.total_seconds:.0f} s")
-    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
-    from laser_fixtures import wiggle_drawing
+    from benchmarks.sets.laser_jobs import wiggle_drawing
 
     smooth = place(wiggle_drawing(20000), PlacementOptions(size=380))
     for arcs in (False, True):

@@ -1,9 +1,9 @@
 """Benchmark: the job-time estimate against independent models, and vector vs raster time.
 
-Run from the repo root: `python benchmarks/laser_time.py`. For each job it prints
+Run from the repo root: `python -m benchmarks.laser_time`. For each job it prints
 - estimate: machines.job_time, planner bound alone (the batch driver of machines.planner_model)
   and with the serial link and parser modelled (what `onestroke laser` prints);
-- simulation: tests/laser_grbl_sim.py, written separately from GRBL's documented rules
+- simulation: benchmarks/metrics/grbl_sim.py, written separately from GRBL's documented rules
   (literal 15-slot planner buffer, GRBL's incremental arc generator, time-stepped motion
   at 0.1 ms; shares no code with the estimator);
 - length/feed: what common senders (LaserGRBL, bCNC) show.
@@ -13,24 +13,21 @@ drawing on the same machine model.
 
 from __future__ import annotations
 
-import sys
 import tempfile
 import time
 from pathlib import Path
 from statistics import median
 
-ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT))
-sys.path.insert(0, str(ROOT / "tests"))
+from fabrication.laser.gcode_write import GcodeOptions, gcode_lines
+from machines.job_time import estimate_job_time as estimate_gcode_time
+from fabrication.laser.raster_time import raster_time
+from fabrication.laser.toolpath import ToolpathOptions, plan_toolpath
+from fabrication.placement import PlacementOptions
+from benchmarks.sets.laser_jobs import spiral_points, trefoil_png
+from benchmarks.metrics.grbl_sim import simulate
+from machines.laser_profile import load_laser_profile
 
-from fabrication.laser.gcode_write import GcodeOptions, gcode_lines  # noqa: E402
-from machines.job_time import estimate_job_time as estimate_gcode_time  # noqa: E402
-from fabrication.laser.raster_time import raster_time  # noqa: E402
-from fabrication.laser.toolpath import ToolpathOptions, plan_toolpath  # noqa: E402
-from fabrication.placement import PlacementOptions  # noqa: E402
-from laser_fixtures import spiral_points, trefoil_png  # noqa: E402
-from laser_grbl_sim import simulate  # noqa: E402
-from machines.laser_profile import load_laser_profile  # noqa: E402
+ROOT = Path(__file__).resolve().parents[1]
 
 PROFILE = load_laser_profile()
 

@@ -1,7 +1,7 @@
 #!/usr/bin/env python
 """Render a few benchmark drawings to PNG in examples/ (real raster inputs for the README).
 
-    python benchmarks/make_examples.py [--out examples]
+    python -m benchmarks.make_examples [--out examples]
 
 Writes examples/<kind>-drawing.png for some generated kinds (seed 0) and two Hershey glyphs
 as examples/hershey-<font>-<glyph>.png: 1000 x 1000 px, 8-bit gray, anti-aliased.
@@ -13,15 +13,13 @@ import argparse
 import sys
 from pathlib import Path
 
+from PIL import Image
+
+from benchmarks.sets.drawings import generate_drawing
+from benchmarks.sets.hershey import glyph_ground_truth, load_glyphs
+from benchmarks.common.render import render, to_uint8
+
 ROOT = Path(__file__).resolve().parents[1]
-if str(ROOT) not in sys.path:
-    sys.path.insert(0, str(ROOT))
-
-from PIL import Image  # noqa: E402
-
-from benchmarks.drawings import generate_drawing  # noqa: E402
-from benchmarks.hershey import glyph_ground_truth, load_glyphs  # noqa: E402
-from benchmarks.render import render, to_uint8  # noqa: E402
 
 # (file stem, kind, index): picked for variety of width, crossings and features
 GENERATED = [

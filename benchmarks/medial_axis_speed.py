@@ -1,7 +1,7 @@
 """Benchmark: the medial axis stage alone (`vectorize.axis.medial_axis.medial_axis`), whole and in
 tiles.
 
-Run from the repo root: `python benchmarks/medial_axis_speed.py [DRAWING ...] [--tsp N]
+Run from the repo root: `python -m benchmarks.medial_axis_speed [DRAWING ...] [--tsp N]
 [--repeats R] [--source DIR]` (default: the 1000 px examples loops.png, touch-drawing.png and
 the hershey ampersand; --tsp adds the first N TSP-art drawings of the `kinds` set, ~300,000
 outline samples each). Each drawing is binarized and outlined as the vectorizer does, then
@@ -15,7 +15,8 @@ its medial axis is computed R (7) times per way, and the medians are printed:
   machine the wall columns include waiting for a core (the load average is printed).
 
 --source DIR imports `vectorize` from DIR (another checkout, e.g. a worktree of an older
-commit, whose `medial_axis` may have no `tiles`: then only the whole diagram is timed).
+commit, whose `medial_axis` may have no `tiles`: then only the whole diagram is timed), in
+a child interpreter (benchmarks/common/checkout.py).
 """
 
 from __future__ import annotations
@@ -27,6 +28,8 @@ import sys
 import time
 from pathlib import Path
 from statistics import median
+
+from benchmarks.common.checkout import needs_rerun, rerun_on
 
 ROOT = Path(__file__).resolve().parents[1]
 DEFAULT = ["examples/loops.png", "examples/touch-drawing.png", "examples/hershey-HersheySans1-ampersand.png"]
@@ -46,9 +49,9 @@ def _tsp_images(count: int):
     """The first `count` TSP drawings of the kinds set, rendered as the benchmark does."""
     import numpy as np
 
-    from benchmarks.conditions import condition_image
-    from benchmarks.render import render_truth
-    from benchmarks.tsp_art import tsp_drawing
+    from benchmarks.sets.conditions import condition_image
+    from benchmarks.common.render import render_truth
+    from benchmarks.sets.tsp_art import tsp_drawing
 
     for index in range(count):
         gt = tsp_drawing(0, index)
@@ -64,8 +67,8 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--repeats", type=int, default=7)
     ap.add_argument("--source", type=Path, default=ROOT, help="the checkout whose vectorize to time")
     args = ap.parse_args(argv)
-    sys.path.insert(0, str(ROOT))
-    sys.path.insert(0, str(args.source.resolve()))
+    if needs_rerun(args.source):
+        return rerun_on(args.source, __file__, sys.argv[1:] if argv is None else argv)
     from concurrent.futures import ThreadPoolExecutor
 
     import vectorize.axis.medial_axis as medial

@@ -1,7 +1,7 @@
 """Player page on a 100,000-stitch embroidery file: build time, page size, and in Chromium
 the time to the first picture, to scrub to the end and back, and frames while playing.
 
-    python benchmarks/player_bench.py [--stitches 100000] [--repeat 5]
+    python -m benchmarks.player_bench [--stitches 100000] [--repeat 5]
 
 Prints medians. Needs /usr/bin/chromium (Debian's package) and Playwright.
 """

@@ -1,8 +1,8 @@
 #!/usr/bin/env python
 """How long route inspection's matching takes on large graphs, alone and within a whole run.
 
-    python benchmarks/route_matching_speed.py                 # 100 odd nodes, and the longest cursive lines
-    python benchmarks/route_matching_speed.py --odd 60 100 140 --repeat 5
+    python -m benchmarks.route_matching_speed                 # 100 odd nodes, and the longest cursive lines
+    python -m benchmarks.route_matching_speed --odd 60 100 140 --repeat 5
 
 1. Branch graphs like a long written line (`word_graph`: a wandering spine, stems and stubs
    off it, a few loops), built until they have the asked number of odd nodes: CPU seconds of
@@ -22,15 +22,11 @@ import os
 import statistics
 import sys
 import time
-from pathlib import Path
 
-ROOT = Path(__file__).resolve().parents[1]
-if str(ROOT) not in sys.path:
-    sys.path.insert(0, str(ROOT))
+import numpy as np
 
-import numpy as np  # noqa: E402
+from vectorize.axis.graph import Branch, MedialGraph
 
-from vectorize.axis.graph import Branch, MedialGraph  # noqa: E402
 
 LONG_LINES = ("the kitten and the little duck hated the tall candle",
               "little kettle tilted at the tent and the little duck")
@@ -132,8 +128,8 @@ def synthetic(odd_targets: list[int], repeat: int) -> None:
 
 
 def drawings(count: int) -> None:
-    from benchmarks.cursive import LINES, cursive_drawing
-    from benchmarks.render import render_truth, to_uint8
+    from benchmarks.sets.cursive import LINES, cursive_drawing
+    from benchmarks.common.render import render_truth, to_uint8
     from vectorize import VectorizeOptions, vectorize_image
 
     longest = sorted(range(len(LINES)), key=lambda i: -len(LINES[i].replace(" ", "")))[:count]

@@ -2,10 +2,10 @@
 """Do two versions of the vectorizer write the same SVG bytes? (speed work must not change
 the output).
 
-    python benchmarks/same_svg.py make /tmp/inputs                 # the inputs, once
-    python benchmarks/same_svg.py run /tmp/inputs /work/wt/base-x /tmp/base.json
-    python benchmarks/same_svg.py run /tmp/inputs . /tmp/new.json
-    python benchmarks/same_svg.py compare /tmp/base.json /tmp/new.json
+    python -m benchmarks.same_svg make /tmp/inputs                 # the inputs, once
+    python -m benchmarks.same_svg run /tmp/inputs /work/wt/base-x /tmp/base.json
+    python -m benchmarks.same_svg run /tmp/inputs . /tmp/new.json
+    python -m benchmarks.same_svg compare /tmp/base.json /tmp/new.json
 
 `make` renders the drawings of every set of `benchmarks/vectorize_bench.py` (seeds 0 and 1,
 "kinds" included; --sets/--seeds/--count to take fewer) as the benchmark hands them to the
@@ -30,6 +30,8 @@ import sys
 import time
 from pathlib import Path
 
+from benchmarks.common.checkout import needs_rerun, rerun_on
+
 HERE = Path(__file__).resolve().parents[1]
 # The ink widths along a path (vectorize/svg_write.py): hashed apart from the curves, so that
 # the curves of versions before and after widths existed compare equal.
@@ -39,12 +41,11 @@ SETTINGS = [(None, 0.0), (0.35, 0.0), (0.5, 0.0), (None, 0.75), (0.4, 0.75), (No
 
 
 def make(folder: Path, sets: list[str], seeds: list[int], count: int | None) -> int:
-    sys.path.insert(0, str(HERE))
     import numpy as np
 
-    from benchmarks.conditions import condition_image
-    from benchmarks.render import render_truth
-    from benchmarks.vectorize_bench import DEFAULT_COUNTS, KINDS_COUNT, build_set
+    from benchmarks.common.render import render_truth
+    from benchmarks.sets.conditions import condition_image
+    from benchmarks.sets.registry import DEFAULT_COUNTS, KINDS_COUNT, build_set
 
     folder.mkdir(parents=True, exist_ok=True)
     made = 0
@@ -101,7 +102,8 @@ def _one(task: tuple) -> tuple[str, str]:
 
 
 def run(folder: Path, tree: Path, out: Path, jobs: int) -> int:
-    sys.path.insert(0, str(tree.resolve()))
+    if needs_rerun(tree):  # `vectorize` from that tree, in a child interpreter
+        return rerun_on(tree, __file__, ["run", str(folder), str(tree), str(out), "--jobs", str(jobs)])
     import vectorize
 
     source = Path(vectorize.__file__).resolve().parents[1]
@@ -153,8 +155,7 @@ def main(argv: list[str] | None = None) -> int:
     args = ap.parse_args(argv)
     if args.command == "make":
         if args.sets is None:
-            sys.path.insert(0, str(HERE))
-            from benchmarks.vectorize_bench import SETS
+            from benchmarks.sets.registry import SETS
 
             args.sets = [*SETS, "kinds"]
         return make(args.folder, args.sets, args.seeds, args.count)

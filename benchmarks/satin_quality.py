@@ -1,42 +1,38 @@
 """Satin quality: the column's width against the drawn width on drawings whose line swells
 and thins, and the corner drawings of embroidery_quality.py.
 
-Run from the repository root: python benchmarks/satin_quality.py [--count 6] [--size 90]
-(also part of python benchmarks/embroidery_quality.py). The varying-width set is the
+Run from the repository root: python -m benchmarks.satin_quality [--count 6] [--size 90]
+(also part of python -m benchmarks.embroidery_quality). The varying-width set is the
 vectorizer benchmark's brush kana (pressure, tapered ends) and broad-nib capitals (marker-
 like: thick and thin by direction), rendered with their known width profiles
-(benchmarks/brush.py), vectorized, placed at --size mm and sewn with `--style satin`. Per
-drawing: the share of the column's length whose sewn width (benchmarks/column_metrics.py)
+(benchmarks/sets/brush.py), vectorized, placed at --size mm and sewn with `--style satin`. Per
+drawing: the share of the column's length whose sewn width (benchmarks/metrics/columns.py)
 lies within 10 % or 0.2 mm of the drawn width x the design's scale (the acceptance of
 issue 27), over the length where the stroke's ink is its own (where two passes of the line
 share ink, a V's sides or a crossing, one pass's width cannot be seen: that share is shown);
 density with every needle point counted and repeated holes (fabrication.embroidery.quality),
-slits (column_metrics.slits), and needle points planned per second.
+slits (metrics.columns.slits), and needle points planned per second.
 """
 
 from __future__ import annotations
 
 import argparse
 import statistics
-import sys
 import time
-from pathlib import Path
 
 import numpy as np
 from scipy.spatial import cKDTree
 
-ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT))
+from benchmarks.sets.brush import capital_set, kana_set
+from benchmarks.metrics.columns import sewn_widths, shared_ground, slits
+from benchmarks.common.render import profile_widths, render_truth, to_uint8
+from fabrication.embroidery.plan import STITCH, PlanOptions, plan_embroidery, style_options
+from fabrication.embroidery.quality import needle_density, repeated_holes
+from fabrication.placement import PlacementOptions, place
+from vectorize.drawing import Drawing
+from vectorize.pipeline import vectorize_image
+from vectorize.stroke import Stroke
 
-from benchmarks.brush import capital_set, kana_set  # noqa: E402
-from benchmarks.column_metrics import sewn_widths, shared_ground, slits  # noqa: E402
-from benchmarks.render import profile_widths, render_truth, to_uint8  # noqa: E402
-from fabrication.embroidery.plan import STITCH, PlanOptions, plan_embroidery, style_options  # noqa: E402
-from fabrication.embroidery.quality import needle_density, repeated_holes  # noqa: E402
-from fabrication.placement import PlacementOptions, place  # noqa: E402
-from vectorize.drawing import Drawing  # noqa: E402
-from vectorize.pipeline import vectorize_image  # noqa: E402
-from vectorize.stroke import Stroke  # noqa: E402
 
 CORNER_ANGLES = (30, 45, 60, 90, 120, 150, 170)
 

@@ -1,8 +1,8 @@
 #!/usr/bin/env python
 """CPU seconds per pipeline stage on a sample of the benchmark sets (issue 10's speed work).
 
-    python benchmarks/stage_cpu.py                  # every 8th drawing of each set (35)
-    python benchmarks/stage_cpu.py --step 4 --cprofile 30
+    python -m benchmarks.stage_cpu                  # every 8th drawing of each set (35)
+    python -m benchmarks.stage_cpu --step 4 --cprofile 30
 
 On a machine shared with other work the wall time includes waiting for a core; the CPU
 time (`time.process_time`, all threads of this process) does not, so it is what to compare
@@ -21,14 +21,9 @@ import pstats
 import statistics
 import sys
 import time
-from pathlib import Path
 
-ROOT = Path(__file__).resolve().parents[1]
-if str(ROOT) not in sys.path:
-    sys.path.insert(0, str(ROOT))
-
-from benchmarks.render import render  # noqa: E402
-from benchmarks.vectorize_bench import SETS, build_set  # noqa: E402
+from benchmarks.common.render import render
+from benchmarks.vectorize_bench import SETS, build_set
 
 
 def main(argv: list[str] | None = None) -> int:

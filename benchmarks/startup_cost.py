@@ -2,11 +2,11 @@
 """What a whole `onestroke vectorize IN.png -o OUT.svg` process spends, part by part, and
 how it compares with a bare process that imports the same libraries.
 
-    python benchmarks/startup_cost.py              # the 9 drawings of `vectorize_bench.py --whole-process 9`
-    python benchmarks/startup_cost.py --count 5 --repeat 3
-    python benchmarks/startup_cost.py --pairs 15   # the command against the bare import floor, side by side
+    python -m benchmarks.startup_cost              # the 9 drawings of `vectorize_bench.py --whole-process 9`
+    python -m benchmarks.startup_cost --count 5 --repeat 3
+    python -m benchmarks.startup_cost --pairs 15   # the command against the bare import floor, side by side
 
-`--pairs N` (`startup_ratio.py`): N drawings (as `--whole-process N` picks them), each run
+`--pairs N` (`benchmarks/common/startup_ratio.py`): N drawings (as `--whole-process N` picks them), each run
 as the command and as a bare process importing exactly the third-party modules that
 command loaded (found by an unmeasured run of the command in a process that lists them),
 one right after the other (which one first alternates); the ratio command / bare per pair,
@@ -31,7 +31,7 @@ includes waiting for a core; compare CPU time between versions (the load is prin
 
 What is measured is what a user runs: this working tree installed the regular way (`pip
 install .`, modules compiled by pip) into a new virtual environment in a temporary folder,
-its dependencies from this interpreter's (`user_install.py`). `--editable` measures the
+its dependencies from this interpreter's (`benchmarks/common/user_install.py`). `--editable` measures the
 working tree through PYTHONPATH instead, as the tests run it: with PYTHONDONTWRITEBYTECODE=1
 in the environment every process then compiles the project's own modules from source; the
 line "bytecode" says which was measured, and --pycache DIR lets the children keep compiled
@@ -102,27 +102,11 @@ def _parts_child(source: str, output: str) -> None:
     print(json.dumps(parts))
 
 
-def child_cpu_seconds() -> float:
-    """User + sys seconds of this process's finished children so far (all their threads)."""
-    import resource
-
-    usage = resource.getrusage(resource.RUSAGE_CHILDREN)
-    return usage.ru_utime + usage.ru_stime
-
-
-def bytecode_note(env, installed: bool = False) -> str:
-    """Whether processes with environment `env` keep the project's compiled modules."""
-    if installed:
-        return "the project's modules compiled at install (a regular `pip install .`, what a user runs)"
-    if env.get("PYTHONDONTWRITEBYTECODE"):
-        return ("not written (PYTHONDONTWRITEBYTECODE is set: each process compiles the project's own modules "
-                "from source; an installed package has them compiled)")
-    return f"cached in {env.get('PYTHONPYCACHEPREFIX') or 'the __pycache__ folders'}"
-
-
 def _timed(cmd: list[str], env: dict, timeout: float) -> tuple[float, float, str]:
     """(wall s, CPU s of the child, stdout) of one process run to the end."""
     import subprocess
+
+    from benchmarks.common.processes import child_cpu_seconds
 
     cpu0, start = child_cpu_seconds(), time.perf_counter()
     proc = subprocess.run(cmd, capture_output=True, text=True, env=env, timeout=timeout)
@@ -139,10 +123,10 @@ def main(argv: list[str] | None = None) -> int:
     import tempfile
     from pathlib import Path
 
+    from benchmarks.common.user_install import bytecode_note
+    from benchmarks.sets.registry import DEFAULT_COUNTS, SETS, build_set
+
     root = Path(__file__).resolve().parents[1]
-    if str(root) not in sys.path:
-        sys.path.insert(0, str(root))
-    from benchmarks.vectorize_bench import DEFAULT_COUNTS, SETS, build_set
 
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[1])
     ap.add_argument("--count", type=int, default=9, help="drawings, picked across all sets as --whole-process picks")
@@ -172,14 +156,14 @@ def main(argv: list[str] | None = None) -> int:
             python, exe = sys.executable, shutil.which("onestroke")
             command = [exe] if exe else [sys.executable, "-m", "fabrication.cli"]
         else:
-            from benchmarks.user_install import regular_install
+            from benchmarks.common.user_install import regular_install
 
             env = dict(os.environ)
             bin_dir = regular_install(Path(tmp) / "venv", root)
             python, command = str(bin_dir / "python"), [str(bin_dir / "onestroke")]
         note = bytecode_note(env, installed=not args.editable)
         if args.pairs:
-            from benchmarks.startup_ratio import ratio_pairs
+            from benchmarks.common.startup_ratio import ratio_pairs
 
             print(f"bytecode: {note}")
             return ratio_pairs(picks, command, python, env, args.timeout)
@@ -195,7 +179,7 @@ def _parts(picks: list, command: list[str], python: str, env: dict, note: str, r
 
     from PIL import Image
 
-    from benchmarks.render import render, to_uint8
+    from benchmarks.common.render import render, to_uint8
 
     whole_wall, whole_cpu, parts = [], [], {}
     for gt in picks:

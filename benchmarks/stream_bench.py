@@ -7,7 +7,7 @@ run time in machine seconds (the emulator's machine clock, `EmulatorStats.job_ti
 same whatever the load), the emulator's planner-limited time,
 their ratio, RX overflow bytes and whether the emulator's log equals the file.
 
-    python benchmarks/stream_bench.py [--lines 20000] [--scale 4] [--repeat 3]
+    python -m benchmarks.stream_bench [--lines 20000] [--scale 4] [--repeat 3]
 """
 
 from __future__ import annotations
@@ -16,16 +16,13 @@ import argparse
 import math
 import multiprocessing as mp
 import statistics
-import sys
 import time
-from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from machines.emulator import EmulatorOptions, GrblEmulator  # noqa: E402
-from machines.gcode_program import program_from_text  # noqa: E402
-from machines.ports import open_port  # noqa: E402
-from machines.streamer import DRAIN_LINE, GrblStreamer, StreamOptions  # noqa: E402
+from machines.emulator import EmulatorOptions, GrblEmulator
+from machines.gcode_program import program_from_text
+from machines.ports import open_port
+from machines.streamer import DRAIN_LINE, GrblStreamer, StreamOptions
 
 
 def make_job(lines: int, step: float, feed: float) -> str:

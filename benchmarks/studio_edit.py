@@ -3,7 +3,7 @@
 Prints wall-clock medians and, below them, the CPU seconds the answer took in this
 process (all threads): on a loaded machine the wall time includes waiting for a core.
 
-Run from the repo root: `python benchmarks/studio_edit.py [DRAWING ...]` (default: the
+Run from the repo root: `python -m benchmarks.studio_edit [DRAWING ...]` (default: the
 1000 px examples loops.png, touch-drawing.png and hershey ampersand). After the first
 vectorization, each edit kind is sent --repeats (7) times through Starlette's test client, the
 way the page sends it, and the median answer time is printed per kind. Every answer is
@@ -37,20 +37,17 @@ from __future__ import annotations
 
 import argparse
 import os
-import sys
 import time
 from dataclasses import replace
 from pathlib import Path
 from statistics import median
 
-ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT))
+from starlette.testclient import TestClient
 
-from starlette.testclient import TestClient  # noqa: E402
+from fabrication.studio.app import create_app
+from fabrication.studio.session import StudioSession
+from vectorize.refine.edits import PAIRINGS, Edits
 
-from fabrication.studio.app import create_app  # noqa: E402
-from fabrication.studio.session import StudioSession  # noqa: E402
-from vectorize.refine.edits import PAIRINGS, Edits  # noqa: E402
 
 REPEATS = 7
 # The page's default panel values (fabrication/studio/static/index.html).
@@ -173,9 +170,9 @@ def hand_drawings() -> list[Path]:
 
     from PIL import Image
 
-    from benchmarks.drawings import generate_set
-    from benchmarks.handwriting import handwriting_drawing
-    from benchmarks.render import render, to_uint8
+    from benchmarks.sets.drawings import generate_set
+    from benchmarks.sets.handwriting import handwriting_drawing
+    from benchmarks.common.render import render, to_uint8
 
     folder = Path(tempfile.mkdtemp(prefix="studio-edit-"))
     paths = []
@@ -187,10 +184,10 @@ def hand_drawings() -> list[Path]:
 
 def gap_drawing() -> Path:
     """The cursive word "little" with two pen gaps wiped out, as the studio's browser tests
-    draw it (`tests/studio_fixtures.bench_drawing`), as a PNG in a temporary folder."""
+    draw it (`benchmarks.sets.hand_drawings.bench_drawing`), as a PNG in a temporary folder."""
     import tempfile
 
-    from tests.studio_fixtures import bench_drawing
+    from benchmarks.sets.hand_drawings import bench_drawing
 
     return bench_drawing(Path(tempfile.mkdtemp(prefix="studio-edit-gaps-")), "little")
 

@@ -11,8 +11,9 @@ on a loaded machine the wall time includes waiting for a core) and the peak memo
 process during the request (VmHWM, reset before each request through /proc/self/clear_refs),
 and per endpoint its worst case. The load average is printed with them.
 
-Run from the repo root: `python benchmarks/studio_worst.py [--repeats 3] [--only laser,embroidery]`.
-`--root DIR` imports onestroke from another checkout (e.g. to measure main before a change)
+Run from the repo root: `python -m benchmarks.studio_worst [--repeats 3] [--only laser,embroidery]`.
+`--root DIR` imports onestroke from another checkout (e.g. to measure main before a change, in
+a child interpreter: benchmarks/common/checkout.py)
 while the cases stay these.
 """
 
@@ -27,6 +28,8 @@ import time
 import warnings
 from pathlib import Path
 from statistics import median
+
+from benchmarks.common.checkout import needs_rerun, rerun_on
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -100,7 +103,8 @@ def main() -> None:
     parser.add_argument("--bed", type=float, default=None, help="bed side of the uploaded profile (mm)")
     parser.add_argument("--hoop", type=float, default=None, help="custom hoop side (mm)")
     args = parser.parse_args()
-    sys.path.insert(0, args.root)
+    if needs_rerun(args.root):
+        sys.exit(rerun_on(args.root, __file__, sys.argv[1:]))
     warnings.filterwarnings("ignore")
     from starlette.testclient import TestClient
 

@@ -1,12 +1,12 @@
 #!/usr/bin/env python
 """Vectorizer benchmark: one command, one table.
 
-    python benchmarks/vectorize_bench.py                       # all sets, default classifiers
-    python benchmarks/vectorize_bench.py --set touch --classifier both --count 30
-    python benchmarks/vectorize_bench.py --csv /tmp/bench.csv  # plus one row per drawing
-    python benchmarks/vectorize_bench.py --whole-process 5     # time `onestroke vectorize` as a subprocess
-    python benchmarks/vectorize_bench.py --ground-truth-as-output   # check the metrics machinery
-    python benchmarks/vectorize_bench.py --set plain --condition scan  # scan-like input (conditions.py)
+    python -m benchmarks.vectorize_bench                       # all sets, default classifiers
+    python -m benchmarks.vectorize_bench --set touch --classifier both --count 30
+    python -m benchmarks.vectorize_bench --csv /tmp/bench.csv  # plus one row per drawing
+    python -m benchmarks.vectorize_bench --whole-process 5     # time `onestroke vectorize` as a subprocess
+    python -m benchmarks.vectorize_bench --ground-truth-as-output   # check the metrics machinery
+    python -m benchmarks.vectorize_bench --set plain --condition scan  # scan-like input (benchmarks/sets/conditions.py)
 
 Sets: "plain" (generated, no touches), "touch" (generated, with tangential touches and
 near-touches), "hershey" (single-stroke font glyphs), "hershey-retrace" (the glyphs whose
@@ -14,10 +14,10 @@ retraced branch cannot be told from the ink, fair-retrace rule), "relief" (Relie
 SingleLine glyphs), "triple" (three passes through a point), "handwriting" (jittered
 cursive words); "heldout" (not in "all"): glyphs, words and seeds no other set uses, under
 scan, JPEG, noise, pen-pressure, broken-line, half-resolution and pencil conditions
-(benchmarks/heldout.py); "kinds" (not in "all"): TSP art, brush kana, broad-nib capitals and
-phone photos of pen drawings (benchmarks/kinds.py); "cursive" (not in "all"): long cursive words
+(benchmarks/sets/heldout.py); "kinds" (not in "all"): TSP art, brush kana, broad-nib capitals and
+phone photos of pen drawings (benchmarks/sets/kinds.py); "cursive" (not in "all"): long cursive words
 and short sentences as one line, with overshoot hooks, entry stubs and drifting stem loops
-(benchmarks/cursive.py). Classifier "auto" runs the CNN everywhere and the geometric rule on touch
+(benchmarks/sets/cursive.py). Classifier "auto" runs the CNN everywhere and the geometric rule on touch
 too. See docs/benchmark.md for the columns.
 
 Each drawing is vectorized in a fresh process forked from this one (the vectorizer's
@@ -32,7 +32,6 @@ from __future__ import annotations
 import argparse
 import csv
 import gc
-import math
 import multiprocessing as mp
 import os
 import platform
@@ -45,58 +44,21 @@ import time
 import traceback
 from pathlib import Path
 
+import numpy as np
+
+from benchmarks.sets.conditions import CONDITIONS, condition_image
+from benchmarks.metrics.tables import PSNR_CAP, print_failures, print_fair_only, print_tables
+from benchmarks.metrics.ink import ink_pieces, ink_scores, verdict
+from benchmarks.metrics.table1 import ORDER_THRESHOLD, evaluate, order_tolerance
+from benchmarks.metrics.route_figures import print_route_figures, route_row
+from benchmarks.common.render import render, render_truth, to_uint8
+from benchmarks.sets.registry import CURSIVE_COUNT, DEFAULT_COUNTS, HELDOUT_COUNT, KINDS_COUNT, SETS, build_set
+
 ROOT = Path(__file__).resolve().parents[1]
-if str(ROOT) not in sys.path:
-    sys.path.insert(0, str(ROOT))
 
-import numpy as np  # noqa: E402
-
-from benchmarks.conditions import CONDITIONS, condition_image  # noqa: E402
-from benchmarks.bench_tables import PSNR_CAP, print_failures, print_fair_only, print_tables  # noqa: E402
-from benchmarks.drawings import generate_set  # noqa: E402
-from benchmarks.hershey import hershey_set  # noqa: E402
-from benchmarks.ink_metrics import ink_pieces, ink_scores, verdict  # noqa: E402
-from benchmarks.metrics import ORDER_THRESHOLD, evaluate, order_tolerance  # noqa: E402
-from benchmarks.relief import relief_set  # noqa: E402
-from benchmarks.route_figures import print_route_figures, route_row  # noqa: E402
-from benchmarks.render import render, render_truth, to_uint8  # noqa: E402
-
-DEFAULT_COUNTS = {"plain": 42, "touch": 40, "hershey": 40, "hershey-retrace": 40, "relief": 40, "triple": 40,
-                  "handwriting": 40}
-SETS = tuple(DEFAULT_COUNTS)
-HELDOUT_COUNT = 93  # --set heldout (benchmarks/heldout.py): not part of "all", which are the sets tuned on
-KINDS_COUNT = 40  # --set kinds (benchmarks/kinds.py): not part of "all" either
-CURSIVE_COUNT = 40  # --set cursive (benchmarks/cursive.py): long lines, not part of "all"
-
-
-def build_set(name: str, count: int, seed: int) -> list:
-    """The ground truths of one benchmark set."""
-    if name == "hershey":
-        return hershey_set(count, seed)
-    if name == "hershey-retrace":
-        return hershey_set(count, seed, ambiguous=True)
-    if name == "relief":
-        return relief_set(count, seed)
-    if name == "handwriting":
-        from benchmarks.handwriting import handwriting_set
-
-        return handwriting_set(count, seed)
-    if name == "heldout":
-        from benchmarks.heldout import heldout_set
-
-        return heldout_set(count, seed)
-    if name == "kinds":
-        from benchmarks.kinds import kinds_set
-
-        return kinds_set(count, seed)
-    if name == "cursive":
-        from benchmarks.cursive import cursive_set
-
-        return cursive_set(count, seed)
-    return generate_set(name, count, seed)
 TASKS: list = []  # (set name, GroundTruth), inherited by the forked workers
 PLOT_DIR: list = []  # [Path] when --plot is given
-CONDITION: list = ["clean"]  # how the rendered page is degraded (benchmarks/conditions.py)
+CONDITION: list = ["clean"]  # how the rendered page is degraded (benchmarks/sets/conditions.py)
 
 
 def overlay(gt, output, gray: np.ndarray, path: Path) -> None:
@@ -107,7 +69,7 @@ def overlay(gt, output, gray: np.ndarray, path: Path) -> None:
 
     from PIL import Image, ImageDraw
 
-    from benchmarks.metrics import drawing_polylines, polyline_intersections
+    from benchmarks.metrics.table1 import drawing_polylines, polyline_intersections
 
     im = Image.fromarray(to_uint8(0.6 + 0.4 * gray)).convert("RGB")
     draw = ImageDraw.Draw(im)
@@ -267,7 +229,8 @@ def whole_process(gts: list, timeout: float, classifier: str) -> None:
     imports, model load, PNG read, SVG write included)."""
     from PIL import Image
 
-    from benchmarks.startup_cost import bytecode_note, child_cpu_seconds
+    from benchmarks.common.processes import child_cpu_seconds
+    from benchmarks.common.user_install import bytecode_note
     from vectorize.svg.svg_read import read_svg
 
     exe = shutil.which("onestroke")
@@ -382,7 +345,7 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--name", action="append", default=None, metavar="TEXT",
                     help="only the drawings whose name contains TEXT (repeatable; the set is built as usual first)")
     ap.add_argument("--condition", default="clean", choices=CONDITIONS,
-                    help="degrade each rendered page like a real input (see benchmarks/conditions.py)")
+                    help="degrade each rendered page like a real input (see benchmarks/sets/conditions.py)")
     ap.add_argument("--scale", type=float, default=1.0,
                     help="draw every drawing this many times larger on a canvas as much larger (e.g. 3.5: "
                          "3500 px pages; the vectorizer's max_size still applies)")
@@ -413,7 +376,7 @@ def main(argv: list[str] | None = None) -> int:
         if args.name:
             gts = [gt for gt in gts if any(text in gt.name for text in args.name)]
         if args.scale != 1.0:
-            from benchmarks.kinds import scaled
+            from benchmarks.sets.kinds import scaled
 
             gts = [scaled(gt, args.scale) for gt in gts]
         TASKS.extend((name, gt) for gt in gts)

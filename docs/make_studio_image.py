@@ -18,7 +18,8 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path[:0] = [str(ROOT), str(ROOT / "tests")]
 
 from conftest import CHROMIUM, CHROMIUM_ARGS  # noqa: E402
-from studio_fixtures import IDLE, bench_drawing, click_at, open_page, settle  # noqa: E402
+from studio_fixtures import IDLE, click_at, open_page, settle  # noqa: E402
+from benchmarks.sets.hand_drawings import bench_drawing  # noqa: E402
 
 from fabrication.studio.server import StudioServer  # noqa: E402
 from fabrication.studio.session import StudioSession  # noqa: E402

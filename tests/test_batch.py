@@ -20,7 +20,7 @@ from pathlib import Path
 import pytest
 from click.testing import CliRunner
 
-from benchmarks.batch_drawings import make_drawing_folder
+from benchmarks.sets.batch_drawings import make_drawing_folder
 from fabrication.cli import main
 
 pytestmark = pytest.mark.slow

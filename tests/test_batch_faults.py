@@ -22,8 +22,8 @@ from pathlib import Path
 import pytest
 from click.testing import CliRunner
 
-from benchmarks.batch_drawings import make_drawing_folder
-from benchmarks.processes import alive, children, state, workers_of
+from benchmarks.sets.batch_drawings import make_drawing_folder
+from benchmarks.common.processes import alive, children, state, workers_of
 from fabrication.batch.pool import RETRIED
 from fabrication.cli import main
 from fault_fixtures import child_env, run_with_mounts, tmpfs

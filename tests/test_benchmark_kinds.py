@@ -1,27 +1,21 @@
 """The `kinds` benchmark set's machinery: TSP tours, variable-width rendering and excursion,
-brush profiles and phone photos (benchmarks/tsp_art.py, brush.py, photo.py, kinds.py)."""
+brush profiles and phone photos (benchmarks/sets/tsp_art.py, brush.py, photo.py, kinds.py)."""
 
 from __future__ import annotations
 
-import sys
-from pathlib import Path
 
 import numpy as np
 import shapely
 
-ROOT = Path(__file__).resolve().parents[1]
-if str(ROOT) not in sys.path:
-    sys.path.insert(0, str(ROOT))
-
-from benchmarks.brush import THIN, brush_profile, kana_set, nib_profile  # noqa: E402
-from benchmarks.ground_truth import interleaved  # noqa: E402
-from benchmarks.ink_metrics import ink_scores  # noqa: E402
-from benchmarks.metrics import polyline_intersections  # noqa: E402
-from benchmarks.photo import apply_homography, photo_image, photographed  # noqa: E402
-from benchmarks.render import render_profile  # noqa: E402
-from benchmarks.tsp_art import tsp_tour  # noqa: E402
-from vectorize.drawing import Drawing  # noqa: E402
-from vectorize.stroke import Stroke  # noqa: E402
+from benchmarks.sets.brush import THIN, brush_profile, kana_set, nib_profile
+from benchmarks.metrics.ground_truth import interleaved
+from benchmarks.metrics.ink import ink_scores
+from benchmarks.metrics.table1 import polyline_intersections
+from benchmarks.sets.photo import apply_homography, photo_image, photographed
+from benchmarks.common.render import render_profile
+from benchmarks.sets.tsp_art import tsp_tour
+from vectorize.drawing import Drawing
+from vectorize.stroke import Stroke
 
 
 def test_a_tsp_tour_is_closed_never_crosses_and_keeps_paper_between_its_passes():
@@ -51,7 +45,7 @@ def test_render_profile_draws_the_local_width_along_the_line():
 
 
 def test_the_excursion_bound_follows_the_local_width():
-    from benchmarks.ground_truth import GroundTruth
+    from benchmarks.metrics.ground_truth import GroundTruth
 
     line = Stroke.from_polyline(np.array([[20.0, 50.0], [180.0, 50.0]]))
     drawing = Drawing((line,), 200, 100, unit="px", stroke_width=9.0)

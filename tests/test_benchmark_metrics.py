@@ -2,19 +2,13 @@
 
 from __future__ import annotations
 
-import sys
-from pathlib import Path
 
 import numpy as np
 import pytest
 
-ROOT = Path(__file__).resolve().parents[1]
-if str(ROOT) not in sys.path:
-    sys.path.insert(0, str(ROOT))
-
-from benchmarks import drawings as D  # noqa: E402
-from benchmarks.hershey import Glyph, glyph_ground_truth, glyph_stroke, load_glyphs  # noqa: E402
-from benchmarks.metrics import (  # noqa: E402
+from benchmarks.sets import drawings as D
+from benchmarks.sets.hershey import Glyph, glyph_ground_truth, glyph_stroke, load_glyphs
+from benchmarks.metrics.table1 import (
     ORDER_THRESHOLD,
     ambiguous_junctions,
     evaluate,
@@ -25,9 +19,9 @@ from benchmarks.metrics import (  # noqa: E402
     polyline_intersections,
     tiny_loop_crossings,
 )
-from benchmarks.render import render  # noqa: E402
-from vectorize.drawing import Drawing  # noqa: E402
-from vectorize.stroke import Stroke  # noqa: E402
+from benchmarks.common.render import render
+from vectorize.drawing import Drawing
+from vectorize.stroke import Stroke
 
 
 @pytest.fixture(scope="module")
@@ -186,7 +180,7 @@ def test_a_crossing_whose_loop_holds_no_paper_is_not_a_crossing_of_the_drawing()
     assert len(x.crossings) == 1
     assert tiny_loop_crossings(Stroke.from_polyline(loop), False, w, x.crossings) == []
     # hand-kettle-1-0: the k's waist is such a corner (4.5 px line); it was scored undetected.
-    from benchmarks.handwriting import handwriting_drawing
+    from benchmarks.sets.handwriting import handwriting_drawing
 
     gt = handwriting_drawing(1, 0)
     assert len(gt.intersections) == 2
@@ -290,7 +284,7 @@ def test_one_command_runs_and_prints_the_table(tmp_path, capsys):
 # -- ink metrics: excursion, ink pieces, minimum traversal, fair retrace ---------------------------
 
 def test_excursion_is_zero_inside_the_ink_and_the_real_distance_of_a_balloon(loops_gt):
-    from benchmarks.ink_metrics import excursion, excursion_bound
+    from benchmarks.metrics.ink import excursion, excursion_bound
 
     stroke = loops_gt.stroke
     s = np.linspace(0, stroke.length, int(stroke.length))
@@ -309,7 +303,7 @@ def test_excursion_is_zero_inside_the_ink_and_the_real_distance_of_a_balloon(loo
 
 
 def test_ink_pieces_counts_connected_ink_and_ignores_dust(loops_gt):
-    from benchmarks.ink_metrics import ink_pieces
+    from benchmarks.metrics.ink import ink_pieces
 
     image = render(loops_gt.drawing)
     assert ink_pieces(image, loops_gt.width) == 1
@@ -321,7 +315,7 @@ def test_ink_pieces_counts_connected_ink_and_ignores_dust(loops_gt):
 
 
 def test_minimum_traversal_is_route_inspection():
-    from benchmarks.ink_metrics import ink_graph, min_traversal_length
+    from benchmarks.metrics.ink import ink_graph, min_traversal_length
 
     # a T drawn bar left -> right, back to the middle, down the stem: the 5 px half-bar is retraced
     tee = np.array([[0, 0], [10, 0], [5, 0], [5, 10.0]])
@@ -337,7 +331,7 @@ def test_minimum_traversal_is_route_inspection():
 
 def _fork():
     """A Y whose two arms are equal free stubs: either could be the retraced one."""
-    from benchmarks.hershey import Glyph, glyph_ground_truth
+    from benchmarks.sets.hershey import Glyph, glyph_ground_truth
 
     glyph = Glyph("test", "fork", "y", "M 0 0 L 0 10 L -5 15 L 0 10 L 5 15")  # stem, left arm out and back, right arm
     gt = glyph_ground_truth(glyph, 6.0, ambiguous=True)
@@ -346,7 +340,7 @@ def _fork():
 
 
 def test_fair_retrace_rule_accepts_an_equal_stub_and_rejects_an_extra_retrace():
-    from benchmarks.ink_metrics import ink_scores
+    from benchmarks.metrics.ink import ink_scores
 
     gt = _fork()
     # the glyph's vertices in px: stem end, junction, left tip, junction again, right tip
@@ -382,7 +376,7 @@ def _bowtie_with_spike():
 
 
 def test_fair_retrace_rule_covers_any_retracing_ground_truth_but_not_a_wrong_turn():
-    from benchmarks.ink_metrics import ink_scores, verdict
+    from benchmarks.metrics.ink import ink_scores, verdict
 
     gt, p = _bowtie_with_spike()
     # the ground truth draws the spike twice: 40 of its 280 + 200 sqrt(2) font units
@@ -412,7 +406,7 @@ def test_fair_retrace_rule_covers_any_retracing_ground_truth_but_not_a_wrong_tur
 
 
 def test_a_near_retrace_narrower_than_the_line_counts_as_a_retrace():
-    from benchmarks.ink_metrics import fair_meta, near_retraces
+    from benchmarks.metrics.ink import fair_meta, near_retraces
 
     # up a stem and down again 2 font units beside it (2.5 px at this scale, under the 6 px
     # line: no paper between the passes), then on: the ink is one stem drawn twice
@@ -449,7 +443,7 @@ def test_triple_drawings_have_three_passes_through_a_point():
 
 
 def test_handwriting_words_are_jittered_cursive_with_readable_or_flagged_order():
-    from benchmarks import handwriting as H
+    from benchmarks.sets import handwriting as H
 
     for word in H.WORDS:  # readable words have a crossing between each free end and each retrace
         poly = H._runs_stroke(H.word_runs(word))[1]
@@ -468,7 +462,7 @@ def test_handwriting_words_are_jittered_cursive_with_readable_or_flagged_order()
 
 
 def test_relief_glyphs_load_with_their_licence():
-    from benchmarks.relief import RELIEF_DIR, relief_glyphs, relief_set
+    from benchmarks.sets.relief import RELIEF_DIR, relief_glyphs, relief_set
 
     assert (RELIEF_DIR / "OFL.txt").exists() and (RELIEF_DIR / "README.md").exists()
     names = [g.name for g in relief_glyphs()]
@@ -480,7 +474,7 @@ def test_relief_glyphs_load_with_their_licence():
 
 def test_new_sets_run_through_the_command_and_their_ground_truth_is_perfect(capsys):
     from benchmarks import vectorize_bench
-    from benchmarks.bench_tables import failure_kind
+    from benchmarks.metrics.tables import failure_kind
 
     for set_name in ("hershey-retrace", "triple"):
         vectorize_bench.TASKS.clear()

@@ -4,22 +4,17 @@ edits files, and option values of every command (Hypothesis, derandomized, bound
 two minutes). Each command line must exit 0, 1 or 2, show no traceback or internal error,
 leave no partial or half-written file (all its outputs or none), finish within the time
 bound and not push the process's memory peak over 1 GB. The longer run of 2,000+ inputs is
-`python benchmarks/fuzz.py`.
+`python -m benchmarks.fuzz`.
 """
 
 from __future__ import annotations
 
-import sys
-from pathlib import Path
 
 import pytest
 from hypothesis import HealthCheck, given, settings
 
-ROOT = Path(__file__).resolve().parents[1]
-if str(ROOT) not in sys.path:
-    sys.path.insert(0, str(ROOT))
+from benchmarks.sets.fuzz_cases import fuzz_case, run_case
 
-from benchmarks.fuzz_cases import fuzz_case, run_case  # noqa: E402
 
 TIME_BOUND = 60.0  # s per command line: generous for a loaded CI machine; a hang is minutes
 

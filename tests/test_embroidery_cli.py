@@ -167,9 +167,6 @@ def test_unused_options_are_warned_about(inputs, tmp_path, monkeypatch):
 
 
 def _png_input(folder):
-    import sys
-
-    sys.path.insert(0, str(__import__("pathlib").Path(__file__).parent))
     from conftest import alpha_loop, render_polylines
 
     path = folder / "loop.png"

@@ -15,8 +15,8 @@ import numpy as np
 import pyembroidery
 import pytest
 
-from embroidery_fixtures import (FORMATS, STYLE_NAMES, design, lock_figure_ok, needle_runs,
-                                 sewn_stitches, stroke_rows)
+from benchmarks.sets.embroidery_designs import FORMATS, STYLE_NAMES, design
+from benchmarks.metrics.stitches import lock_figure_ok, needle_runs, sewn_stitches, stroke_rows
 from fabrication.embroidery.export import embroidery_bytes, plan_units, write_embroidery, writer_settings
 from fabrication.embroidery.hooping import check_plan_in_hoop
 from fabrication.embroidery.needles import LOCK, TACK

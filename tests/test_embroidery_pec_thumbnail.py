@@ -9,7 +9,7 @@ import pyembroidery
 import pytest
 from pyembroidery import PecGraphics, PecWriter
 
-from embroidery_fixtures import STYLE_NAMES, design
+from benchmarks.sets.embroidery_designs import STYLE_NAMES, design
 from fabrication.embroidery.export import embroidery_bytes, to_pattern
 from fabrication.embroidery.pec_thumbnail import fast_pec_thumbnails, numpy_draw_scaled
 from fabrication.embroidery.plan import PlanOptions, plan_embroidery, style_options

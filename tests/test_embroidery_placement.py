@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from embroidery_fixtures import STYLE_NAMES, design
+from benchmarks.sets.embroidery_designs import STYLE_NAMES, design
 from fabrication.embroidery.hooping import hoop_design
 from fabrication.embroidery.pipeline import EmbroideryJob, embroider
 from fabrication.embroidery.plan import PlanOptions, style_options

@@ -5,7 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from embroidery_fixtures import design, lock_figure_ok, sewn_stitches, spiral, stroke_rows
+from benchmarks.sets.embroidery_designs import design, spiral
+from benchmarks.metrics.stitches import lock_figure_ok, sewn_stitches, stroke_rows
 from fabrication.embroidery.hooping import check_plan_in_hoop, fit_to_hoop
 from fabrication.embroidery.locks import LOCK_FORMS, LockOptions, lock_points, tack_points
 from fabrication.embroidery.needles import BODY, LOCK, TACK, TRAVEL

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from embroidery_fixtures import design
+from benchmarks.sets.embroidery_designs import design
 from fabrication.embroidery.export import write_embroidery
 from fabrication.embroidery.plan import JUMP, STITCH, TRIM, PlanOptions, plan_embroidery, style_options
 from fabrication.embroidery.preview import (PreviewOptions, render_drawing_preview, render_stitch_preview,

@@ -5,27 +5,21 @@ under the column sewn on top), and the files it writes."""
 
 from __future__ import annotations
 
-import sys
-from pathlib import Path
 
 import numpy as np
 import pytest
 
-ROOT = Path(__file__).resolve().parents[1]
-if str(ROOT) not in sys.path:
-    sys.path.insert(0, str(ROOT))
-
-from benchmarks.column_metrics import sewn_widths, slits  # noqa: E402
-from embroidery_fixtures import FORMATS, spiral  # noqa: E402
-from fabrication.embroidery.export import write_embroidery  # noqa: E402
-from fabrication.embroidery.needles import BODY, UNDERLAY  # noqa: E402
-from fabrication.embroidery.plan import STITCH, PlanOptions, plan_embroidery, style_options  # noqa: E402
-from fabrication.embroidery.quality import needle_density, repeated_holes  # noqa: E402
-from fabrication.embroidery.satin import SatinOptions, satin_stitch  # noqa: E402
-from fabrication.embroidery.stats import embroidery_stats  # noqa: E402
-from onestroke.errors import InputError  # noqa: E402
-from vectorize.drawing import Drawing  # noqa: E402
-from vectorize.stroke import Stroke  # noqa: E402
+from benchmarks.metrics.columns import sewn_widths, slits
+from benchmarks.sets.embroidery_designs import FORMATS, spiral
+from fabrication.embroidery.export import write_embroidery
+from fabrication.embroidery.needles import BODY, UNDERLAY
+from fabrication.embroidery.plan import STITCH, PlanOptions, plan_embroidery, style_options
+from fabrication.embroidery.quality import needle_density, repeated_holes
+from fabrication.embroidery.satin import SatinOptions, satin_stitch
+from fabrication.embroidery.stats import embroidery_stats
+from onestroke.errors import InputError
+from vectorize.drawing import Drawing
+from vectorize.stroke import Stroke
 
 
 def line(widths=None, length=30.0) -> Stroke:
@@ -161,7 +155,7 @@ def test_the_command_line_sews_a_brush_drawing_as_wide_as_it_is_drawn(tmp_path):
     from click.testing import CliRunner
     from PIL import Image
 
-    from benchmarks.render import render_profile, to_uint8
+    from benchmarks.common.render import render_profile, to_uint8
     from fabrication.cli import main
     from fabrication.embroidery.read import read_embroidery
 
@@ -191,7 +185,7 @@ def test_the_command_line_sews_a_brush_drawing_as_wide_as_it_is_drawn(tmp_path):
                                    np.array([[0.0, 1.0], [0.5, 4.0], [1.0, 1.5]])), 2.0),
 ])
 def test_tight_bends_and_narrow_columns_keep_the_density_limit_and_pierce_no_hole_twice(name, stroke, width):
-    from embroidery_fixtures import worst_density
+    from benchmarks.metrics.stitches import worst_density
 
     plan = plan_of(stroke, width=width)
     assert worst_density(plan) <= 6, name  # every needle point counted, tacks and locks too

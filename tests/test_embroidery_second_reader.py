@@ -9,7 +9,7 @@ from functools import lru_cache
 import numpy as np
 import pytest
 
-from embroidery_fixtures import FORMATS, STYLE_NAMES, design
+from benchmarks.sets.embroidery_designs import FORMATS, STYLE_NAMES, design
 from embroidery_reader import COLOR, TRIM, read_stitches
 from fabrication.embroidery.export import write_embroidery
 from fabrication.embroidery.plan import COLOR as PLAN_COLOR, STITCH, TRIM as PLAN_TRIM

@@ -7,8 +7,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from embroidery_fixtures import (STYLE_NAMES, design, needle_runs, repeated_penetrations, spiral,
-                                 worst_density)
+from benchmarks.sets.embroidery_designs import STYLE_NAMES, design, spiral
+from benchmarks.metrics.stitches import needle_runs, repeated_penetrations, worst_density
 from fabrication.embroidery.needles import LOCK, TACK, TRAVEL
 from fabrication.embroidery.pipeline import EmbroideryJob, embroider
 from fabrication.embroidery.plan import STITCH, PlanOptions, plan_embroidery, style_options

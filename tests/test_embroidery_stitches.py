@@ -6,7 +6,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from embroidery_fixtures import design, needle_runs, spiral, stroke_rows
+from benchmarks.sets.embroidery_designs import design, spiral
+from benchmarks.metrics.stitches import needle_runs, stroke_rows
 from fabrication.embroidery.arrows import ArrowOptions, arrow_stitch
 from fabrication.embroidery.export import write_embroidery
 from fabrication.embroidery.needles import BODY, LOCK, MOTIF, TACK, UNDERLAY

@@ -12,7 +12,7 @@ import pytest
 from click.testing import CliRunner
 from PIL import Image
 
-from embroidery_fixtures import FORMATS, THREE_COLOURS
+from benchmarks.sets.embroidery_designs import FORMATS, THREE_COLOURS
 from fabrication.cli import main
 from fabrication.embroidery.export import jef_hoop_code
 from fabrication.embroidery.needles import UNDERLAY

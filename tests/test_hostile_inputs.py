@@ -6,7 +6,6 @@ from __future__ import annotations
 import gzip
 import json
 import os
-import sys
 import time
 from pathlib import Path
 
@@ -18,11 +17,9 @@ from fabrication.cli import main
 from onestroke.errors import InputError
 from vectorize.svg.svg_read import read_svg
 
-ROOT = Path(__file__).resolve().parents[1]
-if str(ROOT) not in sys.path:
-    sys.path.insert(0, str(ROOT))
+from benchmarks.hostile_cases import SVG_HEAD, WAVE, _comment, _nested_use
 
-from benchmarks.hostile_cases import SVG_HEAD, WAVE, _comment, _nested_use  # noqa: E402
+ROOT = Path(__file__).resolve().parents[1]
 
 
 def run(*args) -> object:

@@ -9,7 +9,7 @@ from click.testing import CliRunner
 
 from fabrication.cli import main
 from laser_fixtures import grbl_refusals, parse_gcode
-from laser_fixtures import rose_drawing, trefoil_png
+from benchmarks.sets.laser_jobs import rose_drawing, trefoil_png
 from vectorize.svg_write import write_drawing
 
 

@@ -12,7 +12,7 @@ from fabrication.laser.gcode_write import GcodeOptions, fmt, gcode_lines, gcode_
 from machines.job_time import estimate_job_time as estimate_gcode_time
 from fabrication.laser.toolpath import ToolpathOptions, plan_toolpath
 from fabrication.placement import PlacementOptions
-from laser_fixtures import hershey_text_drawing, rose_drawing, wiggle_drawing
+from benchmarks.sets.laser_jobs import hershey_text_drawing, rose_drawing, wiggle_drawing
 from machines.laser_profile import LaserProfile, load_laser_profile
 from onestroke.errors import InputError
 
@@ -118,7 +118,7 @@ def sample_arc(moves, k, step=0.002):
 def test_arcs_never_bulge_out_of_the_bed():
     # a circle touching x = 0 and y = 0: arcs fitted there must not cross the bed edge
     from vectorize.drawing import Drawing
-    from laser_fixtures import catmull_rom_stroke
+    from benchmarks.sets.laser_jobs import catmull_rom_stroke
 
     t = np.linspace(0, 2 * np.pi, 40, endpoint=False)
     drawing = Drawing((catmull_rom_stroke(np.c_[np.cos(t), np.sin(t)] * 100 + 200, closed=True),), 400, 400, "px")

@@ -11,7 +11,7 @@ import pytest
 from fabrication.laser.gcode_write import GcodeOptions, gcode_lines, gcode_text
 from fabrication.laser.toolpath import ToolpathOptions, plan_toolpath
 from fabrication.placement import PlacementOptions
-from laser_fixtures import hershey_text_drawing, rose_drawing
+from benchmarks.sets.laser_jobs import hershey_text_drawing, rose_drawing
 from machines.laser_profile import load_laser_profile
 
 GOLDEN = Path(__file__).with_name("golden")

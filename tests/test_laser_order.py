@@ -10,7 +10,7 @@ import pytest
 from fabrication.laser.toolpath import ToolpathOptions, plan_toolpath
 from fabrication.laser.travel_order import order_strokes, travel_length
 from fabrication.placement import PlacementOptions
-from laser_fixtures import hershey_text_drawing
+from benchmarks.sets.laser_jobs import hershey_text_drawing
 from machines.laser_profile import load_laser_profile
 
 

@@ -16,7 +16,7 @@ from fabrication.laser.preview import order_colours, render_gcode_preview
 from fabrication.laser.raster_time import raster_time
 from fabrication.laser.toolpath import ToolpathOptions, plan_toolpath
 from fabrication.placement import PlacementOptions
-from laser_fixtures import hershey_text_drawing, rose_drawing
+from benchmarks.sets.laser_jobs import hershey_text_drawing, rose_drawing
 from machines.laser_profile import load_laser_profile
 from onestroke.errors import InputError
 

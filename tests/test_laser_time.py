@@ -10,8 +10,8 @@ from machines.job_time import estimate_job_time as estimate_gcode_time
 from machines.job_time import format_duration
 from fabrication.laser.toolpath import ToolpathOptions, plan_toolpath
 from fabrication.placement import PlacementOptions
-from laser_fixtures import spiral_points, trefoil_png
-from laser_grbl_sim import simulate
+from benchmarks.sets.laser_jobs import spiral_points, trefoil_png
+from benchmarks.metrics.grbl_sim import simulate
 from machines.laser_profile import LaserProfile, load_laser_profile
 
 PROFILE = load_laser_profile()

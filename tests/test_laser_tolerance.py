@@ -10,7 +10,7 @@ from laser_fixtures import parse_gcode
 from fabrication.laser.gcode_write import GcodeOptions, gcode_lines
 from fabrication.laser.toolpath import ToolpathOptions, plan_toolpath
 from fabrication.placement import PlacementOptions
-from laser_fixtures import hershey_text_drawing, rose_drawing, trefoil_png, wiggle_drawing
+from benchmarks.sets.laser_jobs import hershey_text_drawing, rose_drawing, trefoil_png, wiggle_drawing
 from machines.laser_profile import load_laser_profile
 
 PROFILE = load_laser_profile()

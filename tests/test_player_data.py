@@ -10,7 +10,7 @@ import pyembroidery
 import pytest
 from click.testing import CliRunner
 
-from embroidery_fixtures import design
+from benchmarks.sets.embroidery_designs import design
 from fabrication.cli import main
 from fabrication.embroidery.plan import PlanOptions, plan_embroidery, style_options
 from fabrication.embroidery.read import read_embroidery

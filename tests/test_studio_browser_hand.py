@@ -15,8 +15,8 @@ import pytest
 from conftest import ARTIFACTS
 from fabrication.studio.server import StudioServer
 from fabrication.studio.session import StudioSession
-from studio_fixtures import (bench_drawing, cli_bytes, click_at, curve_under_labels, download, drag_slider,
-                             open_page, settle)
+from benchmarks.sets.hand_drawings import bench_drawing
+from studio_fixtures import cli_bytes, click_at, curve_under_labels, download, drag_slider, open_page, settle
 
 pytestmark = pytest.mark.slow
 

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import pytest
 
-from studio_fixtures import bench_drawing
+from benchmarks.sets.hand_drawings import bench_drawing
 from vectorize import VectorizeOptions, vectorize_file
 from vectorize.refine.edits import Edit, Edits
 from vectorize.refine.refine import StageCache

@@ -12,9 +12,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from benchmarks.drawings import generate_drawing
-from benchmarks.metrics import evaluate
-from benchmarks.render import render
+from benchmarks.sets.drawings import generate_drawing
+from benchmarks.metrics.table1 import evaluate
+from benchmarks.common.render import render
 from vectorize import VectorizeOptions, vectorize_image
 
 

@@ -7,10 +7,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from benchmarks.handwriting import handwriting_drawing
-from benchmarks.ink_metrics import excursion_bound, ink_scores
-from benchmarks.metrics import order_tolerance
-from benchmarks.render import render
+from benchmarks.sets.handwriting import handwriting_drawing
+from benchmarks.metrics.ink import excursion_bound, ink_scores
+from benchmarks.metrics.table1 import order_tolerance
+from benchmarks.common.render import render
 from vectorize import VectorizeOptions, vectorize_image
 
 

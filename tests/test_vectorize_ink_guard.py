@@ -7,12 +7,12 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from benchmarks.conditions import condition_image
-from benchmarks.drawings import generate_drawing
-from benchmarks.hershey import glyph_ground_truth
-from benchmarks.ink_metrics import excursion, excursion_bound
-from benchmarks.relief import relief_glyphs
-from benchmarks.render import render, to_uint8
+from benchmarks.sets.conditions import condition_image
+from benchmarks.sets.drawings import generate_drawing
+from benchmarks.sets.hershey import glyph_ground_truth
+from benchmarks.metrics.ink import excursion, excursion_bound
+from benchmarks.sets.relief import relief_glyphs
+from benchmarks.common.render import render, to_uint8
 from tests.conftest import render_polylines
 from vectorize import VectorizeOptions, vectorize_image
 from vectorize.drawing import Drawing

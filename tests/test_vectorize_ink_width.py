@@ -4,24 +4,18 @@ back from SVG (`data-widths`) and JSON."""
 
 from __future__ import annotations
 
-import sys
-from pathlib import Path
 
 import numpy as np
 import pytest
 
-ROOT = Path(__file__).resolve().parents[1]
-if str(ROOT) not in sys.path:
-    sys.path.insert(0, str(ROOT))
-
-from benchmarks.render import render, render_profile, to_uint8  # noqa: E402
-from fabrication.embroidery.order import _open_at  # noqa: E402
-from onestroke.errors import InputError  # noqa: E402
-from vectorize.drawing import Drawing  # noqa: E402
-from vectorize.pipeline import vectorize_image  # noqa: E402
-from vectorize.stroke import Stroke  # noqa: E402
-from vectorize.svg.svg_read import read_svg  # noqa: E402
-from vectorize.svg_write import drawing_from_json, drawing_to_json, drawing_to_svg  # noqa: E402
+from benchmarks.common.render import render, render_profile, to_uint8
+from fabrication.embroidery.order import _open_at
+from onestroke.errors import InputError
+from vectorize.drawing import Drawing
+from vectorize.pipeline import vectorize_image
+from vectorize.stroke import Stroke
+from vectorize.svg.svg_read import read_svg
+from vectorize.svg_write import drawing_from_json, drawing_to_json, drawing_to_svg
 
 
 def arc_stroke(widths=None) -> Stroke:

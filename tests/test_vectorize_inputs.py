@@ -169,7 +169,7 @@ def shaded_scan(drawing: np.ndarray, seed: int = 0) -> np.ndarray:
     """`drawing` (uint8) as an unevenly lit scan, the benchmark's "scan" condition: paper
     0.68-0.98 across the page, gray ink, grain, JPEG. A global threshold cuts such a page
     in half."""
-    from benchmarks.conditions import condition_image
+    from benchmarks.sets.conditions import condition_image
 
     image, _ = condition_image(None, drawing.astype(np.float64) / 255.0, "scan", np.random.default_rng(seed))
     return image

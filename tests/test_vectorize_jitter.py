@@ -6,9 +6,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from benchmarks.handwriting import _wobble
-from benchmarks.metrics import drawing_polylines, polyline_intersections
-from benchmarks.render import render
+from benchmarks.sets.handwriting import _wobble
+from benchmarks.metrics.table1 import drawing_polylines, polyline_intersections
+from benchmarks.common.render import render
 from vectorize import VectorizeOptions, vectorize_image
 from vectorize.drawing import Drawing
 from vectorize.fit.retraces import retraced_runs
@@ -18,7 +18,7 @@ SIZE = 400
 
 
 def _jittered(path, width: float, seed: int) -> np.ndarray:
-    """The path as a mouse records it (benchmarks/handwriting.py): samples every ~5 px, a
+    """The path as a mouse records it (benchmarks/sets/handwriting.py): samples every ~5 px, a
     slow wobble of up to 0.4 widths along the path and 0.3 px corner noise, rounded."""
     rng = np.random.default_rng(seed)
     clean = Stroke.from_polyline(np.asarray(path, dtype=float))

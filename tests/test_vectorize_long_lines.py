@@ -4,23 +4,18 @@ fitting's per-corner work stays local."""
 
 from __future__ import annotations
 
-import sys
-from pathlib import Path
 
 import numpy as np
 import pytest
 
-ROOT = Path(__file__).resolve().parents[1]
-if str(ROOT) not in sys.path:
-    sys.path.insert(0, str(ROOT))
+from benchmarks.metrics.table1 import order_score
+from benchmarks.common.render import render, to_uint8
+from benchmarks.sets.tsp_art import tsp_tour
+from vectorize import VectorizeOptions, vectorize_image
+from vectorize.drawing import Drawing
+from vectorize.fit.fitting import sharp_corners
+from vectorize.stroke import Stroke
 
-from benchmarks.metrics import order_score  # noqa: E402
-from benchmarks.render import render, to_uint8  # noqa: E402
-from benchmarks.tsp_art import tsp_tour  # noqa: E402
-from vectorize import VectorizeOptions, vectorize_image  # noqa: E402
-from vectorize.drawing import Drawing  # noqa: E402
-from vectorize.fit.fitting import sharp_corners  # noqa: E402
-from vectorize.stroke import Stroke  # noqa: E402
 
 SIDE = 700
 

@@ -164,11 +164,11 @@ def test_pruned_matching_keeps_the_whole_problems_optimum(seed):
 
 def test_a_long_cursive_word_is_not_retraced_a_second_time():
     # "technically" with hooks at its entry cusps, entry stubs and drifting ascender loops
-    # (benchmarks/cursive.py): 18 odd junctions on its ink graph. The greedy matching guessed
+    # (benchmarks/sets/cursive.py): 18 odd junctions on its ink graph. The greedy matching guessed
     # the pen's ends and came out 54 % longer than the shortest line over the ink.
-    from benchmarks.cursive import cursive_drawing
-    from benchmarks.ink_metrics import excursion, excursion_bound
-    from benchmarks.render import render_truth, to_uint8
+    from benchmarks.sets.cursive import cursive_drawing
+    from benchmarks.metrics.ink import excursion, excursion_bound
+    from benchmarks.common.render import render_truth, to_uint8
     from vectorize import VectorizeOptions, vectorize_image
 
     gt = cursive_drawing(0, 27)

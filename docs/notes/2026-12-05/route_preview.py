@@ -1,4 +1,4 @@
-"""route-technically.png: one cursive line (benchmarks/cursive.py, seed 0 index 27, 18 odd
+"""route-technically.png: one cursive line (benchmarks/sets/cursive.py, seed 0 index 27, 18 odd
 junctions) vectorized by two versions of the vectorizer, stretches drawn twice in red.
 
     python docs/notes/2026-12-05/route_preview.py OLD_TREE NEW_TREE
@@ -26,8 +26,8 @@ import sys, numpy as np
 sys.path.insert(0, sys.argv[1])
 from vectorize import VectorizeOptions, vectorize_image
 sys.path.insert(1, sys.argv[2])
-from benchmarks.cursive import cursive_drawing
-from benchmarks.render import render_truth, to_uint8
+from benchmarks.sets.cursive import cursive_drawing
+from benchmarks.common.render import render_truth, to_uint8
 gt = cursive_drawing({seed}, {index})
 result = vectorize_image(to_uint8(render_truth(gt)), VectorizeOptions())
 np.save(sys.argv[3], np.vstack([s.sample_evenly(0.5) for s in result.drawing.strokes]))
@@ -45,7 +45,7 @@ def panel(points: np.ndarray, gray: np.ndarray, width: float, box: tuple, label:
     s = np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(points, axis=0), axis=1))]
     twice = np.array([any(abs(s[j] - s[i]) > 6 * width for j in near)
                       for i, near in enumerate(cKDTree(points).query_ball_point(points, r=0.35 * width))])
-    from benchmarks.render import to_uint8
+    from benchmarks.common.render import to_uint8
 
     im = Image.fromarray(to_uint8(0.78 + 0.22 * gray)).convert("RGB")
     draw = ImageDraw.Draw(im)
@@ -63,8 +63,8 @@ def panel(points: np.ndarray, gray: np.ndarray, width: float, box: tuple, label:
 
 def main() -> None:
     sys.path.insert(0, str(ROOT))
-    from benchmarks.cursive import cursive_drawing
-    from benchmarks.render import render_truth
+    from benchmarks.sets.cursive import cursive_drawing
+    from benchmarks.common.render import render_truth
 
     gt = cursive_drawing(SEED, INDEX)
     gray = render_truth(gt)

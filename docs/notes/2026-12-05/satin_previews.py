@@ -20,8 +20,8 @@ HERE = Path(__file__).resolve().parent
 ROOT = HERE.parents[2]
 sys.path.insert(0, str(ROOT))
 
-from benchmarks.brush import kana_set  # noqa: E402
-from benchmarks.render import render, render_truth, to_uint8  # noqa: E402
+from benchmarks.sets.brush import kana_set  # noqa: E402
+from benchmarks.common.render import render, render_truth, to_uint8  # noqa: E402
 from fabrication.embroidery.pipeline import EmbroideryJob, embroider  # noqa: E402
 from fabrication.embroidery.plan import PlanOptions  # noqa: E402
 from fabrication.embroidery.preview import PreviewOptions, render_stitch_preview, stitch_canvas  # noqa: E402

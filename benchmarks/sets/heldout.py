@@ -6,7 +6,7 @@ Sources (none of them a drawing of another set at seed 0, the seed the team tune
 - Hershey glyphs that neither `hershey` nor `hershey-retrace` (`hershey_set(40, 0)` and its
   ambiguous twin) take: those with a crossing or retrace first, then simple ones, and
   ambiguous ones scored by the fair-retrace rule. The glyph rules are those of
-  benchmarks/hershey.py except that crossings may come within 1 width (not 3) of each
+  benchmarks/sets/hershey.py except that crossings may come within 1 width (not 3) of each
   other's ink-merge zones, of an end, of a retrace or of a merged narrow turn: the crowded
   junctions real lettering has (most glyphs the `hershey` set leaves out are left out for
   that), and that a Hershey glyph whose ends lie within one width counts as closed, as Relief
@@ -17,7 +17,7 @@ Sources (none of them a drawing of another set at seed 0, the seed the team tune
 
 Glyphs get a width of 2-12 px (the other glyph sets: 3-8) and a size of 55-100 % of the
 canvas's room, and every other glyph is turned by -40..40 degrees about the canvas centre.
-Each drawing is rendered under one of `CONDITIONS` in turn (benchmarks/conditions.py:
+Each drawing is rendered under one of `CONDITIONS` in turn (benchmarks/sets/conditions.py:
 clean, paper scan, heavy JPEG, noise, pen pressure, dry-pen breaks, half resolution,
 pencil), stored as meta "condition" and in the drawing's name.
 """
@@ -30,11 +30,11 @@ import numpy as np
 import shapely
 import shapely.affinity
 
-from benchmarks.drawings import generate_set
-from benchmarks.ground_truth import CANVAS, MARGIN, GroundTruth, interleaved
-from benchmarks.handwriting import WORDS, handwriting_drawing
-from benchmarks.hershey import hershey_set, load_glyphs
-from benchmarks.relief import relief_glyphs, relief_set
+from benchmarks.sets.drawings import generate_set
+from benchmarks.metrics.ground_truth import CANVAS, MARGIN, GroundTruth, interleaved
+from benchmarks.sets.handwriting import WORDS, handwriting_drawing
+from benchmarks.sets.hershey import hershey_set, load_glyphs
+from benchmarks.sets.relief import relief_glyphs, relief_set
 from vectorize.drawing import Drawing
 
 CONDITIONS = ("clean", "scan", "jpeg", "noisy", "varwidth", "breaks", "half", "pencil")

@@ -28,8 +28,8 @@ import shapely
 from scipy import ndimage
 from scipy.spatial import cKDTree
 
-from benchmarks.ground_truth import CANVAS, MARGIN, GroundTruth
-from benchmarks.hershey import _sharp_turns
+from benchmarks.metrics.ground_truth import CANVAS, MARGIN, GroundTruth
+from benchmarks.sets.hershey import _sharp_turns
 from vectorize.drawing import Drawing
 from vectorize.stroke import Stroke
 

@@ -14,7 +14,10 @@ centred along the centre line.
 
 from __future__ import annotations
 
+import io
+
 import numpy as np
+from PIL import Image
 from scipy import ndimage
 from scipy.spatial import cKDTree
 
@@ -106,3 +109,11 @@ def render_truth(gt) -> np.ndarray:
 def to_uint8(gray: np.ndarray) -> np.ndarray:
     """Gray float in [0, 1] to uint8 (what a PNG holds and what the vectorizer is given)."""
     return np.clip(np.round(gray * 255.0), 0, 255).astype(np.uint8)
+
+
+def through_jpeg(image: np.ndarray, quality: int, subsampling: int = -1) -> np.ndarray:
+    """`image` (uint8, gray or RGB) through a JPEG file at `quality` (Pillow's chroma
+    subsampling unless given: 2 is 4:2:0, a phone's)."""
+    buffer = io.BytesIO()
+    Image.fromarray(image).save(buffer, "JPEG", quality=quality, subsampling=subsampling)
+    return np.asarray(Image.open(buffer))

@@ -1,8 +1,8 @@
 """Tables of the vectorizer benchmark (benchmarks/vectorize_bench.py): one row per set and
 classifier, the issue's acceptance numbers, and a breakdown by drawing kind.
 
-Per-drawing rows are dicts with the scores of `benchmarks.metrics.evaluate` and
-`benchmarks.ink_metrics.ink_scores`; rows with an "error" count as wrong and are left out of
+Per-drawing rows are dicts with the scores of `benchmarks.metrics.table1.evaluate` and
+`benchmarks.metrics.ink.ink_scores`; rows with an "error" count as wrong and are left out of
 the averages. docs/benchmark.md explains every column.
 """
 
@@ -48,7 +48,7 @@ def _summary(rows: list[dict]) -> dict:
 
 
 def _ink_summary(rows: list[dict], ok: list[dict]) -> dict:
-    """One stroke when the ink is one piece, and the excursion figures (see ink_metrics)."""
+    """One stroke when the ink is one piece, and the excursion figures (see metrics.ink)."""
     pieces = [r for r in rows if r.get("one_piece")]
     exc = np.array([r["excursion"] for r in ok if not math.isnan(r.get("excursion", math.nan))])
     exc_w = np.array([r["excursion_w"] for r in ok if not math.isnan(r.get("excursion_w", math.nan))])
@@ -202,7 +202,7 @@ def _print_headroom(rows: list[dict]) -> None:
     """Per set and classifier, how far inside the bound (half width + 1 px) the excursions stay:
     the smallest headroom (px; negative: outside), its 1st percentile, and the drawings that
     come within `NEAR_MISS` px of the bound or cross it."""
-    from benchmarks.ink_metrics import excursion_bound
+    from benchmarks.metrics.ink import excursion_bound
 
     groups: dict = {}
     for r in rows:
@@ -225,7 +225,7 @@ def failure_kind(row: dict) -> str:
     """Why a drawing is not correct, first reason first: error, split into several strokes,
     leaves the ink, misses ink, extra retrace (fair drawings: longer than the minimum), or a
     wrong order (one stroke in the ink, but a wrong turn or a different retrace)."""
-    from benchmarks.ink_metrics import fair_length_limit
+    from benchmarks.metrics.ink import fair_length_limit
 
     if row.get("error"):
         return "error"

@@ -477,7 +477,7 @@ def evaluate(gt, output: Drawing, gt_image: np.ndarray | None = None) -> Scores:
 
     gt_image: the input render (gray float, 1 = paper); rendered here when omitted.
     """
-    from benchmarks.render import render
+    from benchmarks.common.render import render
 
     width = gt.drawing.stroke_width
     if gt_image is None:

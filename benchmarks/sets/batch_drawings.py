@@ -12,11 +12,11 @@ from pathlib import Path
 import numpy as np
 from PIL import Image
 
-from benchmarks.hershey import glyph_stroke, load_glyphs
-from benchmarks.render import render, to_uint8
+from benchmarks.sets.hershey import glyph_stroke, load_glyphs
+from benchmarks.common.render import render, to_uint8
 from vectorize.drawing import Drawing
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 EXAMPLES = ("closed-drawing", "hershey-HersheySans1-ampersand", "hershey-HersheySans1-eight", "loop-drawing",
             "loops", "shallow-crossing-drawing", "spike-drawing", "touch-drawing")
 # HersheySans1 glyphs drawn in one stroke, picked by name (open, closed, with loops).

@@ -1,4 +1,4 @@
-"""The rules a generated drawing must pass (benchmarks/drawings.py): unambiguous for a human,
+"""The rules a generated drawing must pass (benchmarks/sets/drawings.py): unambiguous for a human,
 hard for the vectorizer. `validate` returns the events and crossings it finds, or raises
 `Rejected`."""
 
@@ -10,8 +10,8 @@ from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components
 from scipy.spatial import cKDTree
 
-from benchmarks.ground_truth import CANVAS, MARGIN, Event, Rejected
-from benchmarks.metrics import ambiguous_junctions, close_passes, polyline_intersections
+from benchmarks.metrics.ground_truth import CANVAS, MARGIN, Event, Rejected
+from benchmarks.metrics.table1 import ambiguous_junctions, close_passes, polyline_intersections
 from vectorize.stroke import Stroke
 
 

@@ -1,11 +1,11 @@
 """The `kinds` set: kinds of real single-line drawings no other set holds (issue 10's new
 users): TSP art, brush kana, broad-nib capitals and phone photos of pen drawings.
 
-- tsp (benchmarks/tsp_art.py): one closed line through 2500-4500 stipple points, no
+- tsp (benchmarks/sets/tsp_art.py): one closed line through 2500-4500 stipple points, no
   crossing, passes 1-3 px of paper apart wherever the tone is dark;
-- brush-kana, brush-capital (benchmarks/brush.py): the ink width changes 3x along the line
+- brush-kana, brush-capital (benchmarks/sets/brush.py): the ink width changes 3x along the line
   (pressure and tapered ends; a broad nib's thick and thin);
-- photo (benchmarks/photo.py): a handwriting word, a Hershey or Relief glyph, a generated
+- photo (benchmarks/sets/photo.py): a handwriting word, a Hershey or Relief glyph, a generated
   drawing or a brush kana at seeds no other set uses (their sources' seed + 5, + 5000 for the
   generator), seen in slight perspective and stored as a phone's JPEG (condition "photo").
 
@@ -22,7 +22,7 @@ import numpy as np
 import shapely
 import shapely.affinity
 
-from benchmarks.ground_truth import GroundTruth, interleaved
+from benchmarks.metrics.ground_truth import GroundTruth, interleaved
 
 SEED_OFFSET = 5  # photo sources: a seed the other sets do not use
 # drawings per kind at the default count (40)
@@ -31,11 +31,11 @@ SHARES = {"tsp": 6, "brush-kana": 12, "brush-capital": 10, "photo": 12}
 
 def photo_sources(count: int, seed: int) -> list[GroundTruth]:
     """Drawings to photograph: the sources in turn (module doc)."""
-    from benchmarks.brush import kana_set
-    from benchmarks.drawings import generate_set
-    from benchmarks.handwriting import handwriting_drawing
-    from benchmarks.hershey import hershey_set
-    from benchmarks.relief import relief_set
+    from benchmarks.sets.brush import kana_set
+    from benchmarks.sets.drawings import generate_set
+    from benchmarks.sets.handwriting import handwriting_drawing
+    from benchmarks.sets.hershey import hershey_set
+    from benchmarks.sets.relief import relief_set
 
     s = seed + SEED_OFFSET
     n = count // 5 + 1
@@ -47,9 +47,9 @@ def photo_sources(count: int, seed: int) -> list[GroundTruth]:
 def kinds_set(count: int | None = None, seed: int = 0) -> list[GroundTruth]:
     """The `kinds` drawings (module doc): `count` (default 40) with every kind in proportion,
     deterministic for a seed."""
-    from benchmarks.brush import capital_set, kana_set
-    from benchmarks.photo import photographed
-    from benchmarks.tsp_art import tsp_drawing
+    from benchmarks.sets.brush import capital_set, kana_set
+    from benchmarks.sets.photo import photographed
+    from benchmarks.sets.tsp_art import tsp_drawing
 
     total = sum(SHARES.values())
     count = total if count is None else count

@@ -1,12 +1,12 @@
 """Route-inspection figures of a benchmark run: how large the matchings were and how close
 each output came to the shortest single line that draws its ink.
 
-- odd nodes (ink): odd-degree junctions of the ground truth's ink graph (`ink_metrics`), the
+- odd nodes (ink): odd-degree junctions of the ground truth's ink graph (`metrics.ink`), the
   size of the matching any route inspection of that drawing solves;
 - odd nodes (vectorizer): those the vectorizer's route inspection matched
   (`VectorizeReport.odd_nodes`, on its own branch graph);
 - route ratio: the output's total length over the minimum traversal of the ground truth's
-  ink graph (`ink_metrics.min_traversal_length`, networkx's blossom on that graph: computed
+  ink graph (`metrics.ink.min_traversal_length`, networkx's blossom on that graph: computed
   independently of the vectorizer). "within 2 %": ratio <= 1.02;
 - drawn ratio: the output's length over the ground-truth pen path's; "> 5 %": outputs longer
   than the drawn line by more than 5 % (a run-away retrace).
@@ -18,7 +18,7 @@ import statistics
 
 import numpy as np
 
-from benchmarks.ink_metrics import ink_graph, min_traversal_length
+from benchmarks.metrics.ink import ink_graph, min_traversal_length
 
 ROUTE_SLACK = 0.02  # an output within this share above the minimum traversal counts as on the route optimum
 DRAWN_SLACK = 0.05  # an output longer than the drawn line by more than this share retraced too much

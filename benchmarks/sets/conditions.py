@@ -16,29 +16,20 @@ real inputs are (seeded, one generator per drawing).
 - breaks: a dry pen: three short breaks across the line, 1 px to 0.6 widths + 1 px long, at
   random places of the line's middle 80 %;
 - photo: a phone photo of the page: uneven light, a soft shadow, paper texture, blur, noise,
-  colour and JPEG (benchmarks/photo.py; the perspective is in the ground truth of the
+  colour and JPEG (benchmarks/sets/photo.py; the perspective is in the ground truth of the
   `kinds` set's photos, so this condition alone keeps the geometry).
 """
 
 from __future__ import annotations
 
-import io
 
 import numpy as np
 from PIL import Image
 from scipy import ndimage
 
-from benchmarks.render import render, to_uint8
+from benchmarks.common.render import render, through_jpeg, to_uint8
 
 CONDITIONS = ("clean", "noisy", "scan", "pencil", "specks", "varwidth", "half", "gaps", "jpeg", "breaks", "photo")
-
-
-def through_jpeg(image: np.ndarray, quality: int, subsampling: int = -1) -> np.ndarray:
-    """`image` (uint8, gray or RGB) through a JPEG file at `quality` (Pillow's chroma
-    subsampling unless given: 2 is 4:2:0, a phone's)."""
-    buffer = io.BytesIO()
-    Image.fromarray(image).save(buffer, "JPEG", quality=quality, subsampling=subsampling)
-    return np.asarray(Image.open(buffer))
 
 
 def condition_image(drawing, gray: np.ndarray, condition: str,
@@ -103,7 +94,7 @@ def condition_image(drawing, gray: np.ndarray, condition: str,
             page[(along <= length / 2) & (across <= drawing.stroke_width / 2 + 1.5)] = 1.0
         return to_uint8(page), 1.0
     if condition == "photo":
-        from benchmarks.photo import photo_image
+        from benchmarks.sets.photo import photo_image
 
         return photo_image(gray, rng), 1.0
     raise ValueError(f"unknown condition {condition!r}; use one of {', '.join(CONDITIONS)}")

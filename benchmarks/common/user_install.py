@@ -19,7 +19,7 @@ import sys
 import sysconfig
 from pathlib import Path
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 # What the wheel is built from; copied to a clean folder first, so that no stale `build/`
 # folder of an earlier build in the working tree puts removed modules into the install.
 PACKAGE_FILES = ("pyproject.toml", "README.md", "onestroke", "vectorize", "fabrication", "machines")
@@ -47,3 +47,13 @@ def regular_install(folder: Path, source: Path = ROOT) -> Path:
                     "--no-build-isolation", "--no-index", str(tree)],
                    capture_output=True, text=True, check=True, cwd=folder)
     return folder / "bin"
+
+
+def bytecode_note(env, installed: bool = False) -> str:
+    """Whether processes with environment `env` keep the project's compiled modules."""
+    if installed:
+        return "the project's modules compiled at install (a regular `pip install .`, what a user runs)"
+    if env.get("PYTHONDONTWRITEBYTECODE"):
+        return ("not written (PYTHONDONTWRITEBYTECODE is set: each process compiles the project's own modules "
+                "from source; an installed package has them compiled)")
+    return f"cached in {env.get('PYTHONPYCACHEPREFIX') or 'the __pycache__ folders'}"

@@ -33,8 +33,8 @@ from __future__ import annotations
 import numpy as np
 import shapely
 
-from benchmarks.ground_truth import CANVAS, MARGIN, GroundTruth
-from benchmarks.handwriting import (
+from benchmarks.metrics.ground_truth import CANVAS, MARGIN, GroundTruth
+from benchmarks.sets.handwriting import (
     LEAD_IN,
     LETTERS,
     _mouse_trace,
@@ -43,8 +43,8 @@ from benchmarks.handwriting import (
     retraced_runs,
     traced_crossings,
 )
-from benchmarks.ink_metrics import fair_meta
-from benchmarks.metrics import ambiguous_junctions
+from benchmarks.metrics.ink import fair_meta
+from benchmarks.metrics.table1 import ambiguous_junctions
 from vectorize.drawing import Drawing
 from vectorize.stroke import Stroke
 

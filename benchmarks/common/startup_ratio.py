@@ -63,7 +63,7 @@ def _run(cmd: list[str], env: dict, timeout: float, cwd: str) -> tuple[float, fl
     """(wall s, CPU s) of one child process run to the end (CPU: user + sys, all threads)."""
     before = os.times()
     start = time.perf_counter()
-    # in `cwd` (not the working tree, which `python -c` would put first on sys.path)
+    # in `cwd` (not the working tree, which `python -c` would put first on the import path)
     done = subprocess.run(cmd, capture_output=True, text=True, env=env, timeout=timeout, cwd=cwd)
     wall = time.perf_counter() - start
     after = os.times()
@@ -77,7 +77,7 @@ def ratio_pairs(picks: list, command: list[str], python: str, env: dict, timeout
     the interpreter `python` the command runs on; print the pairs and the median ratios."""
     from PIL import Image
 
-    from benchmarks.render import render, to_uint8
+    from benchmarks.common.render import render, to_uint8
 
     child = LIST_CHILD.format(roots=repr(third_party_roots()), project=repr(PROJECT))
     print(f"load average at the start {' '.join(f'{x:.1f}' for x in os.getloadavg())}", flush=True)

@@ -5,7 +5,7 @@
 little off-axis, a homography that moves each canvas corner by up to 4 % of the side
 (inward or outward, then fitted back inside the canvas margin). Centre lines are flattened
 (0.05 px) and mapped point by point; the ink width follows the local scale of the map
-(sqrt of its Jacobian determinant) as meta "width_profile" (see benchmarks/render.py);
+(sqrt of its Jacobian determinant) as meta "width_profile" (see benchmarks/common/render.py);
 crossings, events, don't-care zones and the minimum traversal length move with it.
 
 `photo_image(gray, rng)` takes the render (flat ink on white, in the photo's frame) to what
@@ -28,9 +28,9 @@ import numpy as np
 import shapely
 from scipy import ndimage
 
-from benchmarks.conditions import through_jpeg  # it imports this module only where used
-from benchmarks.ground_truth import CANVAS, MARGIN, GroundTruth
-from benchmarks.metrics import FLATTEN_TOLERANCE
+from benchmarks.common.render import through_jpeg
+from benchmarks.metrics.ground_truth import CANVAS, MARGIN, GroundTruth
+from benchmarks.metrics.table1 import FLATTEN_TOLERANCE
 from vectorize.drawing import Drawing
 from vectorize.stroke import Stroke, arc_lengths
 
@@ -86,7 +86,7 @@ def photographed(gt: GroundTruth, rng: np.random.Generator) -> GroundTruth:
     s = arc_lengths(mapped)
     profile = (s / s[-1], gt.width * local_scale(h, poly))
     if "width_profile" in gt.meta:  # a brush's width, foreshortened too
-        from benchmarks.render import profile_widths
+        from benchmarks.common.render import profile_widths
 
         base = profile_widths(gt.meta["width_profile"], arc_lengths(poly) / gt.stroke.length)
         profile = (profile[0], base * profile[1] / gt.width)

@@ -3,7 +3,7 @@ drawn by type designers (benchmarks/data/relief, a copy of ../shared/data/relief
 OFL licence and README).
 
 The glyphs drawn with one move-to go through the same rules and ground truth as the
-Hershey glyphs (benchmarks/hershey.py: scaled to the canvas, seeded width 3-8 px, crossings
+Hershey glyphs (benchmarks/sets/hershey.py: scaled to the canvas, seeded width 3-8 px, crossings
 and touches found on the exact curve, ambiguous or crowded glyphs left out). Size variants
 of one shape (".numr", ".dnom", ".subs", ".osf", ...) count once: the first by name. Many
 closed shapes (O, circle, squares, triangles, 0, 8) end a unit or two short of where they
@@ -16,10 +16,10 @@ from __future__ import annotations
 from dataclasses import replace
 from pathlib import Path
 
-from benchmarks.ground_truth import GroundTruth
-from benchmarks.hershey import Glyph, hershey_set, load_glyphs
+from benchmarks.metrics.ground_truth import GroundTruth
+from benchmarks.sets.hershey import Glyph, hershey_set, load_glyphs
 
-RELIEF_DIR = Path(__file__).resolve().parent / "data" / "relief"
+RELIEF_DIR = Path(__file__).resolve().parents[1] / "data" / "relief"
 
 
 def relief_glyphs(directory: Path | str = RELIEF_DIR) -> list[Glyph]:

@@ -42,9 +42,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from benchmarks.drawing_rules import validate
-from benchmarks.ground_truth import CANVAS, MARGIN, Event, GroundTruth, Rejected  # noqa: F401 (re-exported)
-from benchmarks.ink_metrics import fair_meta
+from benchmarks.metrics.drawing_rules import validate
+from benchmarks.metrics.ground_truth import CANVAS, MARGIN, Event, GroundTruth, Rejected  # noqa: F401 (re-exported)
+from benchmarks.metrics.ink import fair_meta
 from vectorize.drawing import Drawing
 from vectorize.stroke import Stroke
 

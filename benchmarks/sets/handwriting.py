@@ -26,11 +26,11 @@ from __future__ import annotations
 import numpy as np
 import shapely
 
-from benchmarks.drawings import _hermite, _Waypoint
-from benchmarks.ground_truth import CANVAS, MARGIN, Event, GroundTruth
-from benchmarks.hershey import _sharp_turns
-from benchmarks.ink_metrics import fair_meta
-from benchmarks.metrics import (
+from benchmarks.sets.drawings import _hermite, _Waypoint
+from benchmarks.metrics.ground_truth import CANVAS, MARGIN, Event, GroundTruth
+from benchmarks.sets.hershey import _sharp_turns
+from benchmarks.metrics.ink import fair_meta
+from benchmarks.metrics.table1 import (
     MATCH_DISTANCE,
     ambiguous_junctions,
     dont_care_mask,

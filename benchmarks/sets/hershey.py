@@ -27,13 +27,13 @@ import numpy as np
 import shapely
 import svgelements
 
-from benchmarks.drawings import CANVAS, Event, GroundTruth
-from benchmarks.ink_metrics import fair_meta
-from benchmarks.metrics import ambiguous_junctions, hidden_crossings, merged_without_crossing, polyline_intersections
+from benchmarks.sets.drawings import CANVAS, Event, GroundTruth
+from benchmarks.metrics.ink import fair_meta
+from benchmarks.metrics.table1 import ambiguous_junctions, hidden_crossings, merged_without_crossing, polyline_intersections
 from vectorize.drawing import Drawing
 from vectorize.stroke import Stroke
 
-HERSHEY_DIR = Path(__file__).resolve().parent / "data" / "hershey"  # a copy of ../shared/data/hershey
+HERSHEY_DIR = Path(__file__).resolve().parents[1] / "data" / "hershey"  # a copy of ../shared/data/hershey
 GLYPH_MARGIN = 60  # px
 _GLYPH = re.compile(r"<glyph\b([^>]*)/?>", re.S)
 _ATTR = re.compile(r'([\w:-]+)="([^"]*)"')
@@ -187,7 +187,7 @@ def glyph_ground_truth(glyph: Glyph, width: float, *, ambiguous: bool = False,
     dont_care += _sharp_turns(poly, closed, width)
     dont_care += merged_without_crossing(stroke, closed, width, inter.crossings)
     if len(inter.crossings) and dont_care:
-        from benchmarks.metrics import MATCH_DISTANCE, dont_care_mask
+        from benchmarks.metrics.table1 import MATCH_DISTANCE, dont_care_mask
 
         if dont_care_mask(inter.crossings, dont_care, max(MATCH_DISTANCE, width) + spacing * width).any():
             return None  # a crossing inside a retrace or a merged narrow turn: ambiguous

@@ -1,11 +1,11 @@
 """Brush and broad-nib drawings: single-line shapes whose ink width changes 3x along the line.
 
-Two kinds, both through the glyph rules and ground truth of benchmarks/hershey.py (scaled to
+Two kinds, both through the glyph rules and ground truth of benchmarks/sets/hershey.py (scaled to
 the canvas, crossings, retraces, ambiguous junctions scored by the fair-retrace rule):
 
 - brush-kana: kana written in one brush stroke (く し つ て の ひ へ ろ る ん そ フ レ ノ
   and 乙), pen paths drawn here in a 100-unit em from the shapes of the printed characters
-  (smooth runs meeting in cusps, as benchmarks/handwriting.py writes letters). The brush
+  (smooth runs meeting in cusps, as benchmarks/sets/handwriting.py writes letters). The brush
   presses in (the width rises from a third of the full width over the first 8 % of the
   line), the pressure drifts slowly (+-15 %), and the stroke ends either in a sweep (harai:
   the width falls to a third over the last 20 %) or blunt (tome);
@@ -16,7 +16,7 @@ the canvas, crossings, retraces, ambiguous junctions scored by the fair-retrace 
 
 The ground truth's `stroke_width` is the full width W (6-16 px), the one the rules and the
 order tolerance use; meta "width_profile" holds the local width along the line (knot
-fractions of the arc length, widths in px), which benchmarks/render.py draws and the ink
+fractions of the arc length, widths in px), which benchmarks/common/render.py draws and the ink
 metrics measure the excursion against (half the LOCAL width + 1 px).
 """
 
@@ -27,9 +27,9 @@ from dataclasses import replace
 import numpy as np
 from scipy import ndimage
 
-from benchmarks.drawings import _hermite, _Waypoint
-from benchmarks.ground_truth import GroundTruth
-from benchmarks.hershey import Glyph, glyph_ground_truth, load_glyphs
+from benchmarks.sets.drawings import _hermite, _Waypoint
+from benchmarks.metrics.ground_truth import GroundTruth
+from benchmarks.sets.hershey import Glyph, glyph_ground_truth, load_glyphs
 
 # Kana as pen paths, x right, y down, in a 100-unit em: runs of 3+ points are smooth curves
 # through them, runs of 2 points straight lines; consecutive runs meet in a cusp.

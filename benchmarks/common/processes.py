@@ -68,3 +68,11 @@ def state(pid: int) -> str:
     waiting for work), "Z" a zombie...; "" once it is gone."""
     fields = _stat_fields(pid)
     return "" if fields is None else fields[0]
+
+
+def child_cpu_seconds() -> float:
+    """User + sys seconds of this process's finished children so far (all their threads)."""
+    import resource
+
+    usage = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return usage.ru_utime + usage.ru_stime

@@ -58,7 +58,7 @@ def excursion(gt: Drawing, output: Drawing) -> float:
 
 def local_excursion(gt: Drawing, output: Drawing, profile) -> tuple[float, float, float]:
     """Excursion against a width that changes along a one-stroke `gt` (`profile`: knot
-    fractions of its arc length and widths px, as benchmarks/render.py draws it).
+    fractions of its arc length and widths px, as benchmarks/common/render.py draws it).
 
     Returns the largest distance (px), the largest distance over the local width at the
     nearest centre-line point, and the smallest headroom to the local bound (half the local
@@ -66,7 +66,7 @@ def local_excursion(gt: Drawing, output: Drawing, profile) -> tuple[float, float
     """
     if not output.strokes:
         return float("nan"), float("nan"), float("nan")
-    from benchmarks.render import profile_widths
+    from benchmarks.common.render import profile_widths
 
     centre = gt.strokes[0].sample_evenly(CENTRE_SPACING)
     widths = profile_widths(profile, np.linspace(0.0, 1.0, len(centre)))
