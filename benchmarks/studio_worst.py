@@ -5,7 +5,8 @@ Each case is one request the page (or any client holding the token) can make wit
 values inside their declared ranges (`onestroke.ranges`): the most passes at the finest
 tolerance on the largest bed, the densest stitches on the largest hoop, the vectorizer's
 extreme settings, the largest bodies. The session is made and its drawing vectorized
-first (not timed); then each case runs --repeats times through Starlette's test client and
+first (not timed); then each case runs --repeats times (a state request each time from a
+setting never computed: the session's stage cache keeps only the gray images) through Starlette's test client and
 the script prints, per case, the median wall and CPU seconds (this process, all threads:
 on a loaded machine the wall time includes waiting for a core) and the peak memory of the
 process during the request (VmHWM, reset before each request through /proc/self/clear_refs),
@@ -41,8 +42,9 @@ size = "{side}x{side}mm"
 EDITS = {"format": "onestroke-edits", "version": 1, "edits": []}
 
 
-def cases(bed: float, hoop: float) -> list[tuple[str, str, str, object]]:
-    """(endpoint, label, method, body or query) of the heaviest requests found."""
+def cases(bed: float, hoop: float, budget_size: float) -> list[tuple[str, str, str, object]]:
+    """(endpoint, label, method, body or query) of the heaviest requests found; budget_size:
+    the size (mm) at which satin at 0.1 mm spacing makes the studio's step budget."""
     laser_worst = {"size": "400mm", "tolerance": "0.005mm", "passes": "100"}
     big = {"size": f"{bed:g}mm", "tolerance": "0.005mm", "passes": "100", "profile": "@big"}
     field = {"size": f"{hoop:g}mm", "hoop": f"{hoop:g}x{hoop:g}", "fit": True}  # shrunk into the hoop
@@ -51,6 +53,8 @@ def cases(bed: float, hoop: float) -> list[tuple[str, str, str, object]]:
     running = dict(field, style="running", stitch_length="0.1mm", min_stitch="0.1mm")
     triple = dict(field, style="triple", stitch_length="0.1mm", min_stitch="0.1mm", repeats="5")
     arrows = dict(field, style="arrows", arrow_size="0.1mm", spacing="0.2mm", min_stitch="0.1mm")
+    at_budget = dict(satin, size=f"{budget_size:.0f}mm")  # the most steps the studio makes
+    wide_satin = dict(field, style="satin")  # the default 0.4 mm spacing
     many = {"format": "onestroke-edits", "version": 1,
             "edits": [{"kind": "reverse", "at": [float(i % 997), float(i % 599)]} for i in range(9000)]}
     spots = [[float((i * 37) % 997), float((i * 13) % 599)] for i in range(12000)]  # a 1 MiB body holds ~15,000
@@ -62,6 +66,8 @@ def cases(bed: float, hoop: float) -> list[tuple[str, str, str, object]]:
         ("state", "blur 25 px", "POST", {"edits": dict(EDITS, blur=25)}),
         ("state", "multi-stroke, threshold 0.05", "POST", {"edits": dict(EDITS, multi=True, threshold=0.05)}),
         ("state", "threshold 0.05", "POST", {"edits": dict(EDITS, threshold=0.05)}),
+        ("state", "threshold 0.08", "POST", {"edits": dict(EDITS, threshold=0.08)}),
+        ("state", "threshold 0.12", "POST", {"edits": dict(EDITS, threshold=0.12)}),
         ("state", "9,000 reverse edits", "POST", {"edits": many}),
         ("state", "12,000 twice edits", "POST", {"edits": twice}),
         ("state", "12,000 split edits", "POST", {"edits": split}),
@@ -76,6 +82,9 @@ def cases(bed: float, hoop: float) -> list[tuple[str, str, str, object]]:
         ("embroidery", f"triple x5 0.1 mm, {hoop:g} mm hoop", "POST", {"options": triple}),
         ("embroidery", f"arrows 0.1 mm, {hoop:g} mm hoop", "POST", {"options": arrows}),
         ("embroidery", f"satin 0.1 mm spacing, {hoop:g} mm hoop", "POST", {"options": satin}),
+        ("embroidery", f"satin 0.4 mm spacing, {hoop:g} mm hoop", "POST", {"options": wide_satin}),
+        ("embroidery", f"satin 0.1 mm spacing, {budget_size:.0f} mm (step budget)", "POST", {"options": at_budget}),
+        ("export/pes", f"satin 0.1 mm spacing, {budget_size:.0f} mm (step budget)", "POST", {"options": at_budget}),
         ("export/pes", f"zigzag 0.1 mm spacing, {hoop:g} mm hoop", "POST", {"options": zigzag}),
         ("export/dst", f"zigzag 0.1 mm spacing, {hoop:g} mm hoop", "POST", {"options": zigzag}),
         ("export/jef", f"zigzag 0.1 mm spacing, {hoop:g} mm hoop", "POST", {"options": zigzag}),
@@ -88,6 +97,19 @@ def cases(bed: float, hoop: float) -> list[tuple[str, str, str, object]]:
         ("image", "the drawing", "GET", ""),
         ("ports", "list", "GET", ""),
     ]
+
+
+def size_at_step_budget(session, step: float) -> float:
+    """The size (mm, 1 % under) at which the session's drawing, at a style step of `step` mm,
+    makes the studio's embroidery step budget (`fabrication.studio.budgets.STEPS`): the most
+    work a preview in budget does."""
+    from fabrication.placement import PlacementOptions, place
+    from fabrication.studio.budgets import STEPS
+    from vectorize.edits import Edits
+
+    drawing = session.vectorize(Edits()).drawing
+    per_mm = sum(s.length for s in place(drawing, PlacementOptions(size=1000.0)).strokes) / 1000.0
+    return 0.99 * STEPS * step / per_mm
 
 
 def _status(key: str) -> float:
@@ -121,6 +143,10 @@ def main() -> None:
             bed, hoop = bed or 10_000.0, hoop or 11_000.0
     session = StudioSession(args.drawing, edits_path=Path(os.devnull), precompute=False)
     session.warm()
+    try:
+        budget_size = min(hoop, size_at_step_budget(session, 0.1))
+    except ImportError:  # a checkout without the budget
+        budget_size = 570.0
     host = "127.0.0.1:1"
     client = TestClient(create_app(session, token="t", hosts={host}), base_url=f"http://{host}")
     client.headers["X-Studio-Token"] = "t"
@@ -129,7 +155,7 @@ def main() -> None:
     print(f"{Path(args.drawing).name}, from {args.root}; load average {os.getloadavg()[0]:.1f}; "
           f"rss after the first state {_status('VmRSS'):.0f} MB")
     worst: dict[str, tuple[float, float, float, str]] = {}
-    for endpoint, label, method, body in cases(bed, hoop):
+    for endpoint, label, method, body in cases(bed, hoop, budget_size):
         if only and endpoint not in only:
             continue
         body = json.loads(json.dumps(body))
@@ -141,6 +167,10 @@ def main() -> None:
             body["options"]["profile"] = uploaded.json()["id"]
         walls, cpus, peaks = [], [], []
         for _ in range(args.repeats):
+            if endpoint == "state":  # a setting never computed: only the gray images stay cached
+                for store in (session.cache.axis, session.cache.front, session.cache.simplified,
+                              session.cache.solved):
+                    store.clear()
             Path("/proc/self/clear_refs").write_text("5")  # VmHWM := VmRSS
             started, cpu = time.perf_counter(), time.process_time()
             if method == "GET":
@@ -151,9 +181,11 @@ def main() -> None:
             walls.append(time.perf_counter() - started)
             peaks.append(_status("VmHWM"))
         said = answer.json().get("error", "") if answer.status_code != 200 else ""
+        if endpoint == "state":  # the drawing's own state again (not timed), for the next cases
+            client.get("/api/state")
         row = (median(walls), median(cpus), max(peaks), label)
         print(f"{endpoint:13} {label:50} {answer.status_code} wall {row[0]:6.2f} s  cpu {row[1]:6.2f} s  "
-              f"peak {row[2]:5.0f} MB  {len(answer.content) / 1e6:5.1f} MB {said[:80]}", flush=True)
+              f"peak {row[2]:5.0f} MB  {len(answer.content) / 1e6:5.1f} MB {said[:140]}", flush=True)
         if answer.status_code == 200 and (endpoint not in worst or row[1] > worst[endpoint][1]):
             worst[endpoint] = row
     print(f"\nworst case per endpoint (median of {args.repeats}; load average {os.getloadavg()[0]:.1f}):")

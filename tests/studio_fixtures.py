@@ -66,6 +66,24 @@ def settle(page, edits_count=None, extra: str = "") -> None:
     page.wait_for_function(condition)
 
 
+def refused_threshold(page, value: float, says: str) -> None:
+    """Move the threshold slider from the automatic threshold to `value` (as a drag ends),
+    wait for the refusal whose message contains `says`, and check that the slider, its
+    figure and "automatic" went back to the drawing shown."""
+    import pytest
+
+    before = page.evaluate("window.studio.state.report.threshold")
+    assert page.is_checked("#auto-threshold")
+    page.eval_on_selector("#threshold", f"e => {{ e.value = {value}; e.dispatchEvent(new Event('input')); "
+                                        "e.dispatchEvent(new Event('change')); }")
+    page.wait_for_function(f"document.getElementById('warnings').textContent.includes({says!r})")
+    settle(page)
+    page.wait_for_timeout(400)
+    assert page.is_checked("#auto-threshold")
+    assert float(page.input_value("#threshold")) == pytest.approx(before, abs=0.006)
+    assert page.inner_text("#threshold-value") == f"auto {before:.2f}"
+
+
 def click_at(page, at) -> None:
     """A mouse click at image position `at` (px), wherever the view has put it."""
     x, y = page.evaluate(f"window.studio.toScreen({at[0]}, {at[1]})")

@@ -23,7 +23,7 @@ from PIL import Image
 from fabrication.studio.server import StudioServer
 from fabrication.studio.session import StudioSession
 from tests.conftest import ARTIFACTS, alpha_loop, render_polylines
-from tests.studio_fixtures import IDLE, cli_bytes, settle
+from tests.studio_fixtures import IDLE, cli_bytes, refused_threshold, settle
 
 ROOT = Path(__file__).resolve().parents[1]
 AXE = ROOT / "tests" / "assets" / "axe-core" / "axe.min.js"
@@ -210,16 +210,7 @@ def test_honest_controls_and_the_ink_seen(grey, loops, browser):
     # the drawing shows (they used to stay on the refused value, "automatic" unticked).
     with _page(browser, grey[0]) as page:
         assert " s" not in page.inner_text("#summary").split("edit")[-1]  # no "0.00 s" on the first load
-        before = page.evaluate(f"{STATE}.report.threshold")
-        assert page.is_checked("#auto-threshold")
-        page.eval_on_selector("#threshold", "e => { e.value = 0.3; e.dispatchEvent(new Event('input')); "
-                                            "e.dispatchEvent(new Event('change')); }")
-        page.wait_for_function("document.getElementById('warnings').textContent.includes('no ink')")
-        settle(page)
-        page.wait_for_timeout(400)
-        assert page.is_checked("#auto-threshold")
-        assert float(page.input_value("#threshold")) == pytest.approx(before, abs=0.006)
-        assert page.inner_text("#threshold-value") == f"auto {before:.2f}"
+        refused_threshold(page, 0.3, "no ink")
         _shot(page, "refused-threshold-controls-restored", note=True)
     with _page(browser, loops[0]) as page:
         _forced_decision_mask_and_ink(page)

@@ -18,6 +18,11 @@ THRESHOLD = Range(0.0, 1.0, name="--threshold", low_open=True, high_open=True)
 # A Gaussian sigma on the working image (longest side about 1000-2000 px).
 BLUR = Range(0.0, 25.0, unit="px", name="--blur")
 MAX_SIZE = Range(64, None, unit="px", name="max_size", integer=True)
+# A budget, not a range of sizes: route inspection's exact matching (networkx's blossom, pure
+# Python) grows as the cube of the odd nodes it pairs, multi-stroke mode's strokes and
+# crossings with them. The studio sets one
+# (`fabrication.studio.budgets`); the CLI and batch leave it unset and take the time.
+MAX_ODD_NODES = Range(2, None, name="max_odd_nodes", integer=True)
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -31,6 +36,9 @@ class VectorizeOptions:
         the `vectorize.junctions.intersections.IntersectionClassifier` method `classify`.
     max_size: longest side of the working image in px; larger inputs are downscaled.
     seed: seed of every random choice (retry search ties), for reproducible output.
+    max_odd_nodes: refuse (`InputError`, after simplification) a graph with more odd-degree
+        nodes (loose ends and forks) than this (None: no limit): route inspection's matching
+        grows as their cube, multi-stroke mode's strokes with them.
     """
 
     multi: bool = False
@@ -40,6 +48,7 @@ class VectorizeOptions:
     max_size: int = ranged(1000, MAX_SIZE)
     seed: int = 0
     keep_stages: bool = False
+    max_odd_nodes: int | None = ranged(None, MAX_ODD_NODES)
 
     def __post_init__(self) -> None:
         check_ranges(self)

@@ -254,6 +254,9 @@ def _order(graph: MedialGraph, ink, options: VectorizeOptions, ends: int, clock:
         through, posterior = _pair_through(graph, simple.through, ink.gray, w, options)
         simple = replace(simple, through=through, through_posterior=posterior)
         clock.lap("simplification")
+        if options.max_odd_nodes is not None:  # before the crossings' crops and the route
+            odd = sum(1 for n, incident in graph.incident.items() if len(incident) % 2 and n not in simple.through)
+            _refuse_ragged(odd, "loose ends and forks", options, ink.threshold)
         junction_list = _junctions(graph, simple.crossings, w)
         junctions = dict(zip(simple.crossings, junction_list))
         wait("cnn")
@@ -306,6 +309,21 @@ def _refuse_noise(count: int, what: str, limit: int, threshold: float, given: bo
                 else f"try --blur 2 (more for coarse grain), or a --threshold well below {threshold:.2f}")
         raise InputError(f"the ink has {count} {what}: that is paper texture or noise, not a line "
                          f"drawing; {hint}")
+
+
+def _refuse_ragged(count: int, what: str, options: VectorizeOptions, threshold: float) -> None:
+    """Raise `InputError` when the graph has more odd-degree nodes (`what`: its loose ends, or
+    its loose ends and forks once simplified) than `options.max_odd_nodes`. A single line
+    pairs them by route inspection's matching (its work grows as their cube); in multi-stroke
+    mode each pair is a stroke to classify, order and fit. A ragged or grainy edge gives
+    hundreds of them (spurs), a line drawing tens."""
+    if count > options.max_odd_nodes:
+        hint = ("try another --threshold (or the automatic one) or --blur 1, or clean the scan"
+                if options.threshold is not None else "try --blur 1, or clean the scan")
+        work = "strokes to end there" if options.multi else "for the line to pair up"
+        raise InputError(f"the ink has {count} {what} {work} at threshold {threshold:.2f}, more than the "
+                         f"{options.max_odd_nodes} an interactive run takes: that is a ragged edge or noise, "
+                         f"not a line drawing; {hint}")
 
 
 def working_paper(image: np.ndarray, options: VectorizeOptions, cache: StageCache | None = None):
@@ -400,6 +418,11 @@ def _front(image: np.ndarray, options: VectorizeOptions, clock: _Clock, cache: S
             refuse = Unbridging(edits, output_matrix(ink.scale, frame or _pixel_frame(image)))
         bridge_gaps(graph, stroke_width=w, made=bridges, refuse=refuse)
         dropped = keep_largest_piece(graph)
+    if options.max_odd_nodes is not None:
+        # Simplification merges forks into crossings but keeps every loose end: a graph
+        # with too many of them is refused before that work.
+        ends = sum(1 for incident in graph.incident.values() if len(incident) == 1)
+        _refuse_ragged(ends, "loose ends", options, ink.threshold)
     return ink, rings, graph, tuple(bridges), dropped, tuple(refuse.refused) if refuse is not None else ()
 
 

@@ -100,7 +100,8 @@ def column_needles(stroke: Stroke, curve: DenseCurve, columns: list[Column], how
     if straight_density(how.spacing, float(np.median(widths))) <= DENSITY_LIMIT:
         points, keep = relieve_crowding(merged.points, merged.roles, np.concatenate(inward),
                                         lambda rows, at: stroke_sides(stroke, at, merged.t[rows]),
-                                        max_gap=2.0 * how.underlay_stitch_length, max_top_gap=2.0 * how.spacing)
+                                        max_gap=2.0 * how.underlay_stitch_length, max_top_gap=2.0 * how.spacing,
+                                        spacing=how.spacing)
         merged = NeedlePoints(points, merged.t, merged.roles).take(keep)
     return split_body(merged, how.max_stitch - 2 * SNAP_ALLOWANCE, rng if how.random_phase else None)
 

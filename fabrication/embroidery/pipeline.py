@@ -29,6 +29,10 @@ from vectorize.drawing import Drawing
 
 
 TRIM_SECONDS = Range(0.0, None, unit="s", name="trim time")
+# A budget, not a range of sizes: the work of stitching grows with the steps along the curve
+# (curve length over the style's spacing or stitch length). The studio sets one
+# (`fabrication.studio.budgets`); the CLI and batch leave it unset.
+MAX_STEPS = Range(1, None, name="max_steps", integer=True)
 
 @dataclass(frozen=True, kw_only=True)
 class EmbroideryJob:
@@ -36,7 +40,9 @@ class EmbroideryJob:
     a design that does not fit down instead of refusing it; plan: stitch style and
     design-wide rules; stitches_per_minute / trim_seconds: the machine, for the time;
     name: the design name files store (PES, DST); date: YYYYMMDDhhmmss stored in JEF
-    (fixed by default so that files are the same bytes every run)."""
+    (fixed by default so that files are the same bytes every run); max_steps: refuse
+    (`InputError`, before stitching) a design with more steps along its curve than this
+    (`steps_along`; None: no limit)."""
 
     placement: PlacementOptions = field(default_factory=lambda: PlacementOptions(size=90.0))
     hoop: Hoop = field(default_factory=lambda: hoop_named("100x100"))
@@ -46,6 +52,7 @@ class EmbroideryJob:
     trim_seconds: float = ranged(10.0, TRIM_SECONDS)
     name: str = "onestroke"
     date: str = FIXED_DATE
+    max_steps: int | None = ranged(None, MAX_STEPS)
 
     def __post_init__(self) -> None:
         check_ranges(self)
@@ -88,6 +95,8 @@ def embroider(drawing: Drawing, job: EmbroideryJob = EmbroideryJob(), *, progres
     if isinstance(style, ZigzagOptions) and style.width > LOOSE_ZIGZAG:
         warnings.append(f"zigzag stitches {style.width:g} mm wide lie loose and snag (over "
                         f"{LOOSE_ZIGZAG:g} mm); use a narrower --stitch-width")
+    if job.max_steps is not None:
+        _check_steps(hooped, style, job.max_steps)
     plan = plan_embroidery(hooped, job.plan, progress=progress, centre=True)
     check_plan_in_hoop(plan, job.hoop)
     warnings.extend(plan.dropped)
@@ -103,6 +112,23 @@ def embroider(drawing: Drawing, job: EmbroideryJob = EmbroideryJob(), *, progres
     warnings.extend(_hole_warnings(plan))
     return EmbroideryResult(drawing=plan.sewn, plan=plan, stats=stats, hoop=job.hoop,
                             fit_scale=float(fitted.scale), warnings=tuple(warnings), turned=fitted.turned)
+
+
+def steps_along(drawing: Drawing, style) -> tuple[float, float, float]:
+    """(steps, curve length mm, step mm): how many rows, arrows or stitches `style` makes
+    along the strokes of `drawing` (mm) at its shortest step, its spacing or stitch length."""
+    step = min(getattr(style, name) for name in ("spacing", "stitch_length") if hasattr(style, name))
+    length = float(sum(stroke.length for stroke in drawing.strokes))
+    return length / step, length, step
+
+
+def _check_steps(drawing: Drawing, style, limit: int) -> None:
+    steps, length, step = steps_along(drawing, style)
+    if steps > limit:
+        option = "--spacing" if hasattr(style, "spacing") else "--stitch-length"
+        raise InputError(f"{step:g} mm steps along {length:,.0f} mm of curve are {steps:,.0f} steps, more than "
+                         f"the {limit:,} an interactive preview makes; use a {'wider' if option == '--spacing' else 'longer'} "
+                         f"{option} or a smaller --size")
 
 
 # Styles whose body stitches cross a column (the bobbin shows only in its middle third).

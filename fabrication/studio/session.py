@@ -17,6 +17,7 @@ from pathlib import Path
 import numpy as np
 
 from fabrication.job_options import embroidery_settings, laser_settings
+from fabrication.studio import budgets
 from onestroke.atomic import atomic_write_text
 from onestroke.errors import Cancelled, InputError, OnestrokeError
 from vectorize import VectorizeOptions, vectorize_file
@@ -128,8 +129,11 @@ class StudioSession:
             if stale():
                 raise Superseded
             self.cache.cancel = stale
+            # A graph too ragged for the page's pace is refused before its junctions and route.
+            budget = budgets.MULTI_ODD_NODES if edits.applied_to(self.options).multi else budgets.ODD_NODES
             try:
-                return vectorize_file(self.drawing_path, self.options, edits=edits, cache=self.cache)
+                return vectorize_file(self.drawing_path, replace(self.options, max_odd_nodes=budget),
+                                      edits=edits, cache=self.cache)
             except Cancelled:
                 raise Superseded from None
             finally:
@@ -286,7 +290,8 @@ class StudioSession:
         # The input's stem names the design in the file, as `onestroke embroider` does.
         settings = embroidery_settings(output=f"design.{extension}", source=str(self.drawing_path), **values)
         drawing = self.vectorize(edits).drawing
-        return settings, embroider(drawing, settings.job)
+        # Too many steps along the curve for the page's pace: refused before stitching.
+        return settings, embroider(drawing, replace(settings.job, max_steps=budgets.STEPS))
 
     def embroidery_preview(self, edits: Edits, values: dict) -> dict:
         """The stitches for the player (`fabrication.player`), stats lines and warnings."""

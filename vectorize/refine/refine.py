@@ -397,10 +397,20 @@ class Refinement:
         """Apply the start and reverse edits to the finished drawing (output px)."""
         strokes = list(drawing.strokes)
         tol = self.edits.tolerance + drawing.stroke_width
+        # Each stroke flattened once per direction (a reverse edit flips it back and forth):
+        # thousands of edits would otherwise flatten every stroke for each of them.
+        flat: dict[bytes, np.ndarray] = {}
+
+        def polyline(stroke) -> np.ndarray:
+            key = stroke.control.tobytes()
+            if key not in flat:
+                flat[key] = stroke.flatten(0.5)
+            return flat[key]
+
         for edit in self.edits.of("reverse", "start"):
             at = np.asarray(edit.at)
             if edit.kind == "reverse":
-                dists = [float(np.min(np.linalg.norm(s.flatten(0.5) - at, axis=1))) for s in strokes]
+                dists = [float(np.min(np.linalg.norm(polyline(s) - at, axis=1))) for s in strokes]
                 k = int(np.argmin(dists)) if dists else -1
                 if k >= 0 and dists[k] <= tol:
                     strokes[k] = strokes[k].reversed()
