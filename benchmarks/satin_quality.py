@@ -1,7 +1,7 @@
 """Satin quality: the column's width against the drawn width on drawings whose line swells
 and thins, and the corner drawings of embroidery_quality.py.
 
-Run from the repository root: python -m benchmarks.satin_quality [--count 6] [--size 90]
+Run from the repository root: python -m benchmarks.satin_quality [--count 6] [--size 90] [--arcs]
 (also part of python -m benchmarks.embroidery_quality). The varying-width set is the
 vectorizer benchmark's brush kana (pressure, tapered ends) and broad-nib capitals (marker-
 like: thick and thin by direction), rendered with their known width profiles
@@ -11,7 +11,9 @@ lies within 10 % or 0.2 mm of the drawn width x the design's scale (the acceptan
 issue 27), over the length where the stroke's ink is its own (where two passes of the line
 share ink, a V's sides or a crossing, one pass's width cannot be seen: that share is shown);
 density with every needle point counted and repeated holes (fabrication.embroidery.quality),
-slits (metrics.columns.slits), and needle points planned per second.
+slits (metrics.columns.slits), and needle points planned per second. --arcs adds satin on
+arcs of 0.3-3 mm radius at 1-6 mm width (`tight_arcs`): where the column is wider than its
+bend, whether each dense place and repeated hole is warned about.
 """
 
 from __future__ import annotations
@@ -112,12 +114,69 @@ def varying_width(count: int = 6, size: float = 90.0, seed: int = 0) -> list[dic
     return rows
 
 
+ARC_RADII = (0.3, 0.5, 0.8, 1.2, 2.0, 3.0)  # mm
+ARC_WIDTHS = (1.0, 2.0, 3.0, 4.0, 5.0, 6.0)  # mm
+ARC_SWEEPS = (90, 180, 270, 360)  # degrees
+
+
+def tight_arcs() -> list[dict]:
+    """Satin of every width in ARC_WIDTHS on arcs of every radius and sweep above, through the
+    whole job (`embroider`, as embroidery_quality.py): density, repeated holes, whether the
+    warnings name each place, and slits where the arc is wider than the column's half width
+    (on a tighter one the column's inside is held short of the centre by design, and the
+    band the slit measure probes passes it). Arcs shorter than --min-stroke are refused."""
+    from fabrication.embroidery.pipeline import EmbroideryJob, embroider
+    from fabrication.embroidery.quality import DENSITY_LIMIT, hole_places
+    from machines.hoops import hoop_named
+    from onestroke.errors import InputError
+
+    rows = []
+    for radius in ARC_RADII:
+        for width in ARC_WIDTHS:
+            for sweep in ARC_SWEEPS:
+                angle = np.radians(np.linspace(0.0, sweep, sweep // 5 + 1))
+                stroke = Stroke.from_polyline(radius * np.c_[np.cos(angle), np.sin(angle)])
+                style = style_options("satin", width=width)
+                job = EmbroideryJob(placement=PlacementOptions(size=2 * radius), hoop=hoop_named("200x200"),
+                                    plan=PlanOptions(style=style))
+                try:
+                    result = embroider(Drawing((stroke,), 2 * radius, 2 * radius, "mm", width), job)
+                except InputError:
+                    continue
+                plan = result.plan
+                density = needle_density(plan.points[plan.kinds == STITCH])
+                holes = repeated_holes(plan)
+                said = " ".join(result.warnings)
+                spots = hole_places(plan, holes)
+                named = (all(str(p) in said for p in density.places) or f"at {len(density.places)} places" in said) \
+                    and (all(str(p) in said for p in spots) or f"at {len(spots)} places" in said)
+                over = density.maximum > DENSITY_LIMIT or len(holes) > 0
+                rows.append(dict(radius=radius, width=width, sweep=sweep, density=density.maximum, holes=len(holes),
+                                 unwarned=over and not named,
+                                 slits=column_slits(plan, style) if radius > width / 2 else None))
+    print(f"\nsatin on arcs (radius {', '.join(map(str, ARC_RADII))} mm x width {', '.join(map(str, ARC_WIDTHS))} mm"
+          f" x sweep {', '.join(map(str, ARC_SWEEPS))} degrees; {len(rows)} sewn, the rest shorter than --min-stroke)")
+    print(f"{'radius vs half width':22} {'cases':>5} {'over 6':>6} {'worst':>5} {'with holes':>10} {'unwarned':>8} "
+          f"{'with slits':>10}")
+    for label, test in (("radius > half width", lambda r: r["radius"] > r["width"] / 2),
+                        ("radius <= half width", lambda r: r["radius"] <= r["width"] / 2)):
+        part = [r for r in rows if test(r)]
+        cut = [r["slits"] for r in part if r["slits"] is not None]
+        print(f"{label:22} {len(part):5d} {sum(r['density'] > 6 for r in part):6d} "
+              f"{max((r['density'] for r in part), default=0):5d} {sum(r['holes'] > 0 for r in part):10d} "
+              f"{sum(r['unwarned'] for r in part):8d} {(str(sum(c > 0 for c in cut)) if cut else '-'):>10}")
+    return rows
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--count", type=int, default=6, help="drawings of each kind (default 6)")
     parser.add_argument("--size", type=float, default=90.0, help="design size, mm (default 90)")
+    parser.add_argument("--arcs", action="store_true", help="also satin on tight arcs (radius 0.3-3 mm, width 1-6 mm)")
     args = parser.parse_args()
     varying_width(args.count, args.size)
+    if args.arcs:
+        tight_arcs()
 
 
 if __name__ == "__main__":

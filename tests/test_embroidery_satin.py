@@ -217,6 +217,69 @@ def test_crowding_is_relieved_underlay_first_then_by_insetting_top_points():
     assert np.all(relieved[moved, 0] == points[moved, 0])  # inset straight towards the centre
 
 
+def test_a_needle_re_entering_the_underlays_last_hole_leaves_that_hole_out_rather_than_open_a_slit():
+    from fabrication.embroidery.crowding import REENTER, relieve_crowding
+
+    # A 2 mm column's top points every 0.2 mm (spacing 0.4), sides alternating, after an edge
+    # walk that ends 0.2 mm from the first top point on the right: the needle would re-enter
+    # that hole. Insetting the top point clear of it takes it 0.75 mm short of its rail, a
+    # gap of 0.4 mm between its neighbours' stitches there (a slit).
+    top = np.c_[np.arange(12) * 0.2, np.where(np.arange(12) % 2 == 0, 1.0, -1.0)]
+    walk = np.array([[2.0, -0.8], [1.0, -0.8], [0.2, -0.8]])
+    points = np.vstack([walk, top])
+    roles = np.r_[np.full(3, UNDERLAY), np.full(12, BODY)]
+    inward = np.r_[np.zeros((3, 2)), np.c_[np.zeros(12), -top[:, 1]]]
+
+    def sides(rows, at):
+        return np.where(np.abs(at[:, 1]) < 0.15, 0, np.sign(at[:, 1])).astype(int)
+
+    unchecked, _ = relieve_crowding(points, roles, inward, sides, max_gap=6.0)
+    assert unchecked[4, 1] > -0.5  # without the spacing, the top point goes short (as before)
+    relieved, keep = relieve_crowding(points, roles, inward, sides, max_gap=6.0, spacing=0.4)
+    assert np.array_equal(relieved[3:], points[3:]) and keep[3:].all()  # every top point where its row puts it
+    assert not keep[2]  # the walk's last hole, under the top stitches, is left out instead
+    right = relieved[keep & (relieved[:, 1] < 0)]
+    gaps = np.linalg.norm(right[1:] - right[:-1], axis=1)
+    assert gaps.min() >= REENTER  # and nothing re-enters a hole on its side
+
+
+@pytest.mark.parametrize("radius, width, sweep", [(3.0, 3.0, 180), (3.0, 3.0, 270), (2.0, 2.0, 180)])
+def test_a_columns_last_point_inside_a_bend_keeps_its_reach_so_the_end_is_not_slit(radius, width, sweep):
+    # Inside a bend the needle points crowd and step deeper one after another, up to half
+    # the row's width; the last one inside went as deep as its steps said and bared the end.
+    angle = np.radians(np.linspace(0.0, sweep, sweep // 5 + 1))
+    arc = Stroke.from_polyline(radius * np.c_[np.cos(angle), np.sin(angle)])
+    options = SatinOptions(width=width)
+    plan = plan_of(arc, options)
+    half = options.sewn_width(np.array([width]))[0] / 2
+    top = plan.points[(plan.kinds == STITCH) & (plan.roles == BODY)]
+    inside = top[np.linalg.norm(top, axis=1) < radius]
+    # at most a short stitch's inset (a share of the width) short of the rail, on the 0.1 mm grid
+    assert radius - np.linalg.norm(inside[-1]) >= half - options.short_stitch_inset * width - 0.1
+    assert slits(plan, 0, lambda s: np.full(len(s), half), options.spacing, inset=2 * options.short_stitch_inset) == []
+
+
+def test_the_varying_width_sets_capital_s_is_sewn_without_a_slit_where_it_hooks():
+    # The broad-nib S of benchmarks/satin_quality.py: where the spine meets the lower bowl the
+    # line runs up a spur and back and jogs 1 mm sideways through two rounded corners. The
+    # spur's last rows took their direction from the corner's own rounding (the last 0.05 mm
+    # of the curve) and lost their inside; then a needle inset clear of the underlay's last
+    # hole bared the ground beside it: one slit each time.
+    from benchmarks.sets.brush import capital_set
+    from benchmarks.common.render import render_truth, to_uint8
+    from benchmarks.satin_quality import column_slits
+    from fabrication.placement import PlacementOptions, place
+    from vectorize.pipeline import vectorize_image
+
+    s = next(gt for gt in capital_set(2, 0) if gt.name.endswith("-S"))
+    placed = place(vectorize_image(to_uint8(render_truth(s))).drawing, PlacementOptions(size=90.0))
+    style = style_options("satin")
+    plan = plan_embroidery(placed, PlanOptions(style=style))
+    assert column_slits(plan, style) == 0
+    assert needle_density(plan.points[plan.kinds == STITCH]).maximum <= 6
+    assert len(repeated_holes(plan)) == 0
+
+
 def test_a_split_corner_ends_the_first_column_at_the_corner_and_caps_the_second():
     plan = plan_embroidery(Drawing((corner(30.0),), 30, 30, "mm", 2.0), PlanOptions(style=SatinOptions(width=2.0)))
     top = (plan.kinds == STITCH) & (plan.roles == BODY)

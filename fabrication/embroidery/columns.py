@@ -187,9 +187,18 @@ def _turns(stroke: Stroke, curve: DenseCurve, s: np.ndarray, before: np.ndarray,
 def _directions(stroke: Stroke, curve: DenseCurve, s: np.ndarray, reach: np.ndarray, lo: float,
                 hi: float) -> np.ndarray:
     """Unit directions at arc lengths `s`: the chord over +-reach, kept within [lo, hi] (a
-    column does not look round its own corners): a fan on bends, the tangent near ends."""
-    w = np.minimum(reach, np.minimum(s - lo, hi - s))
-    chord = stroke.points_at(curve.t_at(s + w)) - stroke.points_at(curve.t_at(s - w))
+    column does not look round its own corners): a fan on bends, the tangent at the
+    stroke's own ends. Within a reach of a corner the chord stops at the corner but keeps
+    its other side, so the end rows follow the column's last reach, not the corner's own
+    rounding (over the last hundredth of a millimetre it turns towards the next piece: the
+    inside of the last rows, held below that rounding's radius, shrank to nothing and left
+    a slit)."""
+    w = reach
+    if lo <= 0.0:
+        w = np.minimum(w, s - lo)
+    if hi >= curve.length:
+        w = np.minimum(w, hi - s)
+    chord = stroke.points_at(curve.t_at(np.minimum(s + w, hi))) - stroke.points_at(curve.t_at(np.maximum(s - w, lo)))
     norm = np.linalg.norm(chord, axis=1, keepdims=True)
     # At the ends the tangent is taken just inside the column: at a corner's own point it
     # would be the next piece's (the last rows would swing round beyond the corner).

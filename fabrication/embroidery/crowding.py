@@ -7,11 +7,13 @@ columns meeting at a corner), the points there are relieved, cheapest first:
 1. underlay points are left out (the walk then takes one longer stitch, at most
    `max_gap` mm, which the top stitches cover);
 2. top points are inset towards the row's centre (Ink/Stitch's short stitches made deeper),
-   a quarter of their room at a time, to where no point around exceeds the limit and the
-   needle stays clear of its last and next holes on that side;
+   an eighth, a quarter, a half... of their room, to where no point around exceeds the limit and the
+   needle stays clear of its last and next holes on that side, and no ground it leaves
+   bare opens a slit (a gap between top stitches wider than the spacing, judged on the
+   files' 0.1 mm grid: wider than the spacing plus one grid step);
 3. where the line comes back over a place (a crossing, a closed line's ends), top points of
    the first pass there, which the later pass covers, are left out while the stitch that
-   replaces their two stays within `max_top_gap` mm.
+   replaces their two stays within `max_top_gap` mm and no slit opens.
 
 What cannot be relieved so is left to the stats' warning, which names the place. Only
 the neighbourhoods of dense points are visited (a tree query finds them), so a stroke
@@ -30,35 +32,41 @@ from fabrication.embroidery.quality import DENSITY_LIMIT, DENSITY_RADIUS, HOLE_G
 # lies where the line comes back (a crossing, a closed line's ends).
 AGAIN = 12
 # Inset steps tried, as shares of a point's room towards its row's centre.
-STEPS = (0.25, 0.5, 0.75, 1.0)
+STEPS = (0.125, 0.25, 0.5, 0.75, 1.0)
 # An inset needle keeps this far (mm) from the holes around it on its side of the line;
 # one closer than REENTER to a recent hole re-enters it (once snapped to the grid).
 CLEAR = HOLE_GAP + 2.0 * SNAP_ALLOWANCE
 REENTER = HOLE_GAP + SNAP_ALLOWANCE
+# Places (mm apart) probed along the stitches a moved or left-out top point takes away.
+PROBE = 0.05
 
 
 def relieve_crowding(points: np.ndarray, roles: np.ndarray, inward: np.ndarray, sides, *,
-                     max_gap: float, max_top_gap: float = 0.0, limit: int = DENSITY_LIMIT,
-                     radius: float = DENSITY_RADIUS) -> tuple[np.ndarray, np.ndarray]:
+                     max_gap: float, max_top_gap: float = 0.0, spacing: float | None = None,
+                     limit: int = DENSITY_LIMIT, radius: float = DENSITY_RADIUS) -> tuple[np.ndarray, np.ndarray]:
     """(points (N, 2) mm, keep (N,) bool) with the crowding relieved (module doc).
 
     points (N, 2) mm in sewing order; roles (N,) (UNDERLAY points may be left out: not the
     first or last point, and only while the stitch that replaces their two stays within
-    `max_gap` mm; BODY points only as step 3 says, within `max_top_gap` mm); inward (N, 2) mm: how far each point may move towards its
-    row's centre (zeros: it stays); sides: (rows (M,), points (M, 2)) -> (M,) the side of
+    `max_gap` mm; BODY points only as step 3 says, within `max_top_gap` mm); inward (N, 2)
+    mm: how far each point may move towards its row's centre (zeros: it stays); spacing:
+    the top stitches' spacing, peak to peak mm, the widest gap a top point moved or left
+    out may open (None: not checked); sides: (rows (M,), points (M, 2)) -> (M,) the side of
     the line each is on (+1 / -1, 0 on the line: `quality.stroke_sides`), for the clearance
     from its last and next holes on that side.
 
     Last, a needle that re-enters one of the last HOLE_WINDOW holes on its side (the
-    repeated holes of `quality`) is inset where that clears it, or left out.
+    repeated holes of `quality`) is inset where that clears it, or the underlay holes it
+    re-enters are left out, or it is left out (a top point only where no slit opens).
     """
     points = np.asarray(points, dtype=float).copy()
     keep = np.ones(len(points), dtype=bool)
     if not len(points):
         return points, keep
     side = _Sides(points, sides)
-    _relieve_density(points, keep, roles, inward, side, sides, max_gap, max_top_gap, limit, radius)
-    _clear_holes(points, keep, roles, inward, side, sides, max_gap)
+    bares = _Bareness(points, keep, roles, inward, None if spacing is None else (spacing + GRID) / 2.0)
+    _relieve_density(points, keep, roles, inward, side, sides, max_gap, max_top_gap, bares, limit, radius)
+    _clear_holes(points, keep, roles, inward, side, sides, max_gap, bares)
     return points, keep
 
 
@@ -93,7 +101,7 @@ def straight_density(spacing: float, width: float, radius: float = DENSITY_RADIU
     return int(same.sum() + other.sum())
 
 
-def _relieve_density(points, keep, roles, inward, side, sides, max_gap, max_top_gap, limit, reach) -> None:
+def _relieve_density(points, keep, roles, inward, side, sides, max_gap, max_top_gap, bares, limit, reach) -> None:
     """In place: steps 1 to 3 of the module doc. Points are counted where they will be
     written: snapped to the files' grid (the plan snaps them so, in this frame)."""
     grid = _snapped(points)
@@ -132,8 +140,8 @@ def _relieve_density(points, keep, roles, inward, side, sides, max_gap, max_top_
             if crowding[choice] == 0:
                 return
             candidates[choice] = False
-            if not _gap_ok(points, keep, int(local[choice]), roles, gap):
-                continue  # it would leave too long a stitch: try the others
+            if not _gap_ok(points, keep, int(local[choice]), roles, gap) or bares(int(local[choice]), None):
+                continue  # it would leave too long a stitch, or bare ground: try the others
             alive[choice] = False
             keep[local[choice]] = False
             count = count - near[:, choice]
@@ -160,7 +168,7 @@ def _relieve_density(points, keep, roles, inward, side, sides, max_gap, max_top_
         for share in STEPS:
             q = points[g] + inward[g] * share
             q_side = int(sides(np.array([g]), q[None, :])[0])
-            if not _clear(points, keep, side, g, q, q_side):
+            if not _clear(points, keep, side, g, q, q_side) or bares(g, q):
                 continue
             new_near = _within(_snapped(q[None, :]), pts, reach)[0] & alive
             new_near[choice] = True
@@ -182,9 +190,73 @@ def _relieve_density(points, keep, roles, inward, side, sides, max_gap, max_top_
     leave_out((roles[local] == BODY) & (local > 0) & (local < len(points) - 1) & later, max_top_gap)
 
 
-def _clear_holes(points, keep, roles, inward, side, sides, max_gap) -> None:
+class _Bareness:
+    """Whether moving or leaving out a top point bares the ground: whether a place on the
+    top stitches it takes away (the lines to and from it, between consecutive kept BODY
+    points) then lies farther than `cover` mm from every top stitch left, so that the
+    threads around it no longer meet (a slit). A tree of the points where they first were
+    finds the stitches that can pass near (built when first asked)."""
+
+    def __init__(self, points, keep, roles, inward, cover) -> None:
+        self.points, self.keep, self.roles, self.inward, self.cover = points, keep, roles, inward, cover
+        self.tree = None
+
+    def _neighbour(self, i: int, step: int, skip: int) -> int | None:
+        """The kept point before (step -1) or after (+1) `i`, passing over `skip`; None at
+        the ends."""
+        j = i + step
+        while 0 <= j < len(self.points) and (not self.keep[j] or j == skip):
+            j += step
+        return j if 0 <= j < len(self.points) else None
+
+    def __call__(self, g: int, q: np.ndarray | None) -> bool:
+        """Whether moving point `g` to `q` (None: leaving it out) bares the ground."""
+        if self.cover is None or self.roles[g] != BODY:
+            return False
+        points, keep, roles = self.points, self.keep, self.roles
+        if self.tree is None:
+            top = roles == BODY
+            pair = top[:-1] & top[1:]
+            longest = float(np.linalg.norm(np.diff(points, axis=0)[pair], axis=1).max(initial=0.0))
+            # a stitch passing within `cover` of a place has an end this close to where it was
+            self.search = longest / 2.0 + self.cover + 2.0 * float(np.linalg.norm(self.inward, axis=1).max(initial=0.0))
+            self.tree = cKDTree(points.copy())
+        p = points[g].copy()
+        taken = [points[j] for j in (self._neighbour(g, -1, g), self._neighbour(g, 1, g))
+                 if j is not None and roles[j] == BODY]
+        if not taken:
+            return False
+        probes = np.concatenate([end + (p - end) * np.linspace(0.0, 1.0, int(np.ceil(np.hypot(*(p - end)) / PROBE)) + 1)
+                                 [:, None] for end in taken])
+        near = set()
+        for found in self.tree.query_ball_point(probes[::4], self.search + 4 * PROBE):  # every fourth probe's
+            near.update(found)
+        skip = g if q is None else -1
+        stitches = set()
+        for i in near:
+            if not keep[i] or roles[i] != BODY or i == skip:
+                continue
+            for step in (-1, 1):  # the stitches at i: to its kept neighbours
+                j = self._neighbour(i, step, skip)
+                if j is not None and roles[j] == BODY:
+                    stitches.add((min(i, j), max(i, j)))
+        if not stitches:
+            return True
+        pairs = np.array(sorted(stitches))
+        a, b = points[pairs[:, 0]].copy(), points[pairs[:, 1]].copy()
+        if q is not None:
+            a[pairs[:, 0] == g], b[pairs[:, 1] == g] = q, q
+        ab = b - a
+        u = np.einsum("pkj,kj->pk", probes[:, None, :] - a[None], ab) / np.maximum(np.einsum("kj,kj->k", ab, ab), 1e-12)
+        foot = a[None] + np.clip(u, 0.0, 1.0)[..., None] * ab[None]
+        return bool(np.linalg.norm(probes[:, None, :] - foot, axis=2).min(axis=1).max() > self.cover + 1e-9)
+
+
+def _clear_holes(points, keep, roles, inward, side, sides, max_gap, bares) -> None:
     """In place: needles within HOLE_GAP (and a snap) of one of the last HOLE_WINDOW kept
-    ones on their side are inset clear of them, or left out (module doc)."""
+    ones on their side are inset clear of them, or the underlay holes they re-enter (under
+    the top) are left out, or they are left out themselves; a top point only where that
+    bares no ground (module doc)."""
     n = len(points)
     for row in _reentering(points, keep, side).tolist():
         if not keep[row] or roles[row] not in (BODY, UNDERLAY) or row in (0, n - 1) or \
@@ -193,12 +265,37 @@ def _clear_holes(points, keep, roles, inward, side, sides, max_gap) -> None:
         for share in STEPS if np.linalg.norm(inward[row]) > 1e-9 else ():
             q = points[row] + inward[row] * share
             q_side = int(sides(np.array([row]), q[None, :])[0])
-            if _clear(points, keep, side, row, q, q_side):
+            if _clear(points, keep, side, row, q, q_side) and not bares(row, q):
                 points[row], side[row] = q, q_side
                 break
         else:
-            if roles[row] == BODY or _gap_ok(points, keep, row, roles, max_gap):
+            if _leave_out_holes(points, keep, roles, side, row, max_gap):
+                continue
+            if (roles[row] == BODY and not bares(row, None)) or \
+                    (roles[row] == UNDERLAY and _gap_ok(points, keep, row, roles, max_gap)):
                 keep[row] = False
+
+
+def _leave_out_holes(points, keep, roles, side, row: int, max_gap: float) -> bool:
+    """Leave out the holes `row` re-enters (the kept needle points among the last
+    HOLE_WINDOW on its side within REENTER mm) when all are underlay points that may go
+    (`_gap_ok`); whether it did."""
+    holes, k = [], row - 1
+    seen = 0
+    while k >= 0 and seen < HOLE_WINDOW:
+        if keep[k]:
+            seen += 1
+            if side[k] == side[row] and np.hypot(*(points[k] - points[row])) < REENTER:
+                holes.append(k)
+        k -= 1
+    if not holes or any(roles[h] != UNDERLAY or h == 0 for h in holes):
+        return False
+    for k, h in enumerate(holes):
+        if not _gap_ok(points, keep, h, roles, max_gap):
+            keep[holes[:k]] = True
+            return False
+        keep[h] = False
+    return True
 
 
 def _reentering(points: np.ndarray, keep: np.ndarray, side: np.ndarray) -> np.ndarray:

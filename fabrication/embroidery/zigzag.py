@@ -223,7 +223,8 @@ def zigzag_stitch(stroke: Stroke, options: ZigzagOptions = ZigzagOptions()) -> N
     if straight_density(options.spacing, 2.0 * options.reach) <= DENSITY_LIMIT:
         points, keep = relieve_crowding(zig.points, zig.roles, room,
                                         lambda rows, at: stroke_sides(stroke, at, zig.t[rows]),
-                                        max_gap=2.0 * options.underlay_stitch_length, max_top_gap=2.0 * options.spacing)
+                                        max_gap=2.0 * options.underlay_stitch_length, max_top_gap=2.0 * options.spacing,
+                                        spacing=options.spacing)
         zig = NeedlePoints(points, zig.t, zig.roles).take(keep)
     return split_body(zig, options.max_stitch - 2 * SNAP_ALLOWANCE)
 
