@@ -6,7 +6,7 @@ rows crowd on a rail (inside a bend), every other crowded point ends short of it
 `short_stitch_inset` of the row's width (Ink/Stitch's short stitches: 15 % where points on a
 rail come closer than 0.25 mm); a point still within `min_gap` of one of the last two on its
 side (a needle entering a hole it made a moment before) is inset deeper, step by step, up
-to half the row's width. Stitches longer than `max_stitch` are split at staggered points
+to half the row's width, except a column's first and last point on each side. Stitches longer than `max_stitch` are split at staggered points
 (or at a random phase). `random_width` varies each row's reach on either side (seeded).
 
 Underlays (sewn first, each out and back so the top starts near where the column does, none
@@ -182,7 +182,10 @@ def _keep_holes_apart(points, rows: Rows, side, offset, step, width, min_gap) ->
     offset, side, step, width = (np.asarray(v, dtype=float).tolist() for v in (offset, side, step, width))
     hypot = np.hypot
     for i in todo.tolist():
-        if i < 2 or i == n - 1:
+        # A column's first and last point on each side keep their reach: its ends stay
+        # square (the last on the inside of a bend went as deep as the steps before it, and
+        # bared the column's end there: a slit).
+        if i < 2 or i >= n - 2:
             continue
         (ax, ay), (bx, by) = out[i - 2], out[i - 4] if i >= 4 else out[i - 2]
         here, stride, limit = offset[i], step[i], MAX_INSET * width[i]

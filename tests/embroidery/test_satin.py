@@ -243,6 +243,22 @@ def test_a_needle_re_entering_the_underlays_last_hole_leaves_that_hole_out_rathe
     assert gaps.min() >= REENTER  # and nothing re-enters a hole on its side
 
 
+@pytest.mark.parametrize("radius, width, sweep", [(3.0, 3.0, 180), (3.0, 3.0, 270), (2.0, 2.0, 180)])
+def test_a_columns_last_point_inside_a_bend_keeps_its_reach_so_the_end_is_not_slit(radius, width, sweep):
+    # Inside a bend the needle points crowd and step deeper one after another, up to half
+    # the row's width; the last one inside went as deep as its steps said and bared the end.
+    angle = np.radians(np.linspace(0.0, sweep, sweep // 5 + 1))
+    arc = Stroke.from_polyline(radius * np.c_[np.cos(angle), np.sin(angle)])
+    options = SatinOptions(width=width)
+    plan = plan_of(arc, options)
+    half = options.sewn_width(np.array([width]))[0] / 2
+    top = plan.points[(plan.kinds == STITCH) & (plan.roles == BODY)]
+    inside = top[np.linalg.norm(top, axis=1) < radius]
+    # at most a short stitch's inset (a share of the width) short of the rail, on the 0.1 mm grid
+    assert radius - np.linalg.norm(inside[-1]) >= half - options.short_stitch_inset * width - 0.1
+    assert slits(plan, 0, lambda s: np.full(len(s), half), options.spacing, inset=2 * options.short_stitch_inset) == []
+
+
 def test_the_varying_width_sets_capital_s_is_sewn_without_a_slit_where_it_hooks():
     # The broad-nib S of benchmarks/satin_quality.py: where the spine meets the lower bowl the
     # line runs up a spur and back and jogs 1 mm sideways through two rounded corners. The

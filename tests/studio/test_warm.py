@@ -8,7 +8,7 @@ import threading
 from pathlib import Path
 
 from fabrication.studio.session import StudioSession, Superseded
-from vectorize.edits import Edits
+from vectorize.refine.edits import Edits
 
 
 def test_neighbours_are_one_slider_step_away_in_the_direction_of_the_move(loop_png):
