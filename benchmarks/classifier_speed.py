@@ -49,8 +49,8 @@ def pipeline_part(count: int) -> None:
 def classifier_part() -> None:
     from benchmarks.sets.drawings import generate_set
     from benchmarks.common.render import render
-    from vectorize.cnn_classifier import CnnClassifier
-    from vectorize.intersections import Junction
+    from vectorize.junctions.cnn_classifier import CnnClassifier
+    from vectorize.junctions.intersections import Junction
 
     gt = generate_set("touch", 1)[0]
     gray = render(gt.drawing).astype(np.float32)

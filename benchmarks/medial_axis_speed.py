@@ -1,4 +1,4 @@
-"""Benchmark: the medial axis stage alone (`vectorize.medial_axis.medial_axis`), whole and in
+"""Benchmark: the medial axis stage alone (`vectorize.axis.medial_axis.medial_axis`), whole and in
 tiles.
 
 Run from the repo root: `python -m benchmarks.medial_axis_speed [DRAWING ...] [--tsp N]
@@ -71,10 +71,10 @@ def main(argv: list[str] | None = None) -> int:
         return rerun_on(args.source, __file__, sys.argv[1:] if argv is None else argv)
     from concurrent.futures import ThreadPoolExecutor
 
-    import vectorize.medial_axis as medial
-    from vectorize.binarize import binarize
-    from vectorize.image_io import load_image
-    from vectorize.outline import outline_rings
+    import vectorize.axis.medial_axis as medial
+    from vectorize.raster.binarize import binarize
+    from vectorize.raster.image_io import load_image
+    from vectorize.raster.outline import outline_rings
 
     tile_cpu: list[float] = []
 

@@ -25,7 +25,7 @@ import time
 
 import numpy as np
 
-from vectorize.graph import Branch, MedialGraph
+from vectorize.axis.graph import Branch, MedialGraph
 
 
 LONG_LINES = ("the kitten and the little duck hated the tall candle",
@@ -68,7 +68,7 @@ class _Timed:
     """Wraps `route_inspection.match_odd`, keeping (odd nodes, CPU s) per call."""
 
     def __init__(self) -> None:
-        import vectorize.route_inspection as ri
+        import vectorize.route.route_inspection as ri
 
         self.module, self.inner, self.calls = ri, ri.match_odd, []
         ri.match_odd = self
@@ -86,8 +86,8 @@ class _Timed:
 def synthetic(odd_targets: list[int], repeat: int) -> None:
     from scipy.sparse.csgraph import dijkstra
 
-    from vectorize.route_inspection import plan_routes
-    from vectorize.route_matching import SCALE, _blossom
+    from vectorize.route.route_inspection import plan_routes
+    from vectorize.route.route_matching import SCALE, _blossom
 
     print("1. word-like branch graphs (CPU s, medians):")
     print(f"   {'odd nodes':>9s} {'graphs':>6s} {'match_odd':>9s} {'blossom, all pairs':>18s} {'plan_routes':>11s}")

@@ -78,12 +78,12 @@ def _parts_child(source: str, output: str) -> None:
             importlib.import_module(module)
         mark(f"  {name}")
     from vectorize import VectorizeOptions, vectorize_image
-    from vectorize.image_io import load_image
+    from vectorize.raster.image_io import load_image
     from vectorize.svg_write import write_drawing
 
     importlib.import_module("vectorize.vectorizer")
     mark("  the project's modules")
-    from vectorize.classifiers import make_classifier
+    from vectorize.junctions.classifiers import make_classifier
 
     options = VectorizeOptions()
     make_classifier(options.classifier).session  # noqa: B018 - onnxruntime import and session

@@ -46,7 +46,7 @@ from starlette.testclient import TestClient
 
 from fabrication.studio.app import create_app
 from fabrication.studio.session import StudioSession
-from vectorize.edits import PAIRINGS, Edits
+from vectorize.refine.edits import PAIRINGS, Edits
 
 
 REPEATS = 7

@@ -105,7 +105,7 @@ def size_at_step_budget(session, step: float) -> float:
     work a preview in budget does."""
     from fabrication.placement import PlacementOptions, place
     from fabrication.studio.budgets import STEPS
-    from vectorize.edits import Edits
+    from vectorize.refine.edits import Edits
 
     drawing = session.vectorize(Edits()).drawing
     per_mm = sum(s.length for s in place(drawing, PlacementOptions(size=1000.0)).strokes) / 1000.0

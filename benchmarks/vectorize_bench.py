@@ -231,7 +231,7 @@ def whole_process(gts: list, timeout: float, classifier: str) -> None:
 
     from benchmarks.common.processes import child_cpu_seconds
     from benchmarks.common.user_install import bytecode_note
-    from vectorize.svg_read import read_svg
+    from vectorize.svg.svg_read import read_svg
 
     exe = shutil.which("onestroke")
     base = [exe] if exe else [sys.executable, "-c", "from fabrication.cli import main; main()"]
@@ -284,8 +284,8 @@ def junction_check(classifiers: list[str]) -> None:
     """Each classifier on crops centred at the ground-truth crossings, touches and
     near-touches of the generated sets, with branch directions measured on the ground truth
     3 widths out: how well it does when the pipeline's junction is exactly right."""
-    from vectorize.classifiers import make_classifier
-    from vectorize.intersections import Junction
+    from vectorize.junctions.classifiers import make_classifier
+    from vectorize.junctions.intersections import Junction
 
     labels = {}
     for name, gt in TASKS:

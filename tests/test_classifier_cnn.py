@@ -10,9 +10,9 @@ import sys
 import numpy as np
 import pytest
 
-from vectorize.cnn_classifier import DEFAULT_MODEL, CnnClassifier
-from vectorize.intersections import Junction
-from vectorize.junction_crop import dihedral_copies
+from vectorize.junctions.cnn_classifier import DEFAULT_MODEL, CnnClassifier
+from vectorize.junctions.intersections import Junction
+from vectorize.junctions.junction_crop import dihedral_copies
 from vectorize.training.synth import generate
 
 
@@ -89,7 +89,7 @@ def test_training_smoke_run(tmp_path, monkeypatch):
     from click.testing import CliRunner
 
     from fabrication.cli import main
-    from vectorize.cnn_classifier import DEFAULT_MODEL
+    from vectorize.junctions.cnn_classifier import DEFAULT_MODEL
 
     shipped = DEFAULT_MODEL.read_bytes()
     monkeypatch.chdir(tmp_path)

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from onestroke.errors import InputError
-from vectorize.junction_crop import CropSpec, crop_junctions, dihedral_copies
+from vectorize.junctions.junction_crop import CropSpec, crop_junctions, dihedral_copies
 
 
 def _cross_image(size=400, width=5.0):

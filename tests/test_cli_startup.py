@@ -12,7 +12,7 @@ import subprocess
 import sys
 from pathlib import Path
 
-from vectorize.svg_read import read_svg
+from vectorize.svg.svg_read import read_svg
 
 ROOT = Path(__file__).resolve().parents[1]
 DRAWING = ROOT / "examples" / "loops.png"  # 1000 x 600 px: no downscale at the default max_size
@@ -33,10 +33,10 @@ with open(listing, "w") as fh:
 
 # Not on the path of a plain `onestroke vectorize IN.png -o OUT.svg` with stderr in a pipe.
 # (xml.sax's saxutils would bring urllib.request, http.client and ssl; edits only with --edits.)
-NOT_IMPORTED = ("rich", "vectorize.debug_overlay", "vectorize.refine", "vectorize.pass_choices", "skimage.transform._warps", "skimage.filters._gaussian",
+NOT_IMPORTED = ("rich", "vectorize.debug_overlay", "vectorize.refine.refine", "vectorize.refine.pass_choices", "skimage.transform._warps", "skimage.filters._gaussian",
                 "fabrication.embroidery", "fabrication.laser", "fabrication.studio", "machines",
                 "pyembroidery", "svgelements", "torch", "xml.sax", "urllib.request", "http.client", "ssl",
-                "vectorize.edits")
+                "vectorize.refine.edits")
 
 
 def _run(tmp_path: Path, *args: str) -> tuple[dict, subprocess.CompletedProcess]:

@@ -177,9 +177,9 @@ def _png_input(folder):
 @pytest.mark.parametrize("classifier", ["geometric", "cnn"])
 def test_png_end_to_end(classifier, tmp_path, monkeypatch):
     if classifier == "cnn":
-        if importlib.util.find_spec("vectorize.cnn_classifier") is None:
+        if importlib.util.find_spec("vectorize.junctions.cnn_classifier") is None:
             pytest.skip("the CNN crossing classifier is not in the package yet")
-        from vectorize.cnn_classifier import DEFAULT_MODEL
+        from vectorize.junctions.cnn_classifier import DEFAULT_MODEL
 
         if not DEFAULT_MODEL.is_file():
             pytest.skip("the trained crossing model is not shipped yet")
@@ -201,7 +201,7 @@ def test_bundled_example_png_end_to_end(tmp_path, monkeypatch):
     example = Path(__file__).parents[1] / "examples" / "hershey-HersheySans1-ampersand.png"
     if not example.is_file():
         pytest.skip("examples/ has no ampersand drawing")
-    from vectorize.cnn_classifier import DEFAULT_MODEL
+    from vectorize.junctions.cnn_classifier import DEFAULT_MODEL
 
     if not DEFAULT_MODEL.is_file():
         pytest.skip("the trained crossing model is not shipped yet")

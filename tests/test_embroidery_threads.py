@@ -122,7 +122,7 @@ def test_three_svg_colours_give_three_threads_and_two_changes(svg, tmp_path, cha
 
 
 def test_strokes_of_one_colour_are_sewn_together(svg):
-    from vectorize.svg_read import read_svg
+    from vectorize.svg.svg_read import read_svg
 
     drawing = read_svg(svg).as_drawing()
     placed = Drawing(tuple(s.transformed(np.array([[0.5, 0, -25], [0, 0.5, -25]])) for s in drawing.strokes),

@@ -15,7 +15,7 @@ from click.testing import CliRunner
 
 from fabrication.cli import main
 from onestroke.errors import InputError
-from vectorize.svg_read import read_svg
+from vectorize.svg.svg_read import read_svg
 
 from benchmarks.hostile_cases import SVG_HEAD, WAVE, _comment, _nested_use
 

@@ -140,7 +140,7 @@ def test_failed_run_keeps_a_good_file(svg, tmp_path):
 
 @pytest.mark.parametrize("classifier", ["geometric", "cnn"])
 def test_png_end_to_end(tmp_path, classifier):
-    if classifier == "cnn" and importlib.util.find_spec("vectorize.cnn_classifier") is None:
+    if classifier == "cnn" and importlib.util.find_spec("vectorize.junctions.cnn_classifier") is None:
         pytest.skip("the CNN crossing classifier is not in the tree yet")
     png = trefoil_png(tmp_path / "trefoil.png")
     out = tmp_path / "trefoil.gcode"

@@ -30,8 +30,8 @@ from fabrication.placement import PlacementOptions
 from machines.emulator import EmulatorOptions
 from onestroke.errors import InputError
 from onestroke.ranges import Range, ranges_of
-from vectorize.edits import Edits, edits_from_dict
 from vectorize.options import VectorizeOptions
+from vectorize.refine.edits import Edits, edits_from_dict
 
 ROOT = Path(__file__).resolve().parents[1]
 OPTION_TYPES = [VectorizeOptions, Edits, PlacementOptions, RunningOptions, TripleOptions, ZigzagOptions,

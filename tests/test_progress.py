@@ -57,7 +57,7 @@ def test_stage_counts_up_to_total_in_a_bounded_number_of_reports():
 
 
 def test_reading_a_large_svg_reports_bytes_then_shapes(many):
-    from vectorize.svg_read import read_svg
+    from vectorize.svg.svg_read import read_svg
 
     reports: list[Progress] = []
     content = read_svg(many, progress=reports.append)
@@ -75,7 +75,7 @@ def test_embroidery_plan_reports_every_stroke(many):
     from fabrication.embroidery.pipeline import EmbroideryJob, embroider
     from fabrication.placement import PlacementOptions
     from machines.hoops import load_embroidery_profile
-    from vectorize.svg_read import read_svg
+    from vectorize.svg.svg_read import read_svg
 
     drawing = read_svg(many).as_drawing()
     job = EmbroideryJob(placement=PlacementOptions(size=180.0), hoop=load_embroidery_profile().hoop("200x200"))
@@ -89,7 +89,7 @@ def test_embroidery_plan_reports_every_stroke(many):
 def test_laser_program_reports_planning_writing_and_estimate(many):
     from fabrication.job_options import laser_settings
     from fabrication.laser.program import laser_program
-    from vectorize.svg_read import read_svg
+    from vectorize.svg.svg_read import read_svg
 
     drawing = read_svg(many).as_drawing()
     settings = laser_settings(size="180mm")
@@ -107,7 +107,7 @@ def test_laser_program_reports_planning_writing_and_estimate(many):
 def test_svg_paths_are_read_without_svgelements_exact_bbox(many, monkeypatch):
     """The exact bbox of svgelements cost more than reading the path: a path's control
     points bound it and are checked instead. Circles and other shapes still use it."""
-    from vectorize.svg_read import read_svg
+    from vectorize.svg.svg_read import read_svg
 
     calls = []
     original = se.Shape.bbox
@@ -129,7 +129,7 @@ def test_stitch_preview_draws_a_chain_of_stitches_in_one_call(tmp_path, monkeypa
     from fabrication.embroidery.preview import PreviewOptions, render_stitch_preview
     from fabrication.placement import PlacementOptions
     from machines.hoops import load_embroidery_profile
-    from vectorize.svg_read import read_svg
+    from vectorize.svg.svg_read import read_svg
 
     (tmp_path / "long.svg").write_text(long_path_svg(2000), encoding="utf-8")
     drawing = read_svg(tmp_path / "long.svg").as_drawing()
@@ -148,7 +148,7 @@ def test_laser_preview_draws_runs_of_one_colour_in_one_call(tmp_path, monkeypatc
     from fabrication.laser.gcode_write import write_gcode
     from fabrication.laser.preview import render_gcode_preview
     from fabrication.laser.program import laser_program
-    from vectorize.svg_read import read_svg
+    from vectorize.svg.svg_read import read_svg
 
     (tmp_path / "long.svg").write_text(long_path_svg(2000), encoding="utf-8")
     drawing = read_svg(tmp_path / "long.svg").as_drawing()

@@ -13,7 +13,7 @@ from fabrication.cli import main
 from fabrication.studio.app import MAX_BODY, create_app
 from fabrication.studio.session import StudioSession
 from tests.conftest import alpha_loop, render_polylines
-from vectorize.edits import PAIRINGS
+from vectorize.refine.edits import PAIRINGS
 
 HOST = "127.0.0.1:8765"
 TOKEN = "test-token-123"
@@ -323,8 +323,8 @@ def test_the_threshold_mask_is_the_binarization(client, drawing):
     import numpy as np
     from PIL import Image
 
-    from vectorize.binarize import ink_threshold, paper_gray
-    from vectorize.image_io import load_image
+    from vectorize.raster.binarize import ink_threshold, paper_gray
+    from vectorize.raster.image_io import load_image
 
     image, _ = load_image(str(drawing), max_size=1000)
     for query, threshold, blur in (("threshold=auto&blur=0", None, 0.0), ("threshold=0.6&blur=1.5", 0.6, 1.5)):

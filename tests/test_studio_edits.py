@@ -11,8 +11,8 @@ from click.testing import CliRunner
 from fabrication.cli import main
 from tests.conftest import alpha_loop, render_polylines
 from vectorize import VectorizeOptions, vectorize_file
-from vectorize.edits import PAIRINGS, Edit, Edits, edits_from_json
-from vectorize.refine import StageCache
+from vectorize.refine.edits import PAIRINGS, Edit, Edits, edits_from_json
+from vectorize.refine.refine import StageCache
 from vectorize.svg_write import drawing_to_svg
 
 OPTIONS = VectorizeOptions(classifier="geometric")
@@ -48,7 +48,7 @@ def test_passes_name_a_triple_points_branches_by_direction():
     a direction far from every branch, or a count that differs, matches nothing."""
     import numpy as np
 
-    from vectorize.pass_choices import as_angles, foot_angles, slots_of
+    from vectorize.refine.pass_choices import as_angles, foot_angles, slots_of
 
     angles = foot_angles(np.array([[np.cos(a), np.sin(a)] for a in np.radians([200, 20, 265, 85, 330, 150])]))
     assert angles.tolist() == [200.0, 20.0, 265.0, 85.0, 330.0, 150.0]

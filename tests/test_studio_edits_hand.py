@@ -11,8 +11,8 @@ import pytest
 
 from benchmarks.sets.hand_drawings import bench_drawing
 from vectorize import VectorizeOptions, vectorize_file
-from vectorize.edits import Edit, Edits
-from vectorize.refine import StageCache
+from vectorize.refine.edits import Edit, Edits
+from vectorize.refine.refine import StageCache
 from vectorize.svg_write import drawing_to_svg
 
 pytestmark = pytest.mark.slow

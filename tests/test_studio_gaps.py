@@ -15,8 +15,8 @@ from fabrication.studio.app import create_app
 from fabrication.studio.session import StudioSession
 from tests.conftest import render_polylines
 from vectorize import VectorizeOptions, vectorize_file
-from vectorize.edits import Edit, Edits
-from vectorize.refine import StageCache
+from vectorize.refine.edits import Edit, Edits
+from vectorize.refine.refine import StageCache
 from vectorize.svg_write import drawing_to_svg
 
 OPTIONS = VectorizeOptions(classifier="geometric")

@@ -9,7 +9,7 @@ from pathlib import Path
 
 from fabrication.studio.session import StudioSession, Superseded
 from tests.test_studio_edits import loop_png as drawing  # noqa: F401 (the same small drawing)
-from vectorize.edits import Edits
+from vectorize.refine.edits import Edits
 
 
 def test_neighbours_are_one_slider_step_away_in_the_direction_of_the_move(drawing):

@@ -13,7 +13,7 @@ from scipy import ndimage
 
 from tests.conftest import figure_eight, render_polylines
 from tests.test_vectorize_inputs import shaded_scan
-from vectorize.binarize import (
+from vectorize.raster.binarize import (
     blurred,
     downscaled_gray,
     estimate_stroke_width,
@@ -115,7 +115,7 @@ def _closing_flattened(gray: np.ndarray) -> np.ndarray:
 
 @pytest.mark.parametrize("name, page", _pages(), ids=[name for name, _ in _pages()])
 def test_flattened_paper_is_the_closing_divided_out(name, page):
-    from vectorize.binarize import flatten_paper, working_gray
+    from vectorize.raster.binarize import flatten_paper, working_gray
 
     for blur in (0.0, 1.5):
         gray, _ = working_gray(page, max_size=1000, blur=blur)
@@ -123,7 +123,7 @@ def test_flattened_paper_is_the_closing_divided_out(name, page):
 
 
 def test_a_window_holds_the_mask_where_the_maximum_filter_says_so():
-    from vectorize.binarize import in_every_window
+    from vectorize.raster.binarize import in_every_window
 
     rng = np.random.default_rng(5)
     found = 0
@@ -144,7 +144,7 @@ def test_a_window_holds_the_mask_where_the_maximum_filter_says_so():
 
 
 def test_the_paper_noise_floor_of_clean_paper_is_its_level():
-    from vectorize.binarize import paper_noise_floor
+    from vectorize.raster.binarize import paper_noise_floor
 
     def by_percentiles(gray):
         q25, median = np.percentile(gray, [25, 50])
@@ -223,7 +223,7 @@ def test_a_phone_photo_becomes_gray_row_block_by_row_block():
     # at once took two 144 MB copies on the way (a 3500 px photo peaked over 600 MB)
     import tracemalloc
 
-    from vectorize.binarize import GRAY_ROWS, _to_gray, to_gray
+    from vectorize.raster.binarize import GRAY_ROWS, _to_gray, to_gray
 
     rng = np.random.default_rng(0)
     small = (rng.random((GRAY_ROWS * 2 + 17, 50, 3)) * 255).astype(np.uint8)

@@ -3,7 +3,7 @@
 Where one pass of a shallow crossing curves more than the other, the merged node sits in
 the middle of the merged band, up to a width off the crossing, and a crop centred there
 shows two strokes side by side: the CNN said "touch" at these benchmark crossings (the
-route search happened to recover the order). `vectorize.crossing_point` centres the crop
+route search happened to recover the order). `vectorize.junctions.crossing_point` centres the crop
 where the two passes, fitted outside the merged ink, cross.
 """
 

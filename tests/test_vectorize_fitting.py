@@ -1,4 +1,4 @@
-"""Spline fitting on thinned points (`vectorize.fitting`): which points are fitted, how far
+"""Spline fitting on thinned points (`vectorize.fit.fitting`): which points are fitted, how far
 along the line each point is from an uncertain stretch, and that a weighted fit on one point
 per quarter width draws the curve the fit on every point draws."""
 
@@ -6,9 +6,8 @@ import numpy as np
 from scipy.interpolate import splev, splprep
 from scipy.spatial import cKDTree
 
-from vectorize.fitting import along_distance, fit_piece, thinned
-from vectorize.graph import arc_lengths
-from vectorize.stroke import Stroke
+from vectorize.fit.fitting import along_distance, fit_piece, thinned
+from vectorize.stroke import Stroke, arc_lengths
 
 
 def _wavy(count: int, step: float, noise: float, seed: int = 0) -> tuple[np.ndarray, np.ndarray]:

@@ -9,9 +9,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from vectorize.graph import Branch, MedialGraph, edge_lengths, lengths, measure_short
-from vectorize.image_io import load_image
+from vectorize.axis.graph import Branch, MedialGraph, measure_short
 from vectorize.options import VectorizeOptions
+from vectorize.raster.image_io import load_image
+from vectorize.stroke import edge_lengths, lengths
 from vectorize.vectorizer import _axis as axis_stages, _Clock
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
@@ -123,7 +124,7 @@ def test_joining_runs_at_once_is_joining_node_by_node(name):
 def test_pruned_axis_keeps_the_drawing_and_its_lengths_exact():
     """Pruning (bulk measures, joins at once) on a real drawing: branches still run node to
     node, every length is what the branch measures afresh, and copies keep the measures."""
-    from vectorize.pruning import prune
+    from vectorize.axis.pruning import prune
 
     graph, width = _axis("hershey-HersheySans1-ampersand.png")
     before = len(graph.branches)
@@ -141,8 +142,8 @@ def test_pruned_axis_keeps_the_drawing_and_its_lengths_exact():
 def test_slot_directions_from_kept_arc_lengths_are_the_direct_ones():
     """Directions at every junction of a pruned drawing, from the branches' kept arc lengths,
     equal the chord computed afresh from the points (numpy's norm, diff, cumsum, interp)."""
-    from vectorize.pruning import prune
-    from vectorize.simplify import slot_direction, slot_points, slots
+    from vectorize.axis.pruning import prune
+    from vectorize.axis.simplify import slot_direction, slot_points, slots
 
     graph, width = _axis("hershey-HersheySans1-ampersand.png")
     prune(graph, threshold=0.95, stroke_width=width)

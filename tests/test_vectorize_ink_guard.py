@@ -16,7 +16,7 @@ from benchmarks.common.render import render, to_uint8
 from tests.conftest import render_polylines
 from vectorize import VectorizeOptions, vectorize_image
 from vectorize.drawing import Drawing
-from vectorize.ink_guard import FLATNESS, MARGIN, STEP, InkGuard, curve_excess, curve_points, guard_margin
+from vectorize.fit.ink_guard import FLATNESS, MARGIN, STEP, InkGuard, curve_excess, curve_points, guard_margin
 from vectorize.stroke import Stroke
 
 

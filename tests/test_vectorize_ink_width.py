@@ -1,4 +1,4 @@
-"""The ink width along each stroke: measured by the vectorizer (vectorize/ink_width.py),
+"""The ink width along each stroke: measured by the vectorizer (vectorize/fit/ink_width.py),
 carried by `Stroke.widths` through reversal, transforms and re-cutting, written to and read
 back from SVG (`data-widths`) and JSON."""
 
@@ -14,7 +14,7 @@ from onestroke.errors import InputError
 from vectorize.drawing import Drawing
 from vectorize.pipeline import vectorize_image
 from vectorize.stroke import Stroke
-from vectorize.svg_read import read_svg
+from vectorize.svg.svg_read import read_svg
 from vectorize.svg_write import drawing_from_json, drawing_to_json, drawing_to_svg
 
 

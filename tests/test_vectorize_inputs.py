@@ -81,7 +81,7 @@ def test_huge_image_is_downscaled_and_says_so(tmp_path):
     result = run_cli("vectorize", path, "-o", out, "--classifier", "geometric")
     assert result.exit_code == 0, result.output
     assert "downscaled" in result.output and "8000x6000" in result.output
-    from vectorize.svg_read import read_svg
+    from vectorize.svg.svg_read import read_svg
 
     content = read_svg(out)
     assert (content.width, content.height) == (8000, 6000)
@@ -179,7 +179,7 @@ def test_unevenly_lit_scan_is_flattened_before_thresholding():
     from skimage.filters import threshold_li
 
     from vectorize import VectorizeOptions, vectorize_image
-    from vectorize.binarize import flatten_paper
+    from vectorize.raster.binarize import flatten_paper
 
     clean = render_polylines([figure_eight()], width=4.0)
     scan = shaded_scan(clean)

@@ -11,7 +11,7 @@ from benchmarks.metrics.table1 import drawing_polylines, polyline_intersections
 from benchmarks.common.render import render
 from vectorize import VectorizeOptions, vectorize_image
 from vectorize.drawing import Drawing
-from vectorize.retraces import retraced_runs
+from vectorize.fit.retraces import retraced_runs
 from vectorize.stroke import Stroke
 
 SIZE = 400

@@ -13,7 +13,7 @@ from benchmarks.common.render import render, to_uint8
 from benchmarks.sets.tsp_art import tsp_tour
 from vectorize import VectorizeOptions, vectorize_image
 from vectorize.drawing import Drawing
-from vectorize.fitting import sharp_corners
+from vectorize.fit.fitting import sharp_corners
 from vectorize.stroke import Stroke
 
 

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 from scipy.spatial import Voronoi
 
-from vectorize.voronoi import voronoi_part
+from vectorize.axis.voronoi import voronoi_part
 
 
 def _small(points: np.ndarray, vertices: np.ndarray, generator: int) -> bool:
@@ -60,8 +60,8 @@ def _ink(mask: np.ndarray) -> np.ndarray:
 
 
 def test_branches_run_from_node_to_node():
-    from vectorize.medial_axis import medial_axis
-    from vectorize.outline import outline_rings
+    from vectorize.axis.medial_axis import medial_axis
+    from vectorize.raster.outline import outline_rings
 
     yy, xx = np.mgrid[0:160, 0:160]
     ring = _ink(np.abs(np.hypot(xx - 80, yy - 80) - 50) < 4)
@@ -86,7 +86,7 @@ def test_branches_run_from_node_to_node():
 
 
 def test_chains_become_branches_and_a_closed_chain_is_one_loop():
-    from vectorize.medial_axis import _collapse_chains
+    from vectorize.axis.medial_axis import _collapse_chains
 
     # A Y (vertex 0 the junction, arms 0-1-2, 0-3, 0-4-5-6) and a separate cycle 7..11.
     edges = np.array([[0, 1], [1, 2], [3, 0], [0, 4], [5, 4], [5, 6], [8, 7], [8, 9], [9, 10], [10, 11], [11, 7]])
@@ -101,7 +101,7 @@ def test_chains_become_branches_and_a_closed_chain_is_one_loop():
 
 def test_an_axis_of_closed_chains_only_is_one_loop_each():
     """A clean ring's axis has no junction and no end: one node and one loop branch."""
-    from vectorize.medial_axis import _collapse_chains
+    from vectorize.axis.medial_axis import _collapse_chains
 
     edges = np.array([[0, 1], [1, 2], [2, 3], [3, 0], [5, 4], [6, 5], [4, 6]])
     xy = np.column_stack([np.arange(7.0), np.zeros(7)])

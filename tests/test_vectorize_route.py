@@ -12,7 +12,7 @@ from scipy.spatial import cKDTree
 
 from tests.conftest import render_polylines
 from vectorize import VectorizeOptions, vectorize_image
-from vectorize.route_matching import PRUNE_FROM, match_odd
+from vectorize.route.route_matching import PRUNE_FROM, match_odd
 
 OPTIONS = VectorizeOptions(classifier="geometric")
 WIDTH = 6.0

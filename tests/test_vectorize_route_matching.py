@@ -14,9 +14,9 @@ from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import dijkstra
 
 from benchmarks.route_matching_speed import word_graph
-from vectorize.graph import MedialGraph
-from vectorize.route_inspection import plan_routes
-from vectorize.route_matching import PRUNE_FROM, SCALE, _blossom, match_odd
+from vectorize.axis.graph import MedialGraph
+from vectorize.route.route_inspection import plan_routes
+from vectorize.route.route_matching import PRUNE_FROM, SCALE, _blossom, match_odd
 
 
 def _pairings(items: list[int]):

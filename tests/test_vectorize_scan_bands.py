@@ -1,4 +1,4 @@
-"""Huge scans are read a band at a time (vectorize/scan_bands.py): the result equals a full
+"""Huge scans are read a band at a time (vectorize/raster/scan_bands.py): the result equals a full
 decode followed by the conversion and box reduction the reader always did, and the memory
 used scales with a band and the reduced image, not with the input."""
 
@@ -15,7 +15,7 @@ from click.testing import CliRunner
 from PIL import Image, ImageDraw
 
 from fabrication.cli import main
-from vectorize import image_io, scan_bands
+from vectorize.raster import image_io, scan_bands
 
 
 def drawing(mode: str, size=(1003, 777), seed: int = 0) -> Image.Image:
@@ -114,7 +114,7 @@ def test_truncated_large_png_is_refused_in_one_line(tmp_path):
 
 PEAK = textwrap.dedent("""
     import sys
-    from vectorize import image_io
+    from vectorize.raster import image_io
     def status(key):
         return int(next(l.split()[1] for l in open("/proc/self/status") if l.startswith(key)))
     before = status("VmRSS:")

@@ -9,7 +9,7 @@ from scipy.spatial import cKDTree
 from onestroke.errors import InputError
 from vectorize.drawing import Drawing
 from vectorize.stroke import Stroke
-from vectorize.svg_read import read_svg
+from vectorize.svg.svg_read import read_svg
 from vectorize.svg_write import drawing_from_json, drawing_to_json, drawing_to_svg, write_drawing
 
 

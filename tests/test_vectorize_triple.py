@@ -12,10 +12,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from vectorize.clusters import merge_triple_points, straightest_pairs
+from vectorize.axis.clusters import merge_triple_points, straightest_pairs
+from vectorize.axis.simplify import directions
+from vectorize.junctions.pass_scorer import DEFAULT_MODEL, PAIRS, PassScorer, pair_feet
 from vectorize.options import VectorizeOptions
-from vectorize.pass_scorer import DEFAULT_MODEL, PAIRS, PassScorer, pair_feet
-from vectorize.simplify import directions
 from vectorize.training.pass_eval import node_truth, same_pairing
 from vectorize.training.triple_synth import render_scene
 from vectorize.vectorizer import _Clock, _front

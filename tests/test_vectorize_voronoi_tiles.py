@@ -9,12 +9,12 @@ import numpy as np
 import pytest
 from scipy.spatial import Voronoi
 
-import vectorize.medial_axis as medial
-import vectorize.voronoi as voronoi
-from vectorize.binarize import binarize
-from vectorize.image_io import load_image
-from vectorize.medial_axis import _inside, medial_axis
-from vectorize.outline import outline_rings
+import vectorize.axis.medial_axis as medial
+import vectorize.axis.voronoi as voronoi
+from vectorize.axis.medial_axis import _inside, medial_axis
+from vectorize.raster.binarize import binarize
+from vectorize.raster.image_io import load_image
+from vectorize.raster.outline import outline_rings
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 

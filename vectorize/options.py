@@ -33,7 +33,7 @@ class VectorizeOptions:
     threshold: gray level in (0, 1) below which a pixel is ink (None: Li's method).
     blur: Gaussian sigma in px applied before thresholding (0: none), 0-25 px.
     classifier: "cnn" (shipped model), "geometric" (tangent continuity), or any object with
-        the `vectorize.intersections.IntersectionClassifier` method `classify`.
+        the `vectorize.junctions.intersections.IntersectionClassifier` method `classify`.
     max_size: longest side of the working image in px; larger inputs are downscaled.
     seed: seed of every random choice (retry search ties), for reproducible output.
     max_odd_nodes: refuse (`InputError`, after simplification) a graph with more odd-degree
@@ -96,7 +96,7 @@ class VectorizeReport:
 @dataclass(frozen=True)
 class VectorizeResult:
     """The drawing (px, in the input image's frame) and the report; `stages` for --debug;
-    `graph`: the junctions and branches the edits act on (`vectorize.refine.GraphView`),
+    `graph`: the junctions and branches the edits act on (`vectorize.refine.refine.GraphView`),
     when the run was given edits or a stage cache."""
 
     drawing: Drawing

@@ -24,7 +24,7 @@ def vectorize_file(path: str | os.PathLike, options: VectorizeOptions = Vectoriz
                    edits=None, cache=None, progress=None) -> VectorizeResult:
     """Vectorize a raster image or read an SVG (strokes as they are; outlines to centre lines).
 
-    edits: a `vectorize.edits.Edits` to apply; cache: a `vectorize.refine.StageCache`
+    edits: a `vectorize.refine.edits.Edits` to apply; cache: a `vectorize.refine.refine.StageCache`
     reused between calls on the same file (each edit then re-runs only later stages).
     progress: an `onestroke.progress.ProgressCallback` for reading a large SVG.
     """
@@ -42,7 +42,7 @@ def _raster(path: str, options: VectorizeOptions, cache=None):
     """(image, frame) of a raster file, read once per cache."""
     if cache is not None and cache.loaded is not None and cache.loaded[0] == (path, options.max_size):
         return cache.loaded[1]
-    from vectorize.image_io import load_image
+    from vectorize.raster.image_io import load_image
 
     image, frame = load_image(path, max_size=options.max_size)
     if cache is not None:
@@ -66,12 +66,12 @@ def threshold_mask_file(path: str | os.PathLike, options: VectorizeOptions = Vec
 
 def _vectorize_svg(path: str, options: VectorizeOptions, edits=None, cache=None,
                    progress=None) -> VectorizeResult:
-    from vectorize.svg_read import read_svg
+    from vectorize.svg.svg_read import read_svg
 
     start = time.perf_counter()
     content = read_svg(path, progress=progress)
     if content.is_outline:
-        from vectorize.outline_svg import rasterize_rings
+        from vectorize.svg.outline_svg import rasterize_rings
 
         gray, scale, offset = rasterize_rings(content.outline_rings, size=options.max_size)
         frame = InputFrame(scale, (float(offset[0]), float(offset[1])), content.width, content.height)

@@ -9,32 +9,32 @@ from typing import TYPE_CHECKING, NamedTuple
 import numpy as np
 
 from onestroke.errors import InputError
-from vectorize.binarize import downscaled_gray, ink_image, ink_threshold, paper_gray
+from vectorize.axis.clusters import merge_triple_points, straightest_pairs
+from vectorize.axis.gaps import bridge_gaps, keep_largest_piece
+from vectorize.axis.graph import MedialGraph
+from vectorize.axis.medial_axis import medial_axis
+from vectorize.axis.pruning import prune, trim_free_ends
+from vectorize.axis.simplify import Simplified, directions, simplify, slots
 from vectorize.drawing import Drawing
-from vectorize.gaps import bridge_gaps, keep_largest_piece
-from vectorize.graph import MedialGraph, lengths
-from vectorize.ink_guard import InkGuard, guard_margin
-from vectorize.ink_width import edge_offset, ink_widths
-from vectorize.classifiers import make_classifier, shipped_pass_scorer
-from vectorize.clusters import merge_triple_points, straightest_pairs
-from vectorize.crossing_point import crossing_point
-from vectorize.intersections import Junction, JunctionVerdict, ranked_pairings
-from vectorize.medial_axis import medial_axis
-from vectorize.outline import outline_rings
+from vectorize.fit.ink_guard import InkGuard, guard_margin
+from vectorize.fit.ink_width import edge_offset, ink_widths
+from vectorize.fit.retraces import Twin, foot_is_retraced, twin_spans
+from vectorize.junctions.classifiers import make_classifier, shipped_pass_scorer
+from vectorize.junctions.crossing_point import crossing_point
+from vectorize.junctions.intersections import Junction, JunctionVerdict, ranked_pairings
 from vectorize.options import InputFrame, VectorizeOptions, VectorizeReport, VectorizeResult
 from vectorize.preload import preload, wait
-from vectorize.pruning import prune, trim_free_ends
-from vectorize.retraces import Twin, foot_is_retraced, twin_spans
-from vectorize.route_ends import end_costs
-from vectorize.route_inspection import connect_pairings, plan_routes
-from vectorize.simplify import Simplified, directions, simplify, slots
-from vectorize.stroke import Stroke
-from vectorize.traversal import Ordering, order_strokes
+from vectorize.raster.binarize import downscaled_gray, ink_image, ink_threshold, paper_gray
+from vectorize.raster.outline import outline_rings
+from vectorize.route.route_ends import end_costs
+from vectorize.route.route_inspection import connect_pairings, plan_routes
+from vectorize.route.traversal import Ordering, order_strokes
+from vectorize.stroke import Stroke, lengths
 
 if TYPE_CHECKING:  # the studio's refinement is imported where edits or a session ask for it
-    from vectorize.edits import Edits
-    from vectorize.fitting import TracedPoints
-    from vectorize.refine import Refinement, StageCache
+    from vectorize.fit.fitting import TracedPoints
+    from vectorize.refine.edits import Edits
+    from vectorize.refine.refine import Refinement, StageCache
 
 # Vanishing-angle thresholds (notes: 0.95 single-line, 0.90 multi-line).
 PRUNE_SINGLE, PRUNE_MULTI = 0.95, 0.90
@@ -123,7 +123,7 @@ def _pair_through(graph: MedialGraph, nodes, gray: np.ndarray, w: float,
     scorer = shipped_pass_scorer() if six and getattr(make_classifier(options.classifier), "name", "") == "cnn" else None
     posterior = {}
     if six and scorer is not None:
-        from vectorize.pass_scorer import scored_pairings
+        from vectorize.junctions.pass_scorer import scored_pairings
 
         centers = np.array([graph.positions[n] for n in six])
         for node, (pick, odds) in zip(six, scored_pairings(gray, centers, [feet[n] for n in six], w, scorer)):
@@ -142,15 +142,15 @@ def _pairing_costs(verdict: JunctionVerdict) -> tuple[float, float, float]:
 def _trace(graph: MedialGraph, simple: Simplified, ordering: Ordering, junctions: dict,
            verdicts: dict, stroke_width: float) -> list[tuple[TracedPoints, bool, list[Twin]]]:
     """Turn branch passes into point lists flagged for filtering (paper 3.4), with the
-    stretches each stroke draws twice (`vectorize.retraces`)."""
+    stretches each stroke draws twice (`vectorize.fit.retraces`)."""
     wait("fitting")
-    from vectorize.fitting import TracedPoints
+    from vectorize.fit.fitting import TracedPoints
 
     # V-spikes: the foot is where both sides' inks merge, its points are uncertain; the
     # sides run straight to the tip. Retraced (T) spikes: the foot is the spike itself,
     # its points are good, and the line turns sharply at both of its ends.
     # V-spikes whose foot runs on far beyond the corner are a line drawn down and back up:
-    # there the foot is the centre line both passes follow (`vectorize.retraces`).
+    # there the foot is the centre line both passes follow (`vectorize.fit.retraces`).
     foot_branches = {slots(graph, n)[f][0] for n, f in simple.y_feet.items()
                      if n not in simple.retraced and not foot_is_retraced(graph, n, f, stroke_width)}
     sharp_points = [graph.positions[n] for n in simple.retraced]
@@ -357,7 +357,7 @@ def _axis(image: np.ndarray, options: VectorizeOptions, clock: _Clock, cache: St
     ink = ink_image(gray, scale, threshold=options.threshold)
     clock.lap("binarize")
     # The fitting's libraries (scipy.interpolate: FITPACK) load beside the next stages.
-    preload("fitting", ("vectorize.fitting",))
+    preload("fitting", ("vectorize.fit.fitting",))
     w = ink.stroke_width
     spacing = float(np.clip(w / 8.0, 0.3, 1.0))
     rings = outline_rings(ink.gray, ink.threshold, spacing)
@@ -388,7 +388,7 @@ def _front(image: np.ndarray, options: VectorizeOptions, clock: _Clock, cache: S
     that only threshold, blur and mode change (and the edits' "unbridge" positions, in
     `frame`). Returns (ink, rings, graph, bridges, dropped, unbridged), bridges: the pen
     gaps bridged, each as its two ends (working px); unbridged: the bridges the edits
-    refused (`vectorize.refine.Unbridging.refused`).
+    refused (`vectorize.refine.refine.Unbridging.refused`).
 
     With `cache`, the stages before pruning are shared between the modes (a copy of the
     cached graph is pruned) and the paper-flattened gray between thresholds."""
@@ -407,13 +407,13 @@ def _front(image: np.ndarray, options: VectorizeOptions, clock: _Clock, cache: S
                   options.threshold is not None)
     if branch_points and options.classifier == "cnn":
         # Junctions to classify: onnxruntime and the model's session load beside the next stages.
-        preload("cnn", ("vectorize.cnn_classifier",), lambda: make_classifier("cnn").session)
+        preload("cnn", ("vectorize.junctions.cnn_classifier",), lambda: make_classifier("cnn").session)
     bridges: list = []
     dropped = 0
     refuse = None
     if not options.multi:
         if edits is not None and edits.of("unbridge"):
-            from vectorize.refine import Unbridging
+            from vectorize.refine.refine import Unbridging
 
             refuse = Unbridging(edits, output_matrix(ink.scale, frame or _pixel_frame(image)))
         bridge_gaps(graph, stroke_width=w, made=bridges, refuse=refuse)
@@ -437,7 +437,7 @@ def run_pipeline(image: np.ndarray, options: VectorizeOptions, *,
                  cache: StageCache | None = None) -> VectorizeResult:
     """Vectorize `image`; the drawing comes out in `frame` (default: the image's pixels).
 
-    edits: the user's corrections (`vectorize.edits`); cache: a `StageCache` kept between
+    edits: the user's corrections (`vectorize.refine.edits`); cache: a `StageCache` kept between
     calls on the same image, so that an edit re-runs only the stages after it.
     """
     clock = _Clock(cache.checkpoint if cache is not None else None)
@@ -447,8 +447,8 @@ def run_pipeline(image: np.ndarray, options: VectorizeOptions, *,
     refining = edits is not None or cache is not None
     if refining:
         # Only the studio and --edits refine: a plain run never imports (or compiles) it.
-        from vectorize.edits import Edits
-        from vectorize.refine import Refinement, StageCache
+        from vectorize.refine.edits import Edits
+        from vectorize.refine.refine import Refinement, StageCache
 
         edits = edits if edits is not None else Edits()
         options = edits.applied_to(options)
@@ -488,7 +488,7 @@ def run_pipeline(image: np.ndarray, options: VectorizeOptions, *,
                       if len(incident) >= 3]).reshape(-1, 3)
     strokes = list(solved[1]) if solved is not None else []
     wait("fitting")
-    from vectorize.fitting import fit_stroke
+    from vectorize.fit.fitting import fit_stroke
 
     for traced, closed, twins in _trace(graph, simple, ordering, junctions, verdicts, w) if solved is None else ():
         if len(traced) < 2:

@@ -32,7 +32,7 @@ from scipy.sparse.csgraph import dijkstra
 from scipy.spatial import cKDTree
 
 from vectorize.drawing import Drawing
-from vectorize.graph import arc_lengths
+from vectorize.stroke import arc_lengths
 
 EXCURSION_SLACK = 1.0  # px added to half the width: the acceptance bound of the excursion
 CENTRE_SPACING = 0.25  # px between ground-truth centre-line samples (distance error < 0.01 px)

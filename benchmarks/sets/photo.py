@@ -32,8 +32,7 @@ from benchmarks.common.render import through_jpeg
 from benchmarks.metrics.ground_truth import CANVAS, MARGIN, GroundTruth
 from benchmarks.metrics.table1 import FLATTEN_TOLERANCE
 from vectorize.drawing import Drawing
-from vectorize.graph import arc_lengths
-from vectorize.stroke import Stroke
+from vectorize.stroke import Stroke, arc_lengths
 
 TILT = 0.04  # largest corner move, share of the canvas side
 

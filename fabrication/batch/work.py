@@ -126,7 +126,7 @@ def warm_up(job: BatchJob, *, ignore_interrupt: bool = True, parent: int | None 
         import vectorize.vectorizer  # noqa: F401
 
         if job.vectorize.classifier == "cnn":
-            from vectorize.cnn_classifier import CnnClassifier
+            from vectorize.junctions.cnn_classifier import CnnClassifier
 
             CnnClassifier().session  # noqa: B018  (creates the cached onnxruntime session)
     except Exception:  # noqa: BLE001 - only a head start: each drawing's own run reports the error

@@ -176,7 +176,7 @@ def read_drawing(path: str, *, multi: bool = False, threshold: float | None = No
     progress callback (`step`).
     """
     from vectorize import VectorizeOptions, vectorize_file
-    from vectorize.edits import read_edits
+    from vectorize.refine.edits import read_edits
 
     replay = read_edits(edits) if edits is not None else None
     result = vectorize_file(path, VectorizeOptions(multi=multi, threshold=threshold, blur=blur,

@@ -84,7 +84,7 @@ def train_classifier(seed: int, samples: int, epochs: int, batch: int, lr: float
 @click.option("--model", type=InputFile(), default=None, help="ONNX model; default: the shipped one.")
 def validate_classifier(seed: int, count: int, workers: int, model: Path | None) -> None:
     """Accuracy of the CNN on freshly generated crops (onnxruntime, 8-fold augmentation)."""
-    from vectorize.cnn_classifier import DEFAULT_MODEL
+    from vectorize.junctions.cnn_classifier import DEFAULT_MODEL
     from vectorize.training.validate import evaluate_onnx
 
     click.echo(json.dumps(evaluate_onnx(model or DEFAULT_MODEL, count=count, seed=seed, workers=workers),

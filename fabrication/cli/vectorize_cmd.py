@@ -53,7 +53,7 @@ def vectorize(source: str, output: str, multi: bool, threshold: float | None, bl
         placement = PlacementOptions(size=size, width=width, height=height, rotate=rotate)
     replay = None
     if edits is not None:  # the edits module only when there are edits to replay
-        from vectorize.edits import read_edits
+        from vectorize.refine.edits import read_edits
 
         replay = read_edits(edits)
     started = time.perf_counter()

@@ -21,7 +21,7 @@ from fabrication.embroidery.needles import STITCH
 from fabrication.embroidery.quality import DENSITY_LIMIT, DENSITY_RADIUS
 from onestroke.errors import InputError
 from onestroke.ranges import Range, check_ranges, ranged
-from vectorize.graph import arc_lengths
+from vectorize.stroke import arc_lengths
 
 # Positions of the lock's needle points, as fractions of the lock length back from the
 # end of the path. Consecutive entries differ, so no lock stitch has zero length.

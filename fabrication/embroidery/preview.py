@@ -24,7 +24,7 @@ from machines.hoops import Hoop
 from onestroke.errors import InputError
 from onestroke.ranges import Range, check_ranges, ranged
 from vectorize.drawing import Drawing
-from vectorize.graph import arc_lengths
+from vectorize.stroke import arc_lengths
 
 THREAD_WIDTH = 0.35  # mm: a 40 wt embroidery thread
 # Thread is drawn slightly see-through so that layers sewn over each other (triple stitch,

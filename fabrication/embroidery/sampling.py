@@ -11,8 +11,7 @@ from functools import cached_property
 
 import numpy as np
 
-from vectorize.graph import arc_lengths
-from vectorize.stroke import Stroke
+from vectorize.stroke import Stroke, arc_lengths
 
 
 @dataclass(frozen=True, eq=False)

@@ -32,7 +32,7 @@ from starlette.routing import Route
 
 from fabrication.studio.session import StudioSession, Superseded
 from onestroke.errors import InputError, OnestrokeError
-from vectorize.edits import Edits, edits_from_dict
+from vectorize.refine.edits import Edits, edits_from_dict
 
 MAX_BODY = 1 << 20  # 1 MiB: an edits list and option values are a few kB
 COOKIE = "onestroke_studio"  # + a digest of the token: cookies ignore ports, two studios must not mix

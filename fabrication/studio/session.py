@@ -21,8 +21,8 @@ from fabrication.studio import budgets
 from onestroke.atomic import atomic_write_text
 from onestroke.errors import Cancelled, InputError, OnestrokeError
 from vectorize import VectorizeOptions, vectorize_file
-from vectorize.edits import Edits, edits_from_dict, read_edits
-from vectorize.refine import StageCache
+from vectorize.refine.edits import Edits, edits_from_dict, read_edits
+from vectorize.refine.refine import StageCache
 
 EMBROIDERY_FORMATS = ("pes", "dst", "jef", "exp", "vp3")
 # Page fields -> embroidery_settings / laser_settings keywords (the CLI's option names).

@@ -1,6 +1,6 @@
 """The crossing-vs-touching network: a small CNN (about 63k parameters).
 
-Input (N, 2, S, S) float: the near and far junction crops of `vectorize.junction_crop`.
+Input (N, 2, S, S) float: the near and far junction crops of `vectorize.junctions.junction_crop`.
 Output (N,) probability that the two strokes cross. Needs PyTorch (the `train` extra);
 inference uses the exported ONNX file through onnxruntime only.
 """
@@ -26,7 +26,7 @@ class CrossingNet(nn.Module):
     drawing run on a CPU in a few milliseconds.
 
     The pass scorer of triple points is the same design on its 4-channel 32 px crops
-    (`vectorize.pass_crop`): `pass_net()`."""
+    (`vectorize.junctions.pass_crop`): `pass_net()`."""
 
     def __init__(self, channels: tuple[int, ...] = (24, 32, 64, 64), inputs: int = 2) -> None:
         super().__init__()

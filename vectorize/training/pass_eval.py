@@ -21,9 +21,9 @@ import numpy as np
 from scipy.optimize import minimize
 from scipy.special import logsumexp
 
-from vectorize.clusters import Pairs, merge_triple_points, straightest_pairs
-from vectorize.pass_scorer import PAIRING_INDEX, PAIRS, PassScorer, best_pairing, log_odds
-from vectorize.simplify import directions, slot_points, slots
+from vectorize.axis.clusters import Pairs, merge_triple_points, straightest_pairs
+from vectorize.axis.simplify import directions, slot_points, slots
+from vectorize.junctions.pass_scorer import PAIRING_INDEX, PAIRS, PassScorer, best_pairing, log_odds
 from vectorize.training.triple_synth import TripleScene, generate_passes, render_scene
 
 METHODS = ("continuation", "image", "combined")

@@ -23,7 +23,7 @@ from concurrent.futures import ProcessPoolExecutor
 import numpy as np
 from scipy import ndimage
 
-from vectorize.junction_crop import CropSpec, crop_junctions
+from vectorize.junctions.junction_crop import CropSpec, crop_junctions
 
 SUBTYPES = ("shallow_crossing", "steep_crossing", "exact_touch", "near_touch")
 CHUNK = 256  # samples per independently seeded chunk: output does not depend on workers

@@ -22,7 +22,7 @@ import torch
 from torch import nn
 
 from onestroke.atomic import atomic_write_bytes, atomic_write_text
-from vectorize.junction_crop import CropSpec
+from vectorize.junctions.junction_crop import CropSpec
 from vectorize.training.model import CrossingNet, Probability
 from vectorize.training.synth import SUBTYPES, generate
 from vectorize.training.validate import evaluate_onnx
@@ -146,7 +146,7 @@ A small CNN that tells, at a degree-4 node of a single-line drawing's medial axi
 whether the two strokes cross (go straight over) or touch and turn back.
 
 - Input `crops`: (N, 2, {meta['crop']['size']}, {meta['crop']['size']}) float32, the near ({meta['crop']['near_span']} w)
-  and far ({meta['crop']['far_span']} w) crops of `vectorize.junction_crop.crop_junctions`, ink = 1, paper = 0.
+  and far ({meta['crop']['far_span']} w) crops of `vectorize.junctions.junction_crop.crop_junctions`, ink = 1, paper = 0.
 - Output `p_crossing`: (N,) probability of a crossing.
 - Parameters: {meta['parameters']:,}; file size {meta['bytes']:,} bytes; sha256 `{meta['sha256']}`.
 - Training data: {meta['training']['train_samples']:,} synthetic crops (`vectorize.training.synth`, seed

@@ -23,7 +23,7 @@ import torch
 from torch import nn
 
 from onestroke.atomic import atomic_write_text
-from vectorize.pass_crop import PassCropSpec
+from vectorize.junctions.pass_crop import PassCropSpec
 from vectorize.training.model import pass_net
 from vectorize.training.pass_eval import evaluate_pairing, fit_combination
 from vectorize.training.train import base_meta, crop_tensors, export_onnx, fit, seeded_start
@@ -69,12 +69,12 @@ def model_card(meta: dict) -> str:
     return f"""# Pass scorer of triple points (`pass_cnn.onnx`)
 
 A small CNN that tells, at a node where three passes of a single-line drawing cross (six
-branch feet, `vectorize.clusters`), whether a candidate pass (two feet) is one the pen
+branch feet, `vectorize.axis.clusters`), whether a candidate pass (two feet) is one the pen
 drew straight through. The vectorizer pairs the six feet by the pairing whose three passes
-score best, adding the image's log-odds and the continuation cost (`vectorize.pass_scorer`).
+score best, adding the image's log-odds and the continuation cost (`vectorize.junctions.pass_scorer`).
 
 - Input `crops`: (N, 4, {meta['crop']['size']}, {meta['crop']['size']}) float32 from
-  `vectorize.pass_crop.crop_passes`: ink and the candidate's two rays, {meta['crop']['near_span']} and
+  `vectorize.junctions.pass_crop.crop_passes`: ink and the candidate's two rays, {meta['crop']['near_span']} and
   {meta['crop']['far_span']} stroke widths wide, rotated so the candidate runs along +x.
 - Output `p_pass`: (N,) probability that the candidate is a true pass.
 - Parameters: {meta['parameters']:,}; file size {meta['bytes']:,} bytes; sha256 `{meta['sha256']}`.

@@ -20,8 +20,8 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import ndimage
 
-from vectorize.pass_crop import PassCropSpec, crop_passes
-from vectorize.pass_scorer import PAIRS
+from vectorize.junctions.pass_crop import PassCropSpec, crop_passes
+from vectorize.junctions.pass_scorer import PAIRS
 from vectorize.training.synth import _coverage, _curve, _smooth_noise, seeded_chunks
 
 CHUNK = 64  # scenes per independently seeded chunk: output does not depend on workers

@@ -14,7 +14,7 @@ from vectorize.training.synth import SUBTYPES, generate
 
 def evaluate_onnx(model_path: str | os.PathLike, *, count: int, seed: int, workers: int = 1) -> dict:
     """Overall, per-class and per-sub-type accuracy with 8-fold test-time augmentation."""
-    from vectorize.cnn_classifier import CnnClassifier
+    from vectorize.junctions.cnn_classifier import CnnClassifier
 
     data = generate(count, seed=seed, workers=workers)
     classifier = CnnClassifier(model_path, check_hash=False)

@@ -1,0 +1,446 @@
+"""Curve fitting (paper 3.4): filter uncertain points, split at sharp features, fit cubic
+B-splines with `scipy.interpolate.splprep`, and convert them to Bézier segments."""
+
+from __future__ import annotations
+
+import bisect
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.interpolate import splev, splprep
+
+from vectorize.fit.ink_guard import MARGIN, STEP, InkGuard, curve_excess, keep_in_ink
+from vectorize.fit.retraces import (
+    Twin,
+    mirror_flags,
+    mirror_keep,
+    rolled,
+    share_pieces,
+    twin_piece,
+    valid_twins,
+)
+from vectorize.stroke import Stroke, arc_lengths, edge_lengths
+
+
+# The first fit of a piece takes about one traced point per THIN stroke widths of arc
+# length (`thinned`), and every point within DENSE widths of an uncertain stretch.
+THIN = 0.3
+# ... and at most THIN_MAX px: a thick line's tight bend needs its points as much as a thin
+# line's (on a 2.4 px grid the 8 px filled-outline figure eight came 1 px off at its bend).
+THIN_MAX = 1.5
+# Only pieces of more points than this are thinned: FITPACK's time is in the long ones.
+THIN_FROM = 2000
+DENSE = 3.0
+
+
+@dataclass(frozen=True, kw_only=True)
+class TracedPoints:
+    """The points of a traversed stroke with what the filter needs to know about each, as
+    arrays (a stroke has thousands of points: one object per point cost more than the fit).
+
+    xy: (N, 2) px; keep: (N,) bool, keep the point for the fit; split: (N,) bool, split the
+    fit there; corner: (N,) bool or None (none), a corner (split, and the joint goes where
+    the two sides' tangents meet); radius: (N,) px, the medial axis's distance to the
+    outline at each point (half the ink width), or None (unknown).
+    """
+
+    xy: np.ndarray
+    keep: np.ndarray
+    split: np.ndarray
+    corner: np.ndarray | None = None
+    radius: np.ndarray | None = None
+
+    def __len__(self) -> int:
+        return len(self.xy)
+
+
+def _distinct(points: np.ndarray, min_step: float) -> np.ndarray:
+    """Indices of the points to keep when those closer than `min_step` to the previous kept
+    one are dropped (splprep needs distinct points); the last point is always kept."""
+    n = len(points)
+    if n < 2:
+        return np.arange(n)
+    steps = edge_lengths(points)
+    keep = np.ones(n, dtype=bool)
+    # A point is measured from the last kept one, which is its predecessor unless that one
+    # was dropped: only the runs that start with a short step need walking point by point.
+    done = 0
+    for i in (np.flatnonzero(steps < min_step) + 1).tolist():
+        if i <= done:
+            continue
+        last = i - 1
+        while i < n and np.linalg.norm(points[i] - points[last]) < min_step:
+            keep[i] = False
+            i += 1
+        done = i
+    kept = np.flatnonzero(keep)
+    if kept[-1] != n - 1 and np.linalg.norm(points[-1] - points[kept[-1]]) > 1e-9:
+        kept[-1] = n - 1
+    return kept
+
+
+def bspline_to_bezier(tck, u_start: float, u_end: float) -> np.ndarray:
+    """Bézier control points (K, 4, 2) of a parametric cubic spline between two parameters.
+
+    Each knot span of a cubic spline is one cubic polynomial, so its Bézier form follows
+    exactly from the end points and end derivatives (Hermite to Bézier); this works for
+    periodic splines as well as open ones.
+    """
+    knots = np.unique(tck[0])
+    breaks = np.unique(np.concatenate([[u_start, u_end], knots[(knots > u_start) & (knots < u_end)]]))
+    a, b = breaks[:-1], breaks[1:]
+    # Evaluate just inside each span so the derivative belongs to that span's polynomial.
+    pa = np.array(splev(a, tck)).T
+    pb = np.array(splev(b, tck)).T
+    da = np.array(splev(a, tck, der=1)).T
+    db = np.array(splev(b, tck, der=1)).T
+    h = (b - a)[:, None] / 3.0
+    return np.stack([pa, pa + h * da, pb - h * db, pb], axis=1)
+
+
+def thinned(points: np.ndarray, spacing: float, dense: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """The points of an (N, 2) ordered line to fit, and how many of its points each stands for.
+
+    Returns (indices (M,) ascending, counts (M,) summing to N). Kept: the first and the last
+    point, every point where `dense` ((N,) bool) says so, and where the line crosses a line
+    of a `spacing` px grid, the point of the two beside it on the grid line's far side (about
+    1.3 points per `spacing` px). The choice hangs on the points alone, not on where the line
+    starts or which way it runs: the two passes of a retrace, fitted apart on the same
+    centre-line points, get the same points and lie on each other instead of weaving across.
+    Each point stands for the points halfway to its kept neighbours. spacing 0: every point.
+    """
+    n = len(points)
+    if n < 3 or spacing <= 0.0:
+        return np.arange(n), np.ones(n)
+    cells = np.floor(points / spacing)
+    keep = np.zeros(n, dtype=bool)
+    keep[[0, -1]] = True
+    if dense is not None:
+        keep |= dense
+    for axis in (0, 1):
+        crossed = np.flatnonzero(cells[1:, axis] != cells[:-1, axis])
+        far = points[crossed + 1, axis] > points[crossed, axis]
+        keep[np.where(far, crossed + 1, crossed)] = True
+    kept = np.flatnonzero(keep)
+    # point i stands for [i - 1/2, i + 1/2]: the same counts either way along the line
+    bounds = np.concatenate([[-0.5], (kept[:-1] + kept[1:]) / 2.0, [n - 0.5]])
+    return kept, np.diff(bounds)
+
+
+def along_distance(arc: np.ndarray, marked: np.ndarray) -> np.ndarray:
+    """(N,) px along the line from each point to the nearest marked one, either side
+    (inf when none is); arc: (N,) ascending arc lengths, marked: (N,) bool."""
+    at = arc[marked]
+    if not at.size:
+        return np.full(len(arc), np.inf)
+    # one pass, not one per marked point: TSP art has thousands of corners
+    k = np.searchsorted(at, arc)
+    after = np.abs(at[np.minimum(k, at.size - 1)] - arc)
+    before = np.abs(arc - at[np.maximum(k - 1, 0)])
+    return np.minimum(before, after)
+
+
+def fit_piece(points: np.ndarray, *, closed: bool, sigma: float, anchor: bool = True,
+              spacing: float = 0.0, dense: np.ndarray | None = None) -> np.ndarray:
+    """Fit one piece: (N, 2) ordered points -> Bézier control points (K, 4, 2).
+
+    sigma: expected noise of the points in px; the smoothing allows that much residual.
+    anchor: make an open piece start and end exactly on its first and last points.
+    spacing, dense: fit only the points `thinned` keeps (spacing 0: every point), each
+    weighing as much as the points it stands for: about the same sum is minimised.
+    """
+    kept, count = thinned(points, spacing, dense)
+    points = points[kept]
+    distinct = _distinct(points, 1e-3)
+    points, count = points[distinct], count[distinct]
+    if closed and len(points) > 3 and np.linalg.norm(points[0] - points[-1]) < 1e-6:
+        points, count = points[:-1], count[:-1]
+    if len(points) < 4 or (closed and len(points) < 6):
+        line = points if len(points) >= 2 else np.vstack([points, points + 1e-3])
+        if closed:
+            line = np.vstack([line, line[:1]])
+        return Stroke.from_polyline(line).control
+    if closed:
+        points, count = np.vstack([points, points[:1]]), np.append(count, count[0])
+    u = arc_lengths(points)
+    u /= u[-1]
+    # FITPACK minimises sum((w * residual)^2) within s: weights sqrt(count) and s over all the
+    # points stood for ask of the thinned points what the full fit asks of every point.
+    smoothing = float(count.sum()) * sigma * sigma
+    weight = np.sqrt(count) if (count != 1).any() else None
+    try:
+        tck, _ = splprep([points[:, 0], points[:, 1]], w=weight, u=u, k=3, s=smoothing, per=1 if closed else 0,
+                         quiet=2)
+    except (ValueError, TypeError):
+        return Stroke.from_polyline(points).control
+    control = bspline_to_bezier(tck, 0.0, 1.0)
+    if not closed and anchor:
+        # Anchor the ends on the data: strokes must start and end where the ink does.
+        control[0, 1] += points[0] - control[0, 0]
+        control[0, 0] = points[0]
+        control[-1, 2] += points[-1] - control[-1, 3]
+        control[-1, 3] = points[-1]
+    if closed:
+        control[-1, 3] = control[0, 0]
+    return control
+
+
+def _turn(xy: np.ndarray, arc: np.ndarray, reach: float, closed: bool) -> np.ndarray:
+    """Turning angle (rad) at each point between the chords to the points `reach` before and after."""
+    total = arc[-1]
+    before = arc - reach
+    after = arc + reach
+    if closed:
+        before, after = np.mod(before, total), np.mod(after, total)
+    p0 = np.column_stack([np.interp(before, arc, xy[:, 0]), np.interp(before, arc, xy[:, 1])])
+    p2 = np.column_stack([np.interp(after, arc, xy[:, 0]), np.interp(after, arc, xy[:, 1])])
+    u, v = xy - p0, p2 - xy
+    norm = np.linalg.norm(u, axis=1) * np.linalg.norm(v, axis=1)
+    cos = np.where(norm > 1e-12, (u * v).sum(1) / np.maximum(norm, 1e-12), 1.0)
+    angle = np.arccos(np.clip(cos, -1.0, 1.0))
+    if not closed:
+        angle[(arc < reach) | (arc > total - reach)] = 0.0
+    return angle
+
+
+def sharp_corners(xy: np.ndarray, stroke_width: float, *, closed: bool) -> np.ndarray:
+    """Indices of sharp corners: turns over 40 degrees within 1.5 stroke widths, most of it
+    within half a width (a tight smooth bend spreads its turn out; a corner does not)."""
+    if len(xy) < 5:
+        return np.zeros(0, dtype=int)
+    arc = arc_lengths(xy)
+    wide = _turn(xy, arc, 1.5 * stroke_width, closed)
+    narrow = _turn(xy, arc, 0.5 * stroke_width, closed)
+    candidate = (wide > np.radians(40.0)) & (narrow > 0.6 * wide)
+    corners: list[int] = []
+    taken: list[float] = []  # arc lengths of the corners kept so far, sorted
+    for i in np.flatnonzero(candidate)[np.argsort(-wide[candidate], kind="stable")]:
+        # the nearest kept corners on either side (TSP art has thousands of corners: a scan of
+        # all of them per candidate was most of its fitting time)
+        k = bisect.bisect_left(taken, arc[i])
+        if all(abs(arc[i] - taken[j]) > 2.0 * stroke_width for j in (k - 1, k) if 0 <= j < len(taken)):
+            corners.append(int(i))
+            taken.insert(k, float(arc[i]))
+    return np.array(sorted(corners), dtype=int)
+
+
+def _tangent_apex(before: np.ndarray, after: np.ndarray) -> np.ndarray | None:
+    """Where the end tangent of `before` meets the start tangent of `after` (Bézier (K, 4, 2)),
+    ahead of both; None when they are near parallel or meet behind either end.
+
+    Near a sharp corner the medial axis bends away from the centre line (towards the
+    inner corner's Voronoi region); the two straight-ish sides, extended, meet where the
+    pen turned.
+    """
+    a, da = before[-1, 3], before[-1, 3] - before[-1, 2]
+    b, db = after[0, 0], after[0, 1] - after[0, 0]
+    matrix = np.column_stack([da, -db])
+    if abs(np.linalg.det(matrix)) < 1e-9 * (np.linalg.norm(da) * np.linalg.norm(db) + 1e-12):
+        return None
+    s_a, s_b = np.linalg.solve(matrix, b - a)
+    if s_a < 0 or s_b > 0:
+        return None
+    return a + s_a * da
+
+
+def _corner_point(before: np.ndarray, after: np.ndarray, fallback: np.ndarray, limit: float) -> np.ndarray:
+    """The tangents' meeting point (`_tangent_apex`), or `fallback` when there is none within
+    `limit` px of it."""
+    apex = _tangent_apex(before, after)
+    if apex is None or np.linalg.norm(apex - fallback) > limit:
+        return fallback
+    return apex
+
+
+def _tip_in_ink(xy: np.ndarray, arc: np.ndarray, at: int, guard: InkGuard, stroke_width: float,
+                closed: bool) -> np.ndarray | None:
+    """Where the pen turned at the corner `xy[at]` of the traced centre line ((N, 2) px;
+    `arc` (N,) px: arc length at each point), read from the ink: along the corner's outward
+    bisector (away from both sides, as seen 1.5 widths along the line), half a width short of
+    where the ink ends (the pen's round tip). None when the ink does not end within 3 widths.
+
+    At a narrow cusp (the top of a handwritten i, n or u) both sides merge into one blob of
+    ink before the tip: the medial axis turns back a width or more short of it, and the two
+    sides' tangents, bent by that turn, meet short of the tip too; the ink still shows how
+    far the pen went. At an ordinary sharp corner the ink's round outer edge lies half a
+    width beyond the corner, so this finds the corner itself.
+    """
+    reach = 1.5 * stroke_width
+    sides = []
+    for target in (arc[at] - reach, arc[at] + reach):
+        if closed:
+            target = np.mod(target, arc[-1])
+        elif not 0.0 <= target <= arc[-1]:
+            return None
+        # np.interp on the few points around the target: the same value as over the whole
+        # line, without copying the line at every corner (TSP art has thousands)
+        j = int(np.searchsorted(arc, target, side="right"))
+        near = slice(max(j - 2, 0), min(j + 2, len(arc)))
+        point = np.array([np.interp(target, arc[near], xy[near, 0]), np.interp(target, arc[near], xy[near, 1])])
+        chord = point - xy[at]
+        if np.linalg.norm(chord) < 1e-9:
+            return None
+        sides.append(chord / np.linalg.norm(chord))
+    inward = sides[0] + sides[1]
+    if np.linalg.norm(inward) < 1e-6:
+        return None  # the line runs straight through: no corner to extend
+    direction = -inward / np.linalg.norm(inward)
+    count = int(np.ceil(3.0 * stroke_width / (STEP / 2)))
+    steps = np.arange(1, count + 1) * (3.0 * stroke_width / count)
+    outside = guard.excess(xy[at] + steps[:, None] * direction) > 0.0
+    if not outside.any():
+        return None
+    # The first step found outside lies up to the guard's margin beyond the ink's edge.
+    edge = float(steps[int(np.argmax(outside))]) - guard.margin
+    return xy[at] + max(edge - 0.5 * stroke_width, 0.0) * direction
+
+
+def _open_fit(points: np.ndarray, sigma: float) -> np.ndarray:
+    return fit_piece(points, closed=False, sigma=sigma, anchor=True)
+
+
+def _settle(pieces: list[np.ndarray], cuts: list[int], xy: np.ndarray, twins: list[Twin],
+            guard: InkGuard, sigma: float) -> None:
+    """In place, last: every piece of the curve as written lies in the ink.
+
+    The joints move piece ends (to where two sides meet at a corner, to the middle of two
+    ends), and the later pass of a retraced stretch drags its neighbours' ends onto the
+    earlier pass's curve; either can swing a piece out that was checked when fitted (a
+    corner cut across the paper, a loop's end pulled onto a spike's other joint). Each piece
+    that strays now is refitted on all of its traced points between its final ends, so no
+    joint moves again; a later pass takes its earlier twin's settled curve (settled first:
+    it comes earlier) when their ends still agree.
+    """
+    index = {(lo, hi): k for k, (lo, hi) in enumerate(zip(cuts[:-1], cuts[1:]))}
+    for k, (lo, hi) in enumerate(zip(cuts[:-1], cuts[1:])):
+        source = twin_piece(twins, lo, hi)
+        j = index.get(source[:2]) if source is not None else None
+        if j is not None:
+            copy = pieces[j][::-1, ::-1] if source[2] else pieces[j]
+            if np.array_equal(copy[0, 0], pieces[k][0, 0]) and np.array_equal(copy[-1, 3], pieces[k][-1, 3]):
+                pieces[k] = np.array(copy)
+        if curve_excess(guard, pieces[k])[0] <= 0.0:
+            continue
+        whole = xy[lo:hi + 1].copy()
+        whole[0], whole[-1] = pieces[k][0, 0], pieces[k][-1, 3]
+        pieces[k] = keep_in_ink(whole, _open_fit(whole, sigma), guard, _open_fit, sigma)
+
+
+def fit_stroke(traced: TracedPoints, *, closed: bool, sigma: float, stroke_width: float,
+               guard: InkGuard | None = None, twins: tuple[Twin, ...] = ()) -> Stroke:
+    """Filter, split at sharp features (Y-feet tips, cusps, corners) and fit one traversed
+    stroke; with `guard`, every piece is brought back inside the ink where it strays
+    (`vectorize.fit.ink_guard`). twins: stretches the stroke draws twice (`vectorize.fit.retraces`):
+    fitted once, the later pass repeats the earlier one's curve."""
+    xy = np.array(traced.xy, dtype=float).reshape(-1, 2)
+    keep = np.array(traced.keep, dtype=bool)
+    split = np.array(traced.split, dtype=bool)
+    corner = np.zeros(len(xy), dtype=bool)
+    found = sharp_corners(xy, stroke_width, closed=closed)
+    corner[found[keep[found] & ~split[found]]] = True
+    if traced.corner is not None:
+        corner |= np.asarray(traced.corner, dtype=bool)
+    split |= corner
+    twins = valid_twins(xy, twins)
+    mirror_flags(twins, split, corner)
+    split_at = np.flatnonzero(split)
+    if closed and split_at.size and len(xy) > 3:
+        # Where a closed line starts cannot be read from the ink; start at its top-left
+        # sharp feature, as a pen usually does: then it is a chain of open pieces.
+        if np.allclose(xy[0], xy[-1]):
+            xy, keep, split, corner = xy[:-1], keep[:-1], split[:-1], corner[:-1]
+            split_at = np.flatnonzero(split)
+        shift = int(split_at[np.argmin(xy[split_at].sum(axis=1))])
+        xy, keep, split, corner = (np.roll(a, -shift, axis=0) for a in (xy, keep, split, corner))
+        twins = rolled(twins, shift, len(xy))
+        xy = np.vstack([xy, xy[:1]])
+        keep, split, corner = np.append(keep, keep[0]), np.append(split, split[0]), np.append(corner, corner[0])
+        closed = False
+        twins = valid_twins(xy, twins)
+    # Around a corner the axis is off the centre line for about a stroke width: leave it out.
+    # (The corner joints below read the tip along this arc too.)
+    arc = arc_lengths(xy)
+    keep &= along_distance(arc, corner) > stroke_width
+    mirror_keep(twins, keep)
+    # Next to an uncertain stretch (a junction, a corner) the fit bridges a stretch without
+    # points: there its shape, and where two passes cross, hangs on every point either side.
+    dense = along_distance(arc, ~keep) <= DENSE * stroke_width
+    cuts = [0] + [int(i) for i in np.flatnonzero(split) if 0 < i < len(xy) - 1] + [len(xy) - 1]
+    pieces = []
+    previous = None
+    fitted: dict[tuple[int, int], int] = {}
+    for lo, hi in zip(cuts[:-1], cuts[1:]):
+        source = twin_piece(twins, lo, hi)
+        if source is not None and source[:2] in fitted:
+            # The later pass over a retraced stretch: the earlier pass's curve.
+            control = pieces[fitted[source[:2]]]
+            pieces.append(np.array(control[::-1, ::-1] if source[2] else control))
+            previous = None
+            continue
+        mask = keep[lo:hi + 1].copy()
+        if not closed:
+            mask[0] = mask[-1] = True
+            mask[0] &= not corner[lo]
+            mask[-1] &= not corner[hi]
+        piece, near = xy[lo:hi + 1][mask], dense[lo:hi + 1][mask]
+        if len(piece) < 2:
+            piece, near = xy[[lo, hi]], None
+        if previous is not None and len(piece) == len(previous) and np.array_equal(piece, previous[::-1]):
+            # The way back from a retraced spike: exactly the way out, reversed, so the
+            # two passes lie on each other instead of crossing back and forth.
+            control = pieces[-1][::-1, ::-1]
+        else:
+            settings = dict(closed=closed and len(cuts) == 2, sigma=sigma, anchor=not (corner[lo] or corner[hi]))
+            # A long piece is first fitted on about one point per THIN widths away from its
+            # uncertain stretches: FITPACK's time is linear in the points, and the axis gives
+            # 3-5 per px. Where that fit leaves the ink, the piece is fitted on every point
+            # before the guard's ladder: thinned knots can swing across a long uncertain stretch.
+            spacing = min(THIN * stroke_width, THIN_MAX) if len(piece) > THIN_FROM else 0.0
+            control = fit_piece(piece, **settings, spacing=spacing, dense=near)
+            if guard is not None and curve_excess(guard, control)[0] > 0.0:
+                if spacing:
+                    control = fit_piece(piece, **settings)
+                # Measured against every traced point of the piece, the uncertain ones too.
+                whole = xy[lo:hi + 1]
+                if closed and len(cuts) == 2:
+                    whole = np.vstack([whole, whole[:1]])
+                control = keep_in_ink(whole, control, guard, _open_fit, sigma)
+        previous = piece
+        fitted[(lo, hi)] = len(pieces)
+        pieces.append(np.array(control))  # writable: the joints move its ends
+    # Join the pieces: at corners where their sides meet, elsewhere where they end.
+    joints = list(zip(range(len(pieces) - 1), range(1, len(pieces)), cuts[1:-1]))
+    if corner[0] and corner[-1] and len(pieces) > 1:
+        joints.append((len(pieces) - 1, 0, 0))
+    for k, m, at in joints:
+        before, after = pieces[k], pieces[m]
+        on_tangents = False
+        if corner[at]:
+            point = _corner_point(before, after, xy[at], 2.0 * stroke_width)
+            # A corner point is held to the invariant's own slack (half width + 1 px), not to a
+            # thin line's one-width margin: the image probe finds little ink around a faint
+            # tip, and the centre-line point instead cuts the corner.
+            on_tangents = guard is None or guard.excess(point)[0] <= MARGIN - guard.margin
+            if not on_tangents:
+                point = xy[at]
+            # Where the ink shows the pen went further than the tangents say (a narrow cusp
+            # whose axis stops short), the tip goes there; the sides' handles follow it.
+            tip = _tip_in_ink(xy, arc, at, guard, stroke_width, closed) if guard is not None else None
+            # Only a tip beyond the corner point by more than the invariant's slack moves it: a
+            # sharp corner whose sides' tangents meet in the ink is already where the pen turned.
+            if tip is not None and np.linalg.norm(tip - xy[at]) > np.linalg.norm(point - xy[at]) + MARGIN:
+                point, on_tangents = tip, False
+        else:
+            point = (before[-1, 3] + after[0, 0]) / 2.0
+        if not on_tangents or np.array_equal(point, xy[at]):
+            # Elsewhere move the inner handles along, keeping both end tangents; at a
+            # corner the point lies on the tangents already.
+            before[-1, 2] += point - before[-1, 3]
+            after[0, 1] += point - after[0, 0]
+        before[-1, 3] = point
+        after[0, 0] = point
+    share_pieces(twins, cuts, pieces)
+    if guard is not None and not (closed and len(pieces) == 1):  # a closed piece was checked when fitted
+        _settle(pieces, cuts, xy, twins, guard, sigma)
+    control = np.concatenate(pieces, axis=0)
+    return Stroke(control)

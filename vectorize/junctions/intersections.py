@@ -1,0 +1,139 @@
+"""Deciding how the pen went through a degree-4 node: crossing straight over, or touching.
+
+A degree-4 node joins four branches. The pen either crossed (each branch continues into the
+one opposite it) or the two curves touched and turned back (two branches pair up on each
+side). A classifier gives the probability of a crossing; when it says "touching", the
+pairing with the smaller tangent discontinuity is taken (paper, Section 3.3.1). Any
+classifier that follows `IntersectionClassifier` plugs in without touching the traversal
+(`vectorize.junctions.classifiers.make_classifier` builds the named ones).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Protocol
+
+import numpy as np
+
+
+# A configuration pairs the four branch slots 0..3 into two passes through the node.
+Pairing = tuple[tuple[int, int], tuple[int, int]]
+ALL_PAIRINGS: tuple[Pairing, ...] = (((0, 1), (2, 3)), ((0, 2), (1, 3)), ((0, 3), (1, 2)))
+
+
+@dataclass(frozen=True, eq=False)
+class Junction:
+    """One degree-4 node of the simplified medial-axis graph.
+
+    center: (2,) x, y in px of the working image; directions: (4, 2) unit tangents of the
+    four branches pointing away from the node; width: local stroke width in px;
+    crossing: (2,) px where the two straight-through passes are estimated to cross
+    (`vectorize.junctions.crossing_point`), where image classifiers centre their crops; None: center.
+    """
+
+    center: np.ndarray
+    directions: np.ndarray
+    width: float
+    crossing: np.ndarray | None = None
+
+    @property
+    def crop_center(self) -> np.ndarray:
+        """Where an image classifier looks: the estimated crossing, else the node."""
+        return self.center if self.crossing is None else self.crossing
+
+
+@dataclass(frozen=True)
+class JunctionVerdict:
+    """A classifier's answer for one junction.
+
+    p_crossing: probability that the pen crossed straight over, in [0, 1];
+    confidence: how sure the classifier is of its majority answer, in [0.5, 1].
+    """
+
+    p_crossing: float
+    confidence: float
+
+    @property
+    def is_crossing(self) -> bool:
+        return self.p_crossing >= 0.5
+
+
+class IntersectionClassifier(Protocol):
+    """Anything that can tell crossings from touchings for a batch of junctions."""
+
+    name: str
+
+    def classify(self, gray: np.ndarray, junctions: Sequence[Junction],
+                 stroke_width: float) -> list[JunctionVerdict]:
+        """gray: (H, W) float32 in [0, 1], 1 = paper; one verdict per junction."""
+        ...
+
+
+def turn_cost(directions: np.ndarray, pairing: Pairing) -> float:
+    """Total bending of a pairing: for each pass a->b, 1 + cos(angle between the branches).
+
+    A pass straight through (branches pointing in opposite directions) costs 0, a U-turn 2.
+    """
+    d = np.asarray(directions, dtype=float)
+    return float(sum(1.0 + float(np.dot(d[a], d[b])) for a, b in pairing))
+
+
+def crossing_pairing(directions: np.ndarray) -> Pairing:
+    """The pairing of branches that lie opposite each other in angular order around the node.
+
+    Two strokes that cross alternate around the node (A, B, A', B'); two that touch come in
+    side by side (A, A', B', B). Angular order, not tangent smoothness, tells them apart:
+    at a tangential touch both the crossing and the right touching pairing are smooth.
+    """
+    d = np.asarray(directions, dtype=float)
+    order = np.argsort(np.arctan2(d[:, 1], d[:, 0]), kind="stable")
+    a, b, c, e = (int(i) for i in order)
+    return _normal((a, c), (b, e))
+
+
+def touching_pairings(directions: np.ndarray) -> tuple[Pairing, Pairing]:
+    """The two pairings of angular neighbours, the smoother (smaller turn) first."""
+    d = np.asarray(directions, dtype=float)
+    order = np.argsort(np.arctan2(d[:, 1], d[:, 0]), kind="stable")
+    a, b, c, e = (int(i) for i in order)
+    options = [_normal((a, b), (c, e)), _normal((b, c), (e, a))]
+    return tuple(sorted(options, key=lambda p: turn_cost(d, p)))  # type: ignore[return-value]
+
+
+def _normal(first: tuple[int, int], second: tuple[int, int]) -> Pairing:
+    pair = sorted([tuple(sorted(first)), tuple(sorted(second))])
+    return (pair[0], pair[1])  # type: ignore[return-value]
+
+
+def ranked_pairings(junction: Junction, verdict: JunctionVerdict) -> tuple[Pairing, Pairing, Pairing]:
+    """All three pairings, the classifier's choice first, then the alternatives by plausibility."""
+    straight = crossing_pairing(junction.directions)
+    touch_a, touch_b = touching_pairings(junction.directions)
+    if verdict.is_crossing:
+        return straight, touch_a, touch_b
+    return touch_a, straight, touch_b
+
+
+class GeometricClassifier:
+    """Tangent continuity only: a crossing when the straight-through pairing is smooth.
+
+    Two strokes that cross leave the node along two nearly straight lines, so the best
+    straight-through pairing bends little. Two curves touching tangentially also look
+    straight through — which is exactly why this rule gets touchings wrong, and why the
+    CNN exists. Kept as a baseline and as a fallback without the model.
+    """
+
+    name = "geometric"
+
+    def classify(self, gray: np.ndarray, junctions: Sequence[Junction],
+                 stroke_width: float) -> list[JunctionVerdict]:
+        verdicts = []
+        for junction in junctions:
+            straight = turn_cost(junction.directions, crossing_pairing(junction.directions))
+            touch = turn_cost(junction.directions, touching_pairings(junction.directions)[0])
+            # A crossing is likely when going straight through bends less than turning;
+            # at a tangential touch both are smooth and the rule can only guess (p ~ 0.5).
+            p = float(1.0 / (1.0 + np.exp(4.0 * (straight - touch))))
+            verdicts.append(JunctionVerdict(p_crossing=p, confidence=max(p, 1.0 - p)))
+        return verdicts

@@ -1,0 +1,456 @@
+"""One connected drawing, one stroke: route inspection (Chinese postman) on the branch graph.
+
+A single line visits every branch of its ink once, except where the pen went out and back
+(a retraced stem, a crossbar drawn out and back, a sharp spike): those branches are drawn
+twice. When the graph has more than two odd-degree nodes, no walk uses every branch once;
+the cheapest set of branches to draw twice is a minimum-weight matching of the odd nodes
+over shortest-path distances (Edmonds and Johnson's route inspection), in which two of them
+may be left for the pen to start and end at (`route_matching`: one exact matching decides
+both). Every decided junction (a crossing or a touch at
+a degree-4 node, or a cluster where three passes cross) is a set of through-paths here, so
+retraced paths go through it the way the pairing says and the walk never turns there.
+
+The walk itself is Fleury's rule (never cross a bridge of what is left while there is
+another way) with the smoothest exit first: at a junction the pen goes as straight as the
+drawing still allows, and a stub drawn out and back is taken when the pen passes it.
+"""
+
+from __future__ import annotations
+
+import heapq
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.sparse import coo_matrix
+from scipy.sparse.csgraph import connected_components, dijkstra
+
+from vectorize.axis.graph import MedialGraph
+from vectorize.axis.simplify import slots
+from vectorize.route.route_matching import match_odd
+from vectorize.route.traversal import Pass
+
+
+def _back(p: Pass) -> Pass:
+    return Pass(p.branch, "b" if p.start == "a" else "a")
+
+
+@dataclass(frozen=True)
+class Chain:
+    """Branches joined through decided junctions: from (u, u_slot) to (v, v_slot).
+
+    u, v: graph nodes where the chain ends (nodes that are not decided); slots index
+    `slots(graph, node)`. A chain through decided junctions only has u = v = -1.
+    """
+
+    passes: tuple[Pass, ...]
+    u: int
+    u_slot: int
+    v: int
+    v_slot: int
+    length: float
+
+
+@dataclass(frozen=True)
+class Route:
+    """The single stroke: its branch passes in drawing order, whether it is closed, the
+    retraced length (px) the matching added and the odd-degree nodes it matched."""
+
+    passes: tuple[Pass, ...]
+    closed: bool
+    retraced: float
+    odd_nodes: int = 0
+
+
+def _partners(pairings: dict[int, tuple[tuple[int, int], ...]]) -> dict[int, dict[int, int]]:
+    result = {}
+    for node, pairs in pairings.items():
+        result[node] = {}
+        for a, b in pairs:
+            result[node][a], result[node][b] = b, a
+    return result
+
+
+def chains(graph: MedialGraph, pairings: dict) -> list[Chain]:
+    """Cut the graph into chains between undecided nodes (pairings: node -> slot pairs)."""
+    partner = _partners(pairings)
+    node_slots = {n: slots(graph, n) for n in graph.incident}
+    index = {n: {s: i for i, s in enumerate(sl)} for n, sl in node_slots.items()}
+    seen_branch: set[int] = set()
+    result = []
+
+    def follow(node: int, slot: int) -> tuple[list[Pass], int, int, float]:
+        passes, length = [], 0.0
+        while True:
+            bid, end = node_slots[node][slot]
+            seen_branch.add(bid)
+            passes.append(Pass(bid, end))
+            branch = graph.branches[bid]
+            length += branch.length
+            far = branch.b if end == "a" else branch.a
+            far_slot = index[far][(bid, "b" if end == "a" else "a")]
+            if far not in partner:
+                return passes, far, far_slot, length
+            node, slot = far, partner[far][far_slot]
+            if node_slots[node][slot][0] in seen_branch and (node, slot) == start:
+                return passes, -1, -1, length  # back where a closed chain began
+
+    done: set[tuple[int, int]] = set()
+    for node in sorted(graph.incident):
+        if node in partner:
+            continue
+        for slot in range(len(node_slots[node])):
+            if (node, slot) in done:
+                continue
+            start = (node, slot)
+            passes, far, far_slot, length = follow(node, slot)
+            done.add((node, slot))
+            done.add((far, far_slot))
+            result.append(Chain(tuple(passes), node, slot, far, far_slot, length))
+    for node in sorted(partner):
+        for slot in range(len(node_slots[node])):
+            if node_slots[node][slot][0] in seen_branch:
+                continue
+            start = (node, slot)
+            passes, _, _, length = follow(node, slot)
+            result.append(Chain(tuple(passes), -1, -1, -1, -1, length))
+    return result
+
+
+def pieces(graph: MedialGraph, pairings: dict) -> int:
+    """How many separate lines the graph falls into when decided junctions are through-paths."""
+    return PieceCount(graph, pairings)({})
+
+
+class PieceCount:
+    """`pieces` for one graph whose `variable` nodes take many pairings in turn (the search in
+    `connect_pairings` asks hundreds of times): the graph's pieces with those nodes' branch
+    ends all apart are found once; a count then joins each variable node's pairs of ends (all
+    its ends when it is undecided), a union per pair.
+
+    A branch end is a vertex of its own where its node's pairing joins it to its partner (the
+    pair shares one vertex); the whole node is one vertex where it is undecided. `fixed`:
+    pairings of the nodes that are not variable.
+    """
+
+    def __init__(self, graph: MedialGraph, fixed: dict, variable=()) -> None:
+        self.variable = tuple(variable)
+        apart = set(self.variable)
+        partner = _partners({n: p for n, p in fixed.items() if n not in apart})
+        ids: dict[tuple[int, int], int] = {}
+
+        def vertex(node: int, slot: int) -> int:
+            if node in apart:
+                key = (node, slot)
+            elif node in partner:
+                key = (node, min(slot, partner[node][slot]))
+            else:
+                key = (node, -1)
+            return ids.setdefault(key, len(ids))
+
+        rows, cols = [], []
+        for node in graph.incident:
+            for slot, (bid, end) in enumerate(slots(graph, node)):
+                if end == "a":
+                    far = graph.branches[bid].b
+                    rows.append(vertex(node, slot))
+                    cols.append(vertex(far, slots(graph, far).index((bid, "b"))))
+        links = coo_matrix((np.ones(len(rows)), (rows, cols)), shape=(len(ids), len(ids)))
+        self.count, label = connected_components(links, directed=False) if ids else (0, np.zeros(0, int))
+        self.ends = {n: [int(label[ids[n, slot]]) for slot in range(graph.degree(n))] for n in self.variable}
+
+    def __call__(self, choice: dict) -> int:
+        """Pieces when each variable node takes choice[node] (slot pairs), or is undecided
+        where `choice` leaves it out."""
+        parent: dict[int, int] = {}
+
+        def root(x: int) -> int:
+            while parent.get(x, x) != x:
+                x = parent[x]
+            return x
+
+        joined = 0
+        for node in self.variable:
+            ends = self.ends[node]
+            pairs = choice[node] if node in choice else tuple(zip(range(len(ends) - 1), range(1, len(ends))))
+            for a, b in pairs:
+                ra, rb = root(ends[a]), root(ends[b])
+                if ra != rb:
+                    parent[ra] = rb
+                    joined += 1
+        return int(self.count) - joined
+
+
+class _Multigraph:
+    """Chains (and their retraced copies) as edges between undecided nodes."""
+
+    def __init__(self, chain_list: list[Chain]) -> None:
+        self.chains = chain_list
+        self.edges: list[int] = []  # edge -> chain index
+        self.at: dict[int, list[tuple[int, str]]] = {}  # node -> [(edge, end "u"/"v")]
+        self.used: list[bool] = []
+
+    def add(self, chain_index: int) -> None:
+        edge = len(self.edges)
+        self.edges.append(chain_index)
+        self.used.append(False)
+        c = self.chains[chain_index]
+        self.at.setdefault(c.u, []).append((edge, "u"))
+        self.at.setdefault(c.v, []).append((edge, "v"))
+
+    def far(self, edge: int, end: str) -> tuple[int, int]:
+        c = self.chains[self.edges[edge]]
+        return (c.v, c.v_slot) if end == "u" else (c.u, c.u_slot)
+
+    def slot(self, edge: int, end: str) -> int:
+        c = self.chains[self.edges[edge]]
+        return c.u_slot if end == "u" else c.v_slot
+
+    def free_at(self, node: int) -> list[tuple[int, str]]:
+        return [(e, end) for e, end in self.at.get(node, []) if not self.used[e]]
+
+    def reaches(self, start: int, goal: int, skip: int) -> bool:
+        """Whether `goal` can be reached from `start` over unused edges other than `skip`."""
+        if start == goal:
+            return True
+        seen, stack = {start}, [start]
+        while stack:
+            node = stack.pop()
+            for e, end in self.at.get(node, []):
+                if self.used[e] or e == skip:
+                    continue
+                nxt = self.far(e, end)[0]
+                if nxt == goal:
+                    return True
+                if nxt not in seen:
+                    seen.add(nxt)
+                    stack.append(nxt)
+        return False
+
+
+def _fleury(multi: _Multigraph, start: int, first_slot: int | None, turn) -> list[tuple[int, str]]:
+    """An Euler walk from `start`: (edge, end it leaves from) in order; smoothest exit first."""
+    walk: list[tuple[int, str]] = []
+    node, entry = start, first_slot
+    total = len(multi.edges)
+    while len(walk) < total:
+        options = multi.free_at(node)
+        if not options:
+            break
+        options.sort(key=lambda o: (turn(node, entry, multi.slot(*o)), o[0]))
+        choice = options[0]
+        if len(options) > 1:
+            for e, end in options:
+                far = multi.far(e, end)[0]
+                # Not a bridge: the far node is reachable without it, or it is the last way on.
+                if far == node or multi.reaches(node, far, e):
+                    choice = (e, end)
+                    break
+        e, end = choice
+        multi.used[e] = True
+        walk.append(choice)
+        node, entry = multi.far(e, end)
+    return walk
+
+
+def _first_steps(pred: np.ndarray, sources: np.ndarray) -> np.ndarray:
+    """(S, N): the node after source s on its shortest path to each node (the node itself
+    where it is the source's neighbour, the source, or unreachable), from dijkstra's (S, N)
+    predecessors, by pointer doubling."""
+    own = np.arange(pred.shape[1])
+    step = np.where((pred == sources[:, None]) | (pred < 0), own, pred)
+    while True:
+        further = np.take_along_axis(step, step, axis=1)
+        if np.array_equal(further, step):
+            return step
+        step = further
+
+
+def plan_routes(graph: MedialGraph, pairings: dict, *, stroke_width: float, directions: dict,
+                end_cost: dict[int, float] | None = None, weight: dict[int, float] | None = None) -> list[Route]:
+    """One stroke per piece of the graph over all its branches, retracing as little as it can.
+
+    pairings: node -> slot pairs of its through-paths (decided junctions); directions: node
+    -> (D, 2) unit tangents per slot, leaving the node (for junctions of degree >= 3);
+    end_cost: px added when the pen starts or ends at a node (default 0): makes some nodes,
+    such as the tip of a sharp corner's spur, poor places to start. weight: branch id ->
+    factor on its length when retraces are chosen (default 1; a user's "draw this twice"
+    makes it small, "once" large). A graph that is one piece under the pairings (see
+    `connect_pairings`) gives exactly one route.
+    """
+    chain_list = chains(graph, pairings)
+    nodes = sorted({c.u for c in chain_list if c.u >= 0} | {c.v for c in chain_list if c.v >= 0})
+    where = {n: i for i, n in enumerate(nodes)}
+    open_chains = [c for c in chain_list if c.u >= 0]
+    links = coo_matrix((np.ones(len(open_chains)), ([where[c.u] for c in open_chains], [where[c.v] for c in open_chains])),
+                       shape=(len(nodes), len(nodes)))
+    _, label = connected_components(links, directed=False)
+    groups: dict[int, list[Chain]] = {}
+    for c in open_chains:
+        groups.setdefault(int(label[where[c.u]]), []).append(c)
+    routes = [_route(graph, group, stroke_width, directions, end_cost or {}, weight or {})
+              for _, group in sorted(groups.items())]
+    routes += [Route(c.passes, True, 0.0) for c in chain_list if c.u < 0]
+    return routes
+
+
+def _route(graph: MedialGraph, chain_list: list[Chain], stroke_width: float, directions: dict,
+           end_cost: dict[int, float], weight: dict[int, float]) -> Route:
+    """The route over one connected piece of chains (none of them closed on its own)."""
+    # What retracing each chain costs: its length, with the branches' weights.
+    cost_of = [c.length if not weight else sum(graph.branches[p.branch].length * weight.get(p.branch, 1.0)
+                                               for p in c.passes) for c in chain_list]
+    nodes = sorted({c.u for c in chain_list if c.u >= 0} | {c.v for c in chain_list if c.v >= 0})
+    where = {n: i for i, n in enumerate(nodes)}
+    degree = np.zeros(len(nodes), dtype=int)
+    for c in chain_list:
+        if c.u >= 0:
+            degree[where[c.u]] += 1
+            degree[where[c.v]] += 1
+
+    def turn(node: int, entry: int | None, out: int) -> float:
+        """Bending of a pass into the node by slot `entry` and out by `out`: 0 straight, 2 back."""
+        if entry is None or node not in directions:
+            return 0.0
+        d = directions[node]
+        return 1.0 + float(np.dot(d[entry], d[out]))
+
+    def leave_penalty(node: int, slot: int) -> float:
+        # Tie-break by smoothness: at a three-way junction, retracing one branch leaves the
+        # other two to be walked through; prefer the retrace that leaves them straightest.
+        if node not in directions or len(directions[node]) != 3:
+            return 0.0
+        a, b = (i for i in range(3) if i != slot)
+        return 0.25 * stroke_width * turn(node, a, b)
+
+    # Shortest paths between odd nodes over the cheapest chain between each pair of nodes.
+    best_chain: dict[tuple[int, int], int] = {}
+    for k, c in enumerate(chain_list):
+        if c.u < 0 or c.u == c.v:
+            continue
+        key = (min(where[c.u], where[c.v]), max(where[c.u], where[c.v]))
+        if key not in best_chain or cost_of[k] < cost_of[best_chain[key]]:
+            best_chain[key] = k
+    odd = [i for i in range(len(nodes)) if degree[i] % 2]
+    pairs_out: list[tuple[int, int]] = []
+    ends: list[int] = []
+    paths: list[list[int]] = []
+    if odd:
+        keys = list(best_chain)
+        weights = [max(cost_of[best_chain[k]], 1e-6) for k in keys]
+        rows = [k[0] for k in keys]
+        cols = [k[1] for k in keys]
+        matrix = coo_matrix((weights, (rows, cols)), shape=(len(nodes), len(nodes))).tocsr()
+        dist, pred = dijkstra(matrix, directed=False, indices=odd, return_predecessors=True)
+
+        row_of = {a: r for r, a in enumerate(odd)}
+
+        def path(a: int, b: int) -> list[int]:
+            """Chain indices along the shortest path from odd node a to node b."""
+            row = row_of[a]
+            seq = [b]
+            while seq[-1] != a:
+                seq.append(int(pred[row, seq[-1]]))
+            seq.reverse()
+            return [best_chain[(min(x, y), max(x, y))] for x, y in zip(seq[:-1], seq[1:])]
+
+        def penalty(node_index: int, neighbour: int) -> float:
+            """leave_penalty of the path leaving odd node `node_index` towards `neighbour`."""
+            c = chain_list[best_chain[(min(node_index, neighbour), max(node_index, neighbour))]]
+            return leave_penalty(nodes[node_index], c.u_slot if where[c.u] == node_index else c.v_slot)
+
+        # The path from odd[i] to odd[j] leaves odd[i] towards first[i, odd[j]] and reaches
+        # odd[j] from pred[i, odd[j]]: its two end slots, without walking it.
+        first = _first_steps(pred, np.array(odd))
+        m = len(odd)
+        cost = np.full((m, m), np.inf)
+        for i in range(m):
+            for j in range(i + 1, m):
+                dij = dist[i, odd[j]]
+                if np.isfinite(dij):
+                    dij += penalty(odd[i], int(first[i, odd[j]])) + penalty(odd[j], int(pred[i, odd[j]]))
+                cost[i, j] = cost[j, i] = dij
+        ends_cost = np.array([end_cost.get(nodes[i], 0.0) for i in odd])
+        pairs_out, ends = match_odd(cost, ends_cost)
+        paths = [path(odd[i], odd[j]) for i, j in pairs_out]
+    multi = _Multigraph(chain_list)
+    for k, c in enumerate(chain_list):
+        if c.u >= 0:
+            multi.add(k)
+    retraced = 0.0
+    for p in paths:
+        for k in p:
+            multi.add(k)
+            retraced += chain_list[k].length
+    if ends:
+        # Start at the free end if one of the two is one: the walk then reaches every
+        # junction along a branch and can go on as straight as the drawing allows.
+        start = min((nodes[odd[i]] for i in ends), key=lambda n: (len(multi.at[n]), n))
+    else:
+        # A closed walk: begin at the top-left node (any node would do).
+        start = min(nodes, key=lambda n: (float(graph.positions[n].sum()), n))
+    walk = _fleury(multi, start, None, turn)
+    passes: list[Pass] = []
+    for e, end in walk:
+        chain = chain_list[multi.edges[e]]
+        seq = chain.passes if end == "u" else tuple(_back(p) for p in reversed(chain.passes))
+        passes.extend(seq)
+    return Route(tuple(passes), not ends, retraced, len(odd))
+
+
+def connect_pairings(graph: MedialGraph, ranked: dict, costs: dict, *, fixed: dict | None = None,
+                     max_tries: int = 400) -> tuple[dict, int]:
+    """Pairings for the decided junctions under which the drawing stays one piece.
+
+    ranked[node]: its pairings, preferred first; costs[node]: the cost of each. A pairing
+    that turns a touch into a crossing (or back) can cut the line into separate loops; the
+    search tries assignments best-first by total cost until the graph is one piece. If none
+    within `max_tries` is, junctions are left undecided, least sure first, until it is:
+    there the walk may turn any way. Returns node -> pairing (undecided nodes left out) and
+    the number of assignments tried. fixed: node -> slot pairs decided elsewhere (three
+    passes through a point), part of every assignment and never changed.
+    """
+    nodes = sorted(ranked)
+    fixed = fixed or {}
+
+    def assign(ranks: tuple[int, ...]) -> dict:
+        return {**fixed, **{n: ranked[n][r] for n, r in zip(nodes, ranks)}}
+
+    start = tuple(0 for _ in nodes)
+    pieces = PieceCount(graph, fixed, nodes)  # counts under the ranked nodes' pairings (fixed ones stay)
+    best_key, best_ranks = (pieces(assign(start)), 0.0), start
+    tried = 1
+    heap = [(0.0, start, 0)]
+    seen = {start}
+    while best_key[0] > 1 and heap and tried < max_tries:
+        cost, ranks, last = heapq.heappop(heap)
+        if ranks != start:
+            key = (pieces(assign(ranks)), cost)
+            tried += 1
+            if key < best_key:
+                best_key, best_ranks = key, ranks
+                if key[0] == 1:
+                    break
+        # Children change one decision at or after the last changed one: each assignment
+        # is generated once, in order of increasing total cost.
+        for j in range(last, len(nodes)):
+            if ranks[j] + 1 < len(ranked[nodes[j]]):
+                child = ranks[:j] + (ranks[j] + 1,) + ranks[j + 1:]
+                if child not in seen:
+                    seen.add(child)
+                    delta = costs[nodes[j]][ranks[j] + 1] - costs[nodes[j]][ranks[j]]
+                    heapq.heappush(heap, (cost + delta, child, j))
+    pairing = assign(best_ranks)
+    count = best_key[0]
+    for n in fixed:
+        del pairing[n]
+    if count > 1:
+        # Least sure first: the node whose second choice costs least.
+        # A pairing the user fixed (its only choice) stays, even if the line then falls apart.
+        for node in sorted((n for n in nodes if len(ranked[n]) > 1), key=lambda n: (costs[n][1], n)):
+            trial = {n: p for n, p in pairing.items() if n != node}
+            now = pieces({**fixed, **trial})
+            if now < count:
+                pairing, count = trial, now
+            if count <= 1:
+                break
+    return pairing, tried
