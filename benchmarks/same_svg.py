@@ -78,8 +78,12 @@ def _one(task: tuple) -> tuple[str, str]:
                 drawing = vectorize_image(image, VectorizeOptions(multi=multi, classifier="cnn", seed=0)).drawing
                 results.append((f"{key}{' multi' if multi else ''}", drawing_to_svg(drawing)))
         else:
-            from vectorize.refine.edits import Edits
-            from vectorize.refine.refine import StageCache
+            try:
+                from vectorize.refine.edits import Edits
+                from vectorize.refine.refine import StageCache
+            except ModuleNotFoundError:  # a checkout from before the stage packages
+                from vectorize.edits import Edits
+                from vectorize.refine import StageCache
 
             cache = StageCache()  # one per drawing, as the studio keeps
             for threshold, blur in SETTINGS:
