@@ -23,24 +23,13 @@ from machines.job_time import estimate_job_time as estimate_gcode_time
 from fabrication.laser.raster_time import raster_time
 from fabrication.laser.toolpath import ToolpathOptions, plan_toolpath
 from fabrication.placement import PlacementOptions
-from benchmarks.sets.laser_jobs import spiral_points, trefoil_png
+from benchmarks.sets.laser_jobs import spiral_job, straight_line_job, trefoil_png
 from benchmarks.metrics.grbl_sim import simulate
 from machines.laser_profile import load_laser_profile
 
 ROOT = Path(__file__).resolve().parents[1]
 
 PROFILE = load_laser_profile()
-
-
-def straight_line(feed):
-    return ["G21", "G90", "M4S0", "G0X10Y10", "G4P0", f"G1X390Y390S600F{feed:g}", "M5", "M9"]
-
-
-def spiral(feed):
-    pts = spiral_points(segment=0.05, turns=6.0, r0=2.0, pitch=1.2)
-    body = ["G1X%.3fY%.3f" % tuple(p) for p in pts[1:]]
-    body[0] += f"S600F{feed:g}"
-    return ["G21", "G90", "M4S0", "G0X%.3fY%.3f" % tuple(pts[0])] + body + ["M5", "M9"]
 
 
 def vectorized_drawing():
@@ -75,9 +64,9 @@ def row(label, lines):
 def jobs():
     """(label, G-code lines) of every job this benchmark times (laser_estimate_vs_emulator.py too)."""
     for feed in (1500, 6000):
-        yield f"long straight line 537 mm, F{feed}", straight_line(feed)
+        yield f"long straight line 537 mm, F{feed}", straight_line_job(feed)
     for feed in (1500, 3000, 6000):
-        yield f"spiral of 0.05 mm segments, F{feed}", spiral(feed)
+        yield f"spiral of 0.05 mm segments, F{feed}", spiral_job(feed)
     drawing, how = vectorized_drawing()
     for size, feed in ((60, 1500), (60, 3000), (20, 6000)):
         for arcs in (False, True):

@@ -31,7 +31,7 @@ PACKAGES = {
     "onestroke": ("onestroke",),
     "machines": ("machines",),
     "vectorize types": ("vectorize.stroke", "vectorize.drawing", "vectorize.options",
-                        "vectorize.svg_write", "vectorize.cores", "vectorize.preload"),
+                        "vectorize.svg_write"),
     "vectorize.raster": ("vectorize.raster",),
     "vectorize.svg": ("vectorize.svg",),
     "vectorize.axis": ("vectorize.axis",),

@@ -23,7 +23,7 @@ from vectorize.junctions.classifiers import make_classifier, shipped_pass_scorer
 from vectorize.junctions.crossing_point import crossing_point
 from vectorize.junctions.intersections import Junction, JunctionVerdict, ranked_pairings
 from vectorize.options import InputFrame, VectorizeOptions, VectorizeReport, VectorizeResult
-from vectorize.preload import preload, wait
+from onestroke.preload import preload, wait
 from vectorize.raster.binarize import downscaled_gray, ink_image, ink_threshold, paper_gray
 from vectorize.raster.outline import outline_rings
 from vectorize.route.route_ends import end_costs

@@ -78,6 +78,21 @@ def spiral_points(segment: float = 0.05, turns: float = 8.0, r0: float = 2.0, pi
     return np.array(pts)
 
 
+def straight_line_job(feed: float) -> list[str]:
+    """G-code of one 537 mm diagonal burn at `feed` mm/min. G4P0 makes GRBL stop after the
+    rapid, so the burn starts from rest."""
+    return ["G21", "G90", "M4S0", "G0X10Y10", "G4P0", f"G1X390Y390S600F{feed:g}", "M5", "M9"]
+
+
+def spiral_job(feed: float) -> list[str]:
+    """G-code of a 6-turn spiral of 0.05 mm segments at `feed` mm/min (the planner's worst
+    case: thousands of tiny blocks with a junction each)."""
+    pts = spiral_points(segment=0.05, turns=6.0, r0=2.0, pitch=1.2)
+    body = ["G1X%.3fY%.3f" % tuple(p) for p in pts[1:]]
+    body[0] += f"S600F{feed:g}"
+    return ["G21", "G90", "M4S0", "G0X%.3fY%.3f" % tuple(pts[0])] + body + ["M5", "M9"]
+
+
 def trefoil_png(path, size: int = 500, width: int = 7):
     """A raster single-line drawing with three self-crossings (trefoil), for the vectorizer."""
     from PIL import Image, ImageDraw

@@ -128,10 +128,16 @@ def test_read_only_file_system_is_2_and_disk_full_is_1(inputs, tmp_path):
             assert "the disk is full" in lines[0] and result["left"] in ([], ["ballast"]), (argv, result)
 
 
+def _default_hangup() -> None:
+    # As a command started from a terminal: under nohup the test runner's SIGHUP is ignored,
+    # and the command rightly keeps an ignored signal ignored.
+    signal.signal(signal.SIGHUP, signal.SIG_DFL)
+
+
 def _child(*args: str) -> subprocess.Popen:
     code = "import sys; print('ready', flush=True); from fabrication.cli import main; main()"
     return subprocess.Popen([sys.executable, "-c", code, *args], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                            text=True, env=child_env())
+                            text=True, env=child_env(), preexec_fn=_default_hangup)
 
 
 @pytest.mark.parametrize("signum", [signal.SIGTERM, signal.SIGHUP])

@@ -10,7 +10,7 @@ from machines.job_time import estimate_job_time as estimate_gcode_time
 from machines.job_time import format_duration
 from fabrication.laser.toolpath import ToolpathOptions, plan_toolpath
 from fabrication.placement import PlacementOptions
-from benchmarks.sets.laser_jobs import spiral_points, trefoil_png
+from benchmarks.sets.laser_jobs import spiral_job, straight_line_job, trefoil_png
 from benchmarks.metrics.grbl_sim import simulate
 from machines.laser_profile import LaserProfile, load_laser_profile
 
@@ -23,18 +23,6 @@ def _sim(lines, profile=PROFILE):
                     junction_deviation=profile.junction_deviation, arc_tolerance=profile.arc_tolerance,
                     steps_per_mm=(profile.steps_per_mm_x, profile.steps_per_mm_y),
                     planner_blocks=profile.planner_blocks)
-
-
-def straight_line(feed):
-    # G4P0 makes GRBL stop after the rapid, so the burn starts from rest (by-hand check below)
-    return ["G21", "G90", "M4S0", "G0X10Y10", "G4P0", f"G1X390Y390S600F{feed:g}", "M5", "M9"]
-
-
-def spiral(feed):
-    pts = spiral_points(segment=0.05, turns=6.0, r0=2.0, pitch=1.2)
-    body = ["G1X%.3fY%.3f" % tuple(p) for p in pts[1:]]
-    body[0] += f"S600F{feed:g}"
-    return ["G21", "G90", "M4S0", "G0X%.3fY%.3f" % tuple(pts[0])] + body + ["M5", "M9"]
 
 
 @pytest.fixture(scope="module")
@@ -65,7 +53,7 @@ def _compare(lines, label):
 
 @pytest.mark.parametrize("feed", [1500.0, 6000.0])
 def test_long_straight_line(feed):
-    job, sim = _compare(straight_line(feed), f"straight line F{feed:g}")
+    job, sim = _compare(straight_line_job(feed), f"straight line F{feed:g}")
     # by hand: one trapezoid over 537.4 mm from rest to rest
     length = np.hypot(380, 380)
     v = feed / 60
@@ -76,7 +64,7 @@ def test_long_straight_line(feed):
 
 @pytest.mark.parametrize("feed", [1500.0, 3000.0, 6000.0])
 def test_spiral_of_short_segments(feed):
-    job, sim = _compare(spiral(feed), f"spiral of 0.05 mm segments F{feed:g}")
+    job, sim = _compare(spiral_job(feed), f"spiral of 0.05 mm segments F{feed:g}")
     if feed >= 3000:
         # the planner, not the feed, limits dense work: length/feed is far too low
         assert job.naive_seconds < 0.8 * sim
@@ -133,7 +121,7 @@ def test_m3_mode_switch_without_motion_stops():
 
 
 def test_per_line_seconds_are_cumulative():
-    lines = spiral(3000.0)
+    lines = spiral_job(3000.0)
     job = estimate_gcode_time(lines, PROFILE)
     assert len(job.line_seconds) == len(lines)
     assert np.all(np.diff(job.line_seconds) >= 0)
@@ -147,7 +135,7 @@ def test_per_line_seconds_are_cumulative():
 
 def test_slower_machine_takes_longer():
     slow = LaserProfile(acceleration_x=100.0, acceleration_y=100.0)
-    lines = spiral(3000.0)
+    lines = spiral_job(3000.0)
     assert estimate_gcode_time(lines, slow).total_seconds > 1.2 * estimate_gcode_time(lines, PROFILE).total_seconds
 
 

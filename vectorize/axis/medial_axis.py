@@ -10,7 +10,7 @@ from scipy.ndimage import map_coordinates
 from onestroke.errors import VectorizeError
 from vectorize.axis.graph import Branch, MedialGraph
 from vectorize.axis.voronoi import empty_circle_bound, sides, tile_slabs, voronoi_part
-from vectorize.cores import idle_cores
+from onestroke.cores import idle_cores
 from vectorize.stroke import edge_lengths, lengths
 
 # From this many outline samples on, the Voronoi diagram is computed in tiles, one thread per

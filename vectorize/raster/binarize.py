@@ -12,7 +12,7 @@ from scipy import ndimage
 from scipy.spatial import cKDTree
 
 from onestroke.errors import InputError
-from vectorize.cores import idle_cores
+from onestroke.cores import idle_cores
 
 MIN_SIDE = 16
 # Paper darker than this (after shading) is not paper: the division stops there.
@@ -344,7 +344,7 @@ def extract_ink(gray: np.ndarray, *, threshold: float | None,
     other piece is kept (single-line mode bridges and selects pieces later, on the medial
     axis: `gaps.py`). Small holes (pores inside ink blobs, pinholes where strokes nearly
     touch) are filled. threads: 2 or more measures the width beside the labelling (None:
-    while the machine has a core to spare, `vectorize.cores.idle_cores`); the same result.
+    while the machine has a core to spare, `onestroke.cores.idle_cores`); the same result.
     """
     level = ink_threshold(gray, threshold)
     ink = gray < level

@@ -8,7 +8,7 @@ import sys
 import threading
 from pathlib import Path
 
-from vectorize.preload import preload, wait
+from onestroke.preload import preload, wait
 
 
 def test_a_preload_imports_in_its_own_thread_and_a_failed_one_is_harmless():
