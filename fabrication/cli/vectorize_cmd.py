@@ -13,6 +13,14 @@ from onestroke.atomic import all_or_nothing, check_folder
 from onestroke.errors import InputError
 from onestroke.paths import check_distinct
 
+# Set before numpy's first import (the options' decorators below bring it): OpenBLAS's
+# thread pool, a thread per core, spins waiting for work after numpy's import, ~0.23 s of CPU
+# per process on a second core (a process importing the command's libraries: 0.93 -> 0.70 s
+# CPU on this 2-core machine), while the command's linear algebra is on vectors and 2-3
+# column matrices, far below the sizes OpenBLAS splits between threads (the same SVG bytes
+# either way: benchmarks/same_svg.py). A value the user set is kept.
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+
 
 @click.command()
 @input_argument()
