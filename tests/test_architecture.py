@@ -96,7 +96,7 @@ def module_imports(packages: tuple[str, ...] = LIBRARY, root: Path = ROOT) -> nx
                     base = ".".join([*package.split(".")[:len(package.split(".")) - node.level + 1], base]).strip(".")
                 targets = [f"{base}.{a.name}" for a in node.names]
             elif isinstance(node, ast.Constant) and isinstance(node.value, str):
-                # A module named to importlib ("a.b" or "a.b:attribute": preload, lazy commands);
+                # A module named to importlib ("a.b" or "a.b:attribute": the lazy commands);
                 # a string naming the module's own package is a resource look-up, not an import.
                 text = node.value.partition(":")[0]
                 if (re.fullmatch(r"[a-z_][a-z0-9_]*(\.[a-z_][a-z0-9_]*)+", text) and text in modules

@@ -23,7 +23,6 @@ from vectorize.junctions.classifiers import make_classifier, shipped_pass_scorer
 from vectorize.junctions.crossing_point import crossing_point
 from vectorize.junctions.intersections import Junction, JunctionVerdict, ranked_pairings
 from vectorize.options import InputFrame, VectorizeOptions, VectorizeReport, VectorizeResult
-from onestroke.preload import preload, wait
 from vectorize.raster.binarize import downscaled_gray, ink_image, ink_threshold, paper_gray
 from vectorize.raster.outline import outline_rings
 from vectorize.route.route_ends import end_costs
@@ -143,7 +142,6 @@ def _trace(graph: MedialGraph, simple: Simplified, ordering: Ordering, junctions
            verdicts: dict, stroke_width: float) -> list[tuple[TracedPoints, bool, list[Twin]]]:
     """Turn branch passes into point lists flagged for filtering (paper 3.4), with the
     stretches each stroke draws twice (`vectorize.fit.retraces`)."""
-    wait("fitting")
     from vectorize.fit.fitting import TracedPoints
 
     # V-spikes: the foot is where both sides' inks merge, its points are uncertain; the
@@ -259,7 +257,6 @@ def _order(graph: MedialGraph, ink, options: VectorizeOptions, ends: int, clock:
             _refuse_ragged(odd, "loose ends and forks", options, ink.threshold)
         junction_list = _junctions(graph, simple.crossings, w)
         junctions = dict(zip(simple.crossings, junction_list))
-        wait("cnn")
         verdict_list = make_classifier(options.classifier).classify(ink.gray, junction_list, w) if junction_list else []
         if options.classifier == "cnn" and junction_list:
             geometry = make_classifier("geometric").classify(ink.gray, junction_list, w)
@@ -356,8 +353,6 @@ def _axis(image: np.ndarray, options: VectorizeOptions, clock: _Clock, cache: St
     gray, scale = working_paper(image, options, cache)
     ink = ink_image(gray, scale, threshold=options.threshold)
     clock.lap("binarize")
-    # The fitting's libraries (scipy.interpolate: FITPACK) load beside the next stages.
-    preload("fitting", ("vectorize.fit.fitting",))
     w = ink.stroke_width
     spacing = float(np.clip(w / 8.0, 0.3, 1.0))
     rings = outline_rings(ink.gray, ink.threshold, spacing)
@@ -405,9 +400,6 @@ def _front(image: np.ndarray, options: VectorizeOptions, clock: _Clock, cache: S
     branch_points = sum(1 for incident in graph.incident.values() if len(incident) >= 3)
     _refuse_noise(branch_points, "branch points", MAX_BRANCH_POINTS, ink.threshold,
                   options.threshold is not None)
-    if branch_points and options.classifier == "cnn":
-        # Junctions to classify: onnxruntime and the model's session load beside the next stages.
-        preload("cnn", ("vectorize.junctions.cnn_classifier",), lambda: make_classifier("cnn").session)
     bridges: list = []
     dropped = 0
     refuse = None
@@ -487,7 +479,6 @@ def run_pipeline(image: np.ndarray, options: VectorizeOptions, *,
     blobs = np.array([[*graph.positions[n], graph.radii[n]] for n, incident in graph.incident.items()
                       if len(incident) >= 3]).reshape(-1, 3)
     strokes = list(solved[1]) if solved is not None else []
-    wait("fitting")
     from vectorize.fit.fitting import fit_stroke
 
     for traced, closed, twins in _trace(graph, simple, ordering, junctions, verdicts, w) if solved is None else ():
