@@ -3,7 +3,7 @@ nor do the modules of the benchmarks and of the tests.
 
 The imports are read from the source with `ast` (every `import` and `from ... import`, at the
 top of a module or inside a function or `if TYPE_CHECKING:`, and module names given as
-strings to `importlib`/`preload`), module by module, then grouped into the packages of the
+strings to `importlib`), module by module, then grouped into the packages of the
 picture. The picture in docs/architecture.md is this module's output:
 
     python -m tests.test_architecture        # prints the mermaid block the doc holds
