@@ -68,10 +68,11 @@ def describe_os_error(error: OSError) -> str:
 
 def _interrupt(signum, frame) -> None:
     """Ctrl-C, SIGTERM, SIGHUP: raise `KeyboardInterrupt` (`Interrupted` naming the signal)."""
-    code = getattr(frame, "f_code", None)
-    if code is not None and (code.co_filename.startswith("<frozen importlib") or code.co_name == "__del__"):
-        # raised in importlib's module-lock callback or a finalizer, the exception would be
-        # printed and dropped, and the work go on: the same signal again in a moment
+    if _importing_or_finalizing(frame):
+        # raised inside an import or a finalizer, the exception could be dropped (printed by
+        # importlib's module-lock callback or a finalizer; swallowed by a library's optional
+        # import, `except Exception` around a class body that wraps it in RuntimeError) and
+        # the work go on: the same signal again in a moment, once that is over
         import threading
 
         threading.Timer(0.02, os.kill, (os.getpid(), signum)).start()
@@ -79,6 +80,16 @@ def _interrupt(signum, frame) -> None:
     if signum == signal.SIGINT:
         raise KeyboardInterrupt
     raise Interrupted(signal.Signals(signum).name)
+
+
+def _importing_or_finalizing(frame) -> bool:
+    """True when `frame` runs inside an import (importlib's frames below it) or a `__del__`."""
+    while frame is not None:
+        code = frame.f_code
+        if code.co_filename.startswith("<frozen importlib") or code.co_name == "__del__":
+            return True
+        frame = frame.f_back
+    return False
 
 
 def _caused_by_ctrl_c(error: BaseException) -> KeyboardInterrupt | None:
