@@ -12,7 +12,6 @@ from starlette.testclient import TestClient
 from fabrication.cli import main
 from fabrication.studio.app import MAX_BODY, create_app
 from fabrication.studio.session import StudioSession
-from tests.drawings import alpha_loop, render_polylines
 from vectorize.refine.edits import PAIRINGS
 
 HOST = "127.0.0.1:8765"
@@ -20,25 +19,16 @@ TOKEN = "test-token-123"
 
 
 @pytest.fixture(scope="module")
-def drawing(tmp_path_factory):
-    from PIL import Image
-
-    path = tmp_path_factory.mktemp("studio-api") / "loop.png"
-    Image.fromarray(render_polylines([alpha_loop()])).save(path)
-    return path
-
-
-@pytest.fixture(scope="module")
-def client(drawing):
-    session = StudioSession(drawing, edits_path=drawing.with_name("saved.edits.json"))
+def client(loop_png):
+    session = StudioSession(loop_png, edits_path=loop_png.with_name("saved.edits.json"))
     app = create_app(session, token=TOKEN, hosts={HOST})
     with TestClient(app, base_url=f"http://{HOST}") as test_client:
         test_client.headers["X-Studio-Token"] = TOKEN
         yield test_client
 
 
-def test_guard_token_host_and_size(drawing):
-    app = create_app(StudioSession(drawing), token=TOKEN, hosts={HOST})
+def test_guard_token_host_and_size(loop_png):
+    app = create_app(StudioSession(loop_png), token=TOKEN, hosts={HOST})
     with TestClient(app, base_url=f"http://{HOST}") as anonymous:
         assert anonymous.get("/api/state").status_code == 403
         assert anonymous.get("/api/state", headers={"X-Studio-Token": "wrong"}).status_code == 403
@@ -73,7 +63,7 @@ def test_state_pairing_edit_changes_the_order(client):
     assert bad.status_code == 400 and "edits" in bad.json()["error"]
 
 
-def test_save_and_load_edits(client, drawing):
+def test_save_and_load_edits(client, loop_png):
     edits = {"format": "onestroke-edits", "version": 1, "threshold": 0.45, "blur": 1.0, "multi": False,
              "tolerance": 8, "edits": [{"kind": "reverse", "at": [200, 100]}]}
     assert client.get("/api/edits").json()["exists"] is False  # the page then loads nothing
@@ -81,7 +71,7 @@ def test_save_and_load_edits(client, drawing):
     assert saved["saved"].endswith("saved.edits.json")
     loaded = client.get("/api/edits").json()
     assert loaded["exists"] is True and loaded["edits"]["edits"] == edits["edits"]
-    assert drawing.with_name("saved.edits.json").read_text().startswith("{")
+    assert loop_png.with_name("saved.edits.json").read_text().startswith("{")
 
 
 def test_previews(client):
@@ -110,7 +100,7 @@ def test_previews(client):
     ("gcode", "laser", {"size": "40mm", "power": "35%", "arcs": True, "profile": "K40"},
      ["--size", "40mm", "--power", "35%", "--arcs", "--profile", "K40"]),
 ])
-def test_downloads_are_the_cli_bytes(client, drawing, tmp_path, kind, command, options, flags):
+def test_downloads_are_the_cli_bytes(client, loop_png, tmp_path, kind, command, options, flags):
     if options.get("profile") == "K40":
         (tmp_path / "k40.toml").write_text(K40_PROFILE)
         loaded = client.post("/api/profiles", json={"name": "k40.toml", "text": K40_PROFILE})
@@ -127,7 +117,7 @@ def test_downloads_are_the_cli_bytes(client, drawing, tmp_path, kind, command, o
 
     (tmp_path / "edits.json").write_text(json.dumps(edits))
     out = tmp_path / f"cli.{kind}"
-    run = CliRunner().invoke(main, [command, str(drawing), "--edits", str(tmp_path / "edits.json"),
+    run = CliRunner().invoke(main, [command, str(loop_png), "--edits", str(tmp_path / "edits.json"),
                                     "-o", str(out), *flags])
     assert run.exit_code == 0, run.output
     assert page.content == out.read_bytes()
@@ -196,14 +186,14 @@ def test_send_to_the_emulator(client):
     assert status["acked"] == status["total"] > 10
 
 
-def test_send_reads_the_baud_rate_as_the_command_line_does(drawing):
+def test_send_reads_the_baud_rate_as_the_command_line_does(loop_png):
     """One number grammar and one check: a text "9600" is 9600 (as `--baud 9600`); 0, a
     fraction, a flag or other digits than 0-9 are refused in the CLI's words, not read by
     int() nor replaced by the default."""
     from machines.stream_types import parse_baud
     from onestroke.errors import InputError
 
-    session = StudioSession(drawing, edits_path=drawing.with_name("baud.edits.json"))
+    session = StudioSession(loop_png, edits_path=loop_png.with_name("baud.edits.json"))
     with TestClient(create_app(session, token=TOKEN, hosts={HOST}), base_url=f"http://{HOST}",
                     headers={"X-Studio-Token": TOKEN}) as client:
         for bad in (0, "0", 9600.5, True, "9600.0", "\u0669\u0666\u0660\u0660", "1e5", 57601, [9600]):
@@ -239,12 +229,12 @@ def test_send_pause_resume_abort(client):
     assert status["state"] == "aborted" and status["acked"] < status["total"], status
 
 
-def test_an_svg_drawing_opens_and_exports(drawing, tmp_path):
+def test_an_svg_drawing_opens_and_exports(loop_png, tmp_path):
     from vectorize import vectorize_file
     from vectorize.svg_write import write_drawing
 
     svg = tmp_path / "loop.svg"
-    write_drawing(vectorize_file(drawing).drawing, svg)
+    write_drawing(vectorize_file(loop_png).drawing, svg)
     app = create_app(StudioSession(svg), token=TOKEN, hosts={HOST})
     with TestClient(app, base_url=f"http://{HOST}", headers={"X-Studio-Token": TOKEN}) as svg_client:
         state = svg_client.get("/api/state").json()
@@ -267,12 +257,12 @@ def test_multi_stroke_mode_and_a_bad_threshold(client):
     assert answer.status_code == 400 and "threshold" in answer.json()["error"]
 
 
-def test_a_queued_state_request_gives_way_to_the_same_pages_newer_one(drawing):
+def test_a_queued_state_request_gives_way_to_the_same_pages_newer_one(loop_png):
     """A slider dragged over values while a re-run takes a second: the requests that wait
     for the vectorizer are skipped once the page asked for a newer state."""
     import threading
 
-    session = StudioSession(drawing)
+    session = StudioSession(loop_png)
     app = create_app(session, token=TOKEN, hosts={HOST})
     with TestClient(app, base_url=f"http://{HOST}", headers={"X-Studio-Token": TOKEN}) as test_client:
         edits = test_client.get("/api/state").json()["edits"]
@@ -315,7 +305,7 @@ def test_abort_while_connecting(client):
     assert status["state"] == "aborted" and status["acked"] < status["total"], status
 
 
-def test_the_threshold_mask_is_the_binarization(client, drawing):
+def test_the_threshold_mask_is_the_binarization(client, loop_png):
     """GET /api/mask: the working pixels darker than the threshold (the library's own
     binarization of the image at that blur), refused in the CLI's words out of range."""
     from io import BytesIO
@@ -326,7 +316,7 @@ def test_the_threshold_mask_is_the_binarization(client, drawing):
     from vectorize.raster.binarize import ink_threshold, paper_gray
     from vectorize.raster.image_io import load_image
 
-    image, _ = load_image(str(drawing), max_size=1000)
+    image, _ = load_image(str(loop_png), max_size=1000)
     for query, threshold, blur in (("threshold=auto&blur=0", None, 0.0), ("threshold=0.6&blur=1.5", 0.6, 1.5)):
         answer = client.get(f"/api/mask?{query}")
         assert answer.status_code == 200 and answer.headers["content-type"] == "image/png"

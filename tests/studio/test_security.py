@@ -22,27 +22,17 @@ from fabrication.studio.server import StudioServer
 from fabrication.studio.session import StudioSession
 from onestroke.errors import InputError
 from tests.chromium import ARTIFACTS
-from tests.drawings import alpha_loop, render_polylines
 from tests.studio.browser_page import IDLE
 
 HOST = "127.0.0.1:8765"
 TOKEN = "test-token-456"
 
 
-@pytest.fixture(scope="module")
-def drawing(tmp_path_factory):
-    from PIL import Image
-
-    path = tmp_path_factory.mktemp("studio-security") / "loop.png"
-    Image.fromarray(render_polylines([alpha_loop()])).save(path)
-    return path
-
-
 @pytest.fixture
-def session(drawing):
-    edits = drawing.with_name("loop.edits.json")
+def session(loop_png):
+    edits = loop_png.with_name("loop.edits.json")
     edits.unlink(missing_ok=True)
-    return StudioSession(drawing, edits_path=edits)
+    return StudioSession(loop_png, edits_path=edits)
 
 
 # (method, path, headers, status): what a request may do by where it comes from.
