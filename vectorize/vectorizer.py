@@ -21,7 +21,7 @@ from vectorize.fit.ink_width import edge_offset, ink_widths
 from vectorize.fit.retraces import Twin, foot_is_retraced, twin_spans
 from vectorize.junctions.classifiers import make_classifier, shipped_pass_scorer
 from vectorize.junctions.crossing_point import crossing_point
-from vectorize.junctions.intersections import Junction, JunctionVerdict, ranked_pairings
+from vectorize.junctions.intersections import Junction, JunctionVerdict, ranked_pairings, sharp_touch
 from vectorize.options import InputFrame, VectorizeOptions, VectorizeReport, VectorizeResult
 from vectorize.raster.binarize import downscaled_gray, ink_image, ink_threshold, paper_gray
 from vectorize.raster.outline import outline_rings
@@ -93,18 +93,24 @@ def _junctions(graph: MedialGraph, nodes, stroke_width: float) -> list[Junction]
     return result
 
 
-def _with_geometry(image: JunctionVerdict, geometry: JunctionVerdict) -> JunctionVerdict:
+def _with_geometry(image: JunctionVerdict, geometry: JunctionVerdict, sharp: bool = False) -> JunctionVerdict:
     """The CNN's verdict with the branch geometry as independent evidence (log-odds add).
 
     Where touching would mean sharp turns (a steep crossing, perhaps with a hook nearby that
     confuses the image) geometry is decisive; at a touch or a shallow crossing both
-    pairings are smooth, geometry says ~0.5 and the image decides alone.
+    pairings are smooth, geometry says ~0.5 and the image decides alone. `sharp`
+    (`intersections.sharp_touch`): touching would turn a pass sharply where going straight
+    does not, which no touch does: the image's evidence for a touch is not taken (the CNN
+    never saw a stroke bend at a crossing in training, and reads one as a touch with full
+    confidence), its evidence for a crossing is.
     """
     def logit(p: float) -> float:
         p = min(max(p, 1e-4), 1 - 1e-4)
         return float(np.log(p / (1 - p)))
 
     p = float(1.0 / (1.0 + np.exp(-(logit(image.p_crossing) + logit(geometry.p_crossing)))))
+    if sharp and p < geometry.p_crossing:
+        return geometry
     agree = (p >= 0.5) == image.is_crossing
     return JunctionVerdict(p_crossing=p, confidence=image.confidence if agree else max(p, 1 - p))
 
@@ -267,7 +273,8 @@ def _order(graph: MedialGraph, ink, options: VectorizeOptions, ends: int, clock:
         verdict_list = make_classifier(options.classifier).classify(ink.gray, junction_list, w) if junction_list else []
         if options.classifier == "cnn" and junction_list:
             geometry = make_classifier("geometric").classify(ink.gray, junction_list, w)
-            verdict_list = [_with_geometry(v, g) for v, g in zip(verdict_list, geometry)]
+            verdict_list = [_with_geometry(v, g, sharp_touch(j.directions))
+                            for v, g, j in zip(verdict_list, geometry, junction_list)]
         verdicts = dict(zip(simple.crossings, verdict_list))
         if refine is not None:
             refine.store(ends, (graph, simple, junctions, verdicts))

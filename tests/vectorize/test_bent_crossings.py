@@ -1,0 +1,60 @@
+"""A stroke that bends right at a crossing is not a touch: a cursive e's way in bends into
+its loop where the loop's side comes down across it. The CNN, trained on crossings of
+gently curved strokes, reads that as a touch with full confidence; a touch's two passes run
+on smoothly (`intersections.sharp_touch`), so there the geometry decides."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from benchmarks.common.render import render
+from benchmarks.metrics.table1 import drawing_polylines, polyline_intersections
+from benchmarks.sets.cursive import cursive_drawing
+from vectorize import VectorizeOptions, vectorize_image
+from vectorize.drawing import Drawing
+from vectorize.junctions.intersections import sharp_touch
+from vectorize.stroke import Stroke
+
+
+def _unit(degrees: list[float]) -> np.ndarray:
+    a = np.radians(degrees)
+    return np.c_[np.cos(a), np.sin(a)]
+
+
+def test_sharp_touch_needs_a_sharp_touching_turn_and_a_straight_crossing():
+    # An e's entry (measured in incidentally-0-12): straight through bends 10 and 21 degrees,
+    # touching 35 and 66.
+    assert sharp_touch(_unit([129.0, 84.0, -86.0, -30.0]))
+    # Two arcs touching tangentially: both pairings smooth.
+    assert not sharp_touch(_unit([8.0, 172.0, -8.0, 188.0]))
+    # A cusp's tip on a line: going straight through bends as sharply as touching.
+    assert not sharp_touch(_unit([0.0, 180.0, 80.0, 100.0]))
+
+
+def _stretch(seed: int, index: int, center: tuple[float, float], half: float) -> tuple[Drawing, np.ndarray]:
+    """The stretch of a cursive line's pen path from its first to its last point within
+    `half` px of `center`, moved onto a small page, and where `center` moved to."""
+    gt = cursive_drawing(seed, index)
+    points = gt.drawing.strokes[0].sample_evenly(1.0)
+    inside = np.flatnonzero(np.all(np.abs(points - np.array(center)) < half, axis=1))
+    path = points[inside.min():inside.max() + 1]
+    shift = 20.0 - path.min(axis=0)
+    path = path + shift
+    size = path.max(axis=0) + 20.0
+    drawing = Drawing((Stroke.from_polyline(path),), float(size[0]), float(size[1]), "px", gt.width)
+    return drawing, np.array(center) + shift
+
+
+@pytest.mark.parametrize("seed, index, crossing", [
+    (0, 12, (466.0, 527.7)),  # "incidentally", 4.75 px: CNN 0.012, geometry 0.94
+    (0, 18, (506.0, 507.0)),  # "i like mint tea", 3.0 px: CNN 0.025, geometry 0.95
+    (0, 8, (559.0, 505.0)),   # "the planet men", 2.5 px: CNN 0.021, geometry 0.95
+])
+def test_an_e_loops_bent_way_in_is_crossed(seed, index, crossing):
+    drawing, point = _stretch(seed, index, crossing, 45.0)
+    result = vectorize_image(render(drawing), VectorizeOptions(classifier="cnn"))
+    assert result.report.strokes == 1
+    polys, closed = drawing_polylines(result.drawing)
+    crossings = np.asarray(polyline_intersections(polys, closed).crossings).reshape(-1, 2)
+    assert len(crossings) and np.min(np.hypot(*(crossings - point).T)) < 5.0
