@@ -21,7 +21,8 @@ from vectorize.fit.ink_width import edge_offset, ink_widths
 from vectorize.fit.retraces import Twin, foot_is_retraced, twin_spans
 from vectorize.junctions.classifiers import make_classifier, shipped_pass_scorer
 from vectorize.junctions.crossing_point import crossing_point
-from vectorize.junctions.intersections import Junction, JunctionVerdict, ranked_pairings, sharp_touch
+from vectorize.junctions.intersections import (Junction, JunctionVerdict, lone_junctions, ranked_pairings,
+                                              sharp_touch)
 from vectorize.options import InputFrame, VectorizeOptions, VectorizeReport, VectorizeResult
 from vectorize.raster.binarize import downscaled_gray, ink_image, ink_threshold, paper_gray
 from vectorize.raster.outline import outline_rings
@@ -273,8 +274,10 @@ def _order(graph: MedialGraph, ink, options: VectorizeOptions, ends: int, clock:
         verdict_list = make_classifier(options.classifier).classify(ink.gray, junction_list, w) if junction_list else []
         if options.classifier == "cnn" and junction_list:
             geometry = make_classifier("geometric").classify(ink.gray, junction_list, w)
-            verdict_list = [_with_geometry(v, g, sharp_touch(j.directions))
-                            for v, g, j in zip(verdict_list, geometry, junction_list)]
+            lone = lone_junctions(np.array([j.center for j in junction_list]),
+                                  np.array([graph.spans.get(n, 0.0) for n in simple.crossings]), 2.5 * w)
+            verdict_list = [_with_geometry(v, g, sharp_touch(j.directions) and alone)
+                            for v, g, j, alone in zip(verdict_list, geometry, junction_list, lone)]
         verdicts = dict(zip(simple.crossings, verdict_list))
         if refine is not None:
             refine.store(ends, (graph, simple, junctions, verdicts))

@@ -122,6 +122,18 @@ def sharp_touch(directions: np.ndarray) -> bool:
     return touch > TOUCH_MAX_BEND and straight < STRAIGHT_MAX_BEND
 
 
+def lone_junctions(centers: np.ndarray, spans: np.ndarray, reach: float) -> np.ndarray:
+    """(N,) bool: no other junction within `reach` px plus both junctions' spans (px of
+    shared ink, (N,)) of each centre ((N, 2) px). Branch directions measured `reach` beyond
+    a junction's span run through a nearer one's ink (two crossings in one band of three
+    passes): there they do not show how the strokes bend."""
+    c = np.asarray(centers, dtype=float).reshape(-1, 2)
+    s = np.asarray(spans, dtype=float).reshape(-1)
+    gap = np.hypot(*(c[:, None, :] - c[None, :, :]).transpose(2, 0, 1)) - s[:, None] - s[None, :]
+    np.fill_diagonal(gap, np.inf)
+    return gap.min(axis=1, initial=np.inf) >= reach
+
+
 # Degrees. Touches: the touching pairing bends <= 28; cursive e entries bend 21-30 going
 # straight through and 66-80 touching (six at seed 0).
 TOUCH_MAX_BEND = 45.0
