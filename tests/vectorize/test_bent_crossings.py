@@ -13,7 +13,7 @@ from benchmarks.metrics.table1 import drawing_polylines, polyline_intersections
 from benchmarks.sets.cursive import cursive_drawing
 from vectorize import VectorizeOptions, vectorize_image
 from vectorize.drawing import Drawing
-from vectorize.junctions.intersections import sharp_touch
+from vectorize.junctions.intersections import lone_junctions, sharp_touch
 from vectorize.stroke import Stroke
 
 
@@ -30,6 +30,14 @@ def test_sharp_touch_needs_a_sharp_touching_turn_and_a_straight_crossing():
     assert not sharp_touch(_unit([8.0, 172.0, -8.0, 188.0]))
     # A cusp's tip on a line: going straight through bends as sharply as touching.
     assert not sharp_touch(_unit([0.0, 180.0, 80.0, 100.0]))
+
+
+def test_lone_junctions_counts_the_spans():
+    centers = np.array([[0.0, 0.0], [10.0, 0.0], [100.0, 0.0]])
+    # 10 px apart: alone with a reach of 8 px and no shared ink; not with 2 px of span each.
+    assert lone_junctions(centers, np.zeros(3), 8.0).tolist() == [True, True, True]
+    assert lone_junctions(centers, np.array([2.0, 2.0, 0.0]), 8.0).tolist() == [False, False, True]
+    assert lone_junctions(centers[:1], np.zeros(1), 8.0).tolist() == [True]
 
 
 def _stretch(seed: int, index: int, center: tuple[float, float], half: float) -> tuple[Drawing, np.ndarray]:
