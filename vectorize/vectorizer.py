@@ -28,7 +28,7 @@ from vectorize.raster.outline import outline_rings
 from vectorize.route.retrace_paths import turn_prices, turns_at
 from vectorize.route.route_ends import end_costs
 from vectorize.route.route_inspection import connect_pairings, plan_routes
-from vectorize.route.traversal import Ordering, order_strokes
+from vectorize.route.traversal import Ordering, order_strokes, turn_backs
 from vectorize.stroke import Stroke, lengths
 
 if TYPE_CHECKING:  # the studio's refinement is imported where edits or a session ask for it
@@ -168,18 +168,22 @@ def _trace(graph: MedialGraph, simple: Simplified, ordering: Ordering, junctions
         # there lie on one averaged centre line.
         reach = max(reach, graph.spans.get(node, 0.0) + 0.5 * stroke_width)
         reach = float(np.clip(reach, graph.radii[node], 12.0 * stroke_width))
-        zones.append((graph.positions[node], reach, verdicts[node].is_crossing))
+        zones.append((node, reach, verdicts[node].is_crossing))
     for node in simple.through:
         # Three passes cross: their inks overlap about as far as the cluster reached.
         reach = float(np.clip(graph.spans.get(node, 0.0) + stroke_width, graph.radii[node], 12.0 * stroke_width))
-        zones.append((graph.positions[node], reach, True))
+        zones.append((node, reach, True))
     result = []
     # Not retraced stretches: a loop (its direction cannot be told from where it starts) and
     # the foot of a V-spike (each side of the V runs to the tip on its own ink).
     not_twins = {bid for bid, b in graph.branches.items() if b.a == b.b} | foot_branches
+    zone_nodes = {node for node, _, _ in zones}
     for passes, closed in zip(ordering.strokes, ordering.closed):
-        parts, keeps, tips, spans, radii = [], [], [], [], []
+        parts, keeps, tips, spans, radii, owners = [], [], [], [], [], []
         count = 0  # traced points so far
+        # Where the pen turns back at a junction it goes up to the node and returns: its
+        # points there are the line, not uncertain ink of passes running through.
+        turned = turn_backs(graph, passes, zone_nodes, stroke_width)
         for index, step in enumerate(passes):
             branch = graph.branches[step.branch]
             # By end, not by node: a loop starts and ends at the same node.
@@ -195,12 +199,13 @@ def _trace(graph: MedialGraph, simple: Simplified, ordering: Ordering, junctions
             on_foot = step.branch in foot_branches
             # The pen turns back on itself: a cusp (the fit splits there, never loops).
             turns_back = (index + 1 < len(passes) and passes[index + 1].branch == step.branch
-                          and passes[index + 1].start != step.start)
+                          and passes[index + 1].start != step.start) or index in turned
             tip = np.zeros(len(points), dtype=bool)
             tip[-1] = far_node in simple.y_tips or turns_back or (
                 index + 1 < len(passes) and turns_at(graph, decided, step, passes[index + 1]))
             parts.append(points)
             radii.append(radius)
+            owners.append(np.full(len(points), index))
             keeps.append(tip | (not on_foot))
             tips.append(tip)
         twins = twin_spans([p.branch for p in passes], [p.start for p in passes], spans, not_twins)
@@ -211,9 +216,11 @@ def _trace(graph: MedialGraph, simple: Simplified, ordering: Ordering, junctions
         xy, keep, split = np.concatenate(parts), np.concatenate(keeps), np.concatenate(tips)
         for base in sharp_points:
             split[np.all(xy == base, axis=1)] = True
-        for center, reach, crossing in zones:
-            dist = lengths(xy - center)
-            near = dist < reach
+        owner = np.concatenate(owners)
+        for node, reach, crossing in zones:
+            dist = lengths(xy - graph.positions[node])
+            turning = [i for i, at in turned.items() if at == node]
+            near = (dist < reach) & ~np.isin(owner, turning + [i + 1 for i in turning])
             keep[near] &= crossing & (dist[near] < 1e-6)
         result.append((TracedPoints(xy=xy, keep=keep, split=split, radius=np.concatenate(radii)), closed, twins))
     return result

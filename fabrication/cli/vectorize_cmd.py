@@ -54,6 +54,10 @@ def vectorize(source: str, output: str, multi: bool, threshold: float | None, bl
     from vectorize import VectorizeOptions, vectorize_file
     from vectorize.svg_write import write_drawing
 
+    from fabrication.cli.heap import keep_freed_memory
+
+    keep_freed_memory()  # the image's arrays reuse freed heap memory (fabrication/cli/heap.py)
+
     placement = None  # the page at the design's size; None: the input's own page (in mm with --inkstitch)
     if any(v is not None for v in (size, width, height)) or rotate:
         from fabrication.placement import PlacementOptions

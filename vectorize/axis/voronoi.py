@@ -36,6 +36,10 @@ JITTER = 1e-8
 JITTER_SEED = 0
 # Rounding error of the circumcentre formula and the distances, as a fraction of the extent.
 ROUNDING = 1e-12
+# scipy's default options for a 2-D Delaunay triangulation less "Qc", which only records the
+# points left out of it (coincident ones), which nothing here reads: 7 % less time in qhull
+# (15 drawings, sum of the fastest of 5 runs: 685 -> 633 ms), the same triangles.
+QHULL_OPTIONS = "Qbb Qz Q12"
 # Tiling pays while the largest widened tile holds at most this share of the samples.
 MAX_TILE_SHARE = 0.75
 
@@ -130,7 +134,7 @@ def _triangulation(points: np.ndarray, jitter: np.ndarray | None, span: float) -
     inner edge's two triangles first (E,) < second (E,), its samples (E, 2), whether its
     triangles' centres are one vertex (E,)).
     """
-    tri = Delaunay(points if jitter is None else points + jitter)
+    tri = Delaunay(points if jitter is None else points + jitter, qhull_options=QHULL_OPTIONS)
     simplices, neighbors = tri.simplices, tri.neighbors
     # Each corner triple in ascending order: the same triangle gives the same circumcentre
     # bits in every tile.

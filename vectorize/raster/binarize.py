@@ -63,10 +63,9 @@ def to_gray(image: np.ndarray) -> np.ndarray:
 
 
 def _to_gray(image: np.ndarray) -> np.ndarray:
-    if image.dtype == np.uint8:
-        data = image.astype(np.float32) / 255.0
-    elif image.dtype == np.uint16:
-        data = image.astype(np.float32) / 65535.0
+    if image.dtype in (np.uint8, np.uint16):
+        data = image.astype(np.float32)
+        data /= np.float32(255.0 if image.dtype == np.uint8 else 65535.0)  # in place: one array, not two
     elif image.dtype == bool:
         data = (~image).astype(np.float32)
     else:
@@ -274,14 +273,53 @@ def ink_depth(ink: np.ndarray, rows: np.ndarray | None = None, cols: np.ndarray 
     distance[rows[beside], cols[beside]] = np.sqrt(1.0)
     distance[rows[diagonal], cols[diagonal]] = np.sqrt(2.0)
     deep = ~(beside | diagonal)
-    if deep.any():
-        inside = np.column_stack([rows[deep], cols[deep]])
+    inside = _nearest_paper_near(paper, np.column_stack([rows[deep], cols[deep]]), distance)
+    if len(inside):
         edges = np.column_stack(_pixels(edge))
         _, nearest = cKDTree(edges).query(inside)
         offset = (edges[nearest] - inside).astype(np.float64)
         np.multiply(offset, offset, offset)
         distance[inside[:, 0], inside[:, 1]] = np.sqrt(offset[:, 0] + offset[:, 1])
     return distance
+
+
+# Offsets (dy, dx) a deep ink pixel's nearest paper is looked for at directly, nearest first
+# (whole-number squared distances from 4, the nearest a pixel with no paper beside it or on a
+# diagonal can have, to DIRECT_REACH squared); deeper ones go to the k-d tree.
+DIRECT_REACH = 4
+_dy, _dx = np.mgrid[-DIRECT_REACH:DIRECT_REACH + 1, -DIRECT_REACH:DIRECT_REACH + 1]
+_d2 = (_dy * _dy + _dx * _dx).ravel()
+_near = (_d2 >= 4) & (_d2 <= DIRECT_REACH * DIRECT_REACH)
+_order = np.argsort(_d2[_near], kind="stable")
+RING_OFFSETS = np.column_stack([_dy.ravel()[_near], _dx.ravel()[_near]])[_order]
+RING_SQUARES = _d2[_near][_order]
+del _dy, _dx, _d2, _near, _order
+
+
+def _nearest_paper_near(paper: np.ndarray, inside: np.ndarray, distance: np.ndarray) -> np.ndarray:
+    """Write into `distance` the distance of each ink pixel `inside` (K, 2) rows, cols whose
+    nearest `paper` pixel (H, W) is within DIRECT_REACH px, found by looking at the offsets
+    in order of distance (a pen line's ink is a few px deep: cheaper than the k-d tree, and
+    the same numbers, the square root of the same whole number); returns the pixels left."""
+    h, w = paper.shape
+    reach = DIRECT_REACH
+    padded = np.zeros((h + 2 * reach, w + 2 * reach), dtype=bool)  # beyond the edge: no paper
+    padded[reach:h + reach, reach:w + reach] = paper
+    width = w + 2 * reach
+    flat = padded.ravel()
+    at = (inside[:, 0] + reach) * width + inside[:, 1] + reach
+    steps = RING_OFFSETS[:, 0] * width + RING_OFFSETS[:, 1]
+    first = 0
+    while first < len(steps) and len(at):
+        last = first
+        while last < len(steps) and RING_SQUARES[last] == RING_SQUARES[first]:
+            last += 1
+        hit = flat[at[:, None] + steps[None, first:last]].any(axis=1)
+        found = inside[hit]
+        distance[found[:, 0], found[:, 1]] = np.sqrt(float(RING_SQUARES[first]))
+        inside, at = inside[~hit], at[~hit]
+        first = last
+    return inside
 
 
 def grow(mask: np.ndarray, steps: int, *, square: bool = False) -> np.ndarray:

@@ -14,7 +14,19 @@ def outline_rings(gray: np.ndarray, level: float, spacing: float) -> list[np.nda
     The image is padded with paper so that ink touching the border still gives closed
     rings. Rings shorter than a few samples (isolated pixels) are dropped.
     """
-    padded = np.pad(gray, 1, constant_values=1.0)
+    # Marching squares finds a contour only in squares with a corner at or below the level:
+    # the rows and columns past the last such pixel, and one more, are left out (their
+    # squares have none, and the squares before them come in the same order). The first
+    # rows and columns stay: a contour point is its square's row or column plus a fraction,
+    # and the same sum from a cropped row number would round differently.
+    dark = gray <= level
+    rows, cols = np.flatnonzero(dark.any(axis=1)), np.flatnonzero(dark.any(axis=0))
+    if not rows.size:
+        return []
+    bottom, right = int(rows[-1]) + 2, int(cols[-1]) + 2  # padded rows and columns kept: 0 .. bottom
+    padded = np.ones((bottom + 1, right + 1), dtype=gray.dtype)
+    part = gray[:bottom, :right]
+    padded[1:1 + part.shape[0], 1:1 + part.shape[1]] = part
     rings = []
     for contour in find_contours(padded, level):
         xy = contour[:, ::-1] - 1.0  # (row, col) -> (x, y), undo the padding

@@ -13,7 +13,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from vectorize.axis.graph import MedialGraph
-from vectorize.axis.simplify import Simplified, Slot, directions, slots
+from vectorize.axis.simplify import Simplified, Slot, directions, slot_direction, slots
 from vectorize.junctions.intersections import Pairing
 
 @dataclass(frozen=True)
@@ -171,3 +171,25 @@ def order_strokes(graph: MedialGraph, simple: Simplified, ranked: dict[int, tupl
     strokes, closed = walker.traverse(choice)
     ordering = Ordering(tuple(tuple(p) for p in strokes), tuple(closed), tuple(choice[n] for n in nodes))
     return ordering, 1
+
+
+def turn_backs(graph: MedialGraph, passes, nodes, reach: float) -> dict[int, int]:
+    """Where a stroke turns back at one of `nodes`: {i: node} for the passes i, i + 1 that
+    meet at that node and leave it on the same side (their tangents `reach` px beyond the ink
+    the node's passes share, less than 90 degrees apart). At a crossing or touch both passes
+    usually run on through; a pairing that sends the pen back the way it came (along a band
+    of ink two passes share) makes the node a cusp of the line. Measured close to the node
+    (not as far as `directions` looks): two branches that share a band and part at its end
+    turn back, wherever they go further on."""
+    result: dict[int, int] = {}
+    for i in range(len(passes) - 1):
+        step, after = passes[i], passes[i + 1]
+        branch = graph.branches[step.branch]
+        node = branch.b if step.start == "a" else branch.a
+        arrive, leave = (step.branch, "b" if step.start == "a" else "a"), (after.branch, after.start)
+        if node not in nodes or arrive == leave or step.branch == after.branch:
+            continue  # the same branch back is a retrace, handled as one
+        out = reach + graph.spans.get(node, 0.0)
+        if float(slot_direction(graph, arrive, out) @ slot_direction(graph, leave, out)) > 0.0:
+            result[i] = node
+    return result

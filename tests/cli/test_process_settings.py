@@ -1,0 +1,85 @@
+"""The process settings `onestroke vectorize` makes for its own speed, checked in real
+command processes: OpenBLAS's thread pool limited to one thread before numpy is imported
+(its idle pool spins on the second core: `fabrication/cli/vectorize_cmd.py`), and glibc's
+heap keeping freed memory for the next large array (`fabrication/cli/heap.py`)."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from tests.children import child_env
+
+ROOT = Path(__file__).resolve().parents[2]
+DRAWING = ROOT / "examples" / "loops.png"
+
+# Runs the real command line in this process, noting OPENBLAS_NUM_THREADS as it was when
+# numpy's import began; then (when asked) counts the minor page faults of rounds of large
+# arrays allocated together and freed together, as a vectorization's stages do.
+CHILD = """
+import json, os, resource, sys
+report, run_command, argv = sys.argv[1], sys.argv[2] == "1", sys.argv[3:]
+seen = {}
+
+class Watch:
+    def find_spec(self, name, path=None, target=None):
+        if name == "numpy" and "numpy" not in seen:
+            seen["numpy"] = os.environ.get("OPENBLAS_NUM_THREADS")
+        return None
+
+sys.meta_path.insert(0, Watch())
+code = None
+if run_command:
+    sys.argv = ["onestroke", *argv]
+    from fabrication.cli import main
+    try:
+        main()
+    except SystemExit as done:
+        code = done.code
+import numpy as np
+faults = []
+for _ in range(6):
+    before = resource.getrusage(resource.RUSAGE_SELF).ru_minflt
+    arrays = [np.ones(500_000) for _ in range(4)]  # 4 MB each
+    del arrays
+    faults.append(resource.getrusage(resource.RUSAGE_SELF).ru_minflt - before)
+with open(report, "w") as fh:
+    json.dump({"exit": code, "openblas": seen.get("numpy"), "faults": faults}, fh)
+"""
+
+
+def _child(tmp_path: Path, run_command: bool, **env: str) -> dict:
+    report = tmp_path / "report.json"
+    args = ["vectorize", str(DRAWING), "-o", str(tmp_path / "out.svg")] if run_command else []
+    done = subprocess.run([sys.executable, "-c", CHILD, str(report), "1" if run_command else "0", *args],
+                          capture_output=True, text=True, env=child_env(**env), timeout=300)
+    assert done.returncode == 0, done.stderr
+    return json.loads(report.read_text())
+
+
+def test_openblas_pool_is_one_thread_before_numpy_loads(tmp_path):
+    env = {k: v for k, v in child_env().items() if k != "OPENBLAS_NUM_THREADS"}
+    report = tmp_path / "report.json"
+    done = subprocess.run([sys.executable, "-c", CHILD, str(report), "1", "vectorize", str(DRAWING), "-o",
+                           str(tmp_path / "out.svg")], capture_output=True, text=True, env=env, timeout=300)
+    assert done.returncode == 0, done.stderr
+    result = json.loads(report.read_text())
+    assert result["exit"] == 0 and (tmp_path / "out.svg").stat().st_size > 0
+    assert result["openblas"] == "1"
+    # A value the user set is kept.
+    assert _child(tmp_path, True, OPENBLAS_NUM_THREADS="2")["openblas"] == "2"
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="glibc's mallopt")
+def test_vectorize_keeps_freed_heap_memory(tmp_path):
+    tuned = _child(tmp_path, True)
+    plain = _child(tmp_path, False)
+    assert tuned["exit"] == 0
+    # After the first round, arrays freed together are served again from the kept heap.
+    later_tuned, later_plain = sum(tuned["faults"][1:]), sum(plain["faults"][1:])
+    assert later_plain > 4 * 900  # 4 MB a round is ~1000 pages: glibc's defaults fault them again
+    assert later_tuned < later_plain / 10, (tuned["faults"], plain["faults"])

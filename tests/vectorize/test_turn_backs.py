@@ -1,0 +1,44 @@
+"""Where the route turns back at a junction, the curve goes there: a cursive d whose bowl
+touches its stem has three passes in one band (the bowl coming up, the stem drawn up and
+back down); simplification merges the band's two forks into one node, and the route's
+pairing there sends the pen up the band and back down it. The fit used to drop every point
+near that node as uncertain ink of passes running through, and cut the turn off: the band
+between the forks was left undrawn (by 8-16 px at widths of 2-3.5 px)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from benchmarks.common.render import render
+from benchmarks.metrics.ink import excursion, excursion_bound, uncovered
+from benchmarks.metrics.table1 import order_tolerance
+from benchmarks.sets.cursive import cursive_drawing
+from vectorize import VectorizeOptions, vectorize_image
+from vectorize.drawing import Drawing
+from vectorize.stroke import Stroke
+
+
+def _stretch(seed: int, index: int, center: tuple[float, float], half: float) -> Drawing:
+    """The stretch of a cursive line's pen path from its first to its last point within
+    `half` px of `center` (one piece of the line), moved onto a small page."""
+    gt = cursive_drawing(seed, index)
+    points = gt.drawing.strokes[0].sample_evenly(1.0)
+    inside = np.flatnonzero(np.all(np.abs(points - np.array(center)) < half, axis=1))
+    path = points[inside.min():inside.max() + 1]
+    path = path - path.min(axis=0) + 20.0
+    size = path.max(axis=0) + 20.0
+    return Drawing((Stroke.from_polyline(path),), float(size[0]), float(size[1]), "px", gt.width)
+
+
+@pytest.mark.parametrize("seed, index, center, half", [
+    (0, 13, (470.0, 500.0), 50.0),  # "duck", 3.5 px: the band was left out by 15.8 px
+    (0, 26, (905.0, 501.0), 40.0),  # "duke", 2.25 px: by 7.9 px
+])
+def test_a_band_the_route_turns_back_in_is_drawn(seed, index, center, half):
+    drawing = _stretch(seed, index, center, half)
+    width = drawing.stroke_width
+    result = vectorize_image(render(drawing), VectorizeOptions(classifier="cnn"))
+    assert result.report.strokes == 1
+    assert uncovered(drawing, result.drawing) <= order_tolerance(width)
+    assert excursion(drawing, result.drawing) <= excursion_bound(width)
