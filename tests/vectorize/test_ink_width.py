@@ -141,3 +141,39 @@ def test_a_brush_line_measures_its_width_profile():
     error = np.abs(out.widths_at(t) - drawn)
     assert np.mean(error <= 0.1 * drawn) >= 0.95
     assert len(out.widths) < 60  # a few rows per change of width, not one per sample
+
+
+@pytest.mark.parametrize("name", ["loops", "touch-drawing", "spike-drawing"])
+def test_edge_offset_read_in_chunks_is_the_whole_profiles(name, monkeypatch):
+    """`edge_offset` reads the normals a few steps at a time for the points not crossed yet:
+    the same number as reading every step for every point at once (one chunk)."""
+    from pathlib import Path
+
+    from vectorize.fit import ink_width
+    from vectorize.raster.binarize import ink_image, paper_gray
+    from vectorize.raster.image_io import load_image
+    from vectorize.raster.outline import outline_rings
+
+    examples = Path(__file__).resolve().parents[2] / "examples"
+    path = examples / f"{name}.png"
+    image, _ = load_image(path, max_size=1000)
+    for blur in (0.0, 1.5):
+        gray, scale = paper_gray(image, max_size=1000, blur=blur)
+        ink = ink_image(gray, scale, threshold=None)
+        rings = outline_rings(ink.gray, ink.threshold, float(np.clip(ink.stroke_width / 8.0, 0.3, 1.0)))
+        args = (ink.gray, ink.ink, rings, ink.threshold, ink.stroke_width)
+        chunked = ink_width.edge_offset(*args)
+        monkeypatch.setattr(ink_width, "EDGE_CHUNK", 10_000)
+        assert ink_width.edge_offset(*args) == chunked
+        monkeypatch.undo()
+
+
+def test_paper_median_without_sorting_is_numpys():
+    from vectorize.fit.ink_width import _median
+
+    rng = np.random.default_rng(3)
+    for n in (1, 2, 3, 4, 5, 10, 11, 1000, 1001):
+        for top_share in (0.0, 0.4, 0.5, 0.6, 0.9, 1.0):
+            values = rng.random(n).astype(np.float32)
+            values[rng.random(n) < top_share] = 1.0
+            assert _median(values) == float(np.median(values)), (n, top_share)

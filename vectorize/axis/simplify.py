@@ -181,8 +181,10 @@ def simplify(graph: MedialGraph, *, stroke_width: float, multi: bool, ends: int 
         leaves = len(graph.nodes_of_degree(1))
         v_spikes = [n for n in graph.nodes_of_degree(3) if _v_spike(graph, n, reach)]
         def crossing_half(node: int) -> bool:
-            # Another junction within a stroke width: two halves of one crossing.
+            # Another junction within a stroke width, or one that with this node forms a
+            # crossing (`_crossing_halves`): two halves of one crossing, not a spike's base.
             return any(graph.branches[bid].length < stroke_width and graph.degree(graph.branches[bid].other(node)) == 3
+                       or _crossing_halves(graph, node, bid, reach, stroke_width)
                        for bid in graph.incident[node] if graph.branches[bid].other(node) != node)
 
         shaped = sorted(((_t_stub(graph, n, reach, stroke_width)[1], n) for n in graph.nodes_of_degree(3)
@@ -306,6 +308,57 @@ def _v_spike(graph: MedialGraph, node: int, reach: float) -> bool:
     if float(np.dot(dirs[sides[0]], dirs[sides[1]])) < np.cos(np.radians(V_SPIKE_MAX_ANGLE)):
         return False
     return graph.degree(graph.branches[slots(graph, node)[foot][0]].other(node)) == 1
+
+
+def _crossing_halves(graph: MedialGraph, node: int, bid: int, reach: float, stroke_width: float) -> bool:
+    """Whether `node` and the degree-3 junction at the other end of branch `bid` are the two
+    halves of one crossing that closes a loop: two of the four other branch ends are one
+    loop's, the two passes run straight through both junctions (each bends by at most
+    `CROSSING_PASS_MAX_BEND`), the branch between them is the widest at `node`, and it is no
+    longer than the ink two lines crossing at that angle share (w / sin(a / 2), a the angle
+    between the passes, with `CROSSING_JOIN_SLACK`).
+
+    Where a crossing lies a few widths from the line's end (a loop's exit stroke crossing
+    its way in: the last letter's loop, an e at a word's end), the short exit ends free
+    and reads like a spike off a straight line (a T) unless the crossing is seen whole.
+    """
+    other = graph.branches[bid].other(node)
+    if other == node or graph.degree(other) != 3:
+        return False
+    # Two of the four other branch ends are one loop's: the passes through the crossing are
+    # the way into and out of that loop. (A stem drawn down and back up through a crossing,
+    # three passes in one band, also looks straight here, but its stub is a spike: the
+    # route would otherwise pair its free end the long way round.)
+    outer = [b for end in (node, other) for b in graph.incident[end] if b != bid]
+    if len(set(outer)) == len(outer):
+        return False
+    legs = []
+    for end in (node, other):
+        end_slots = slots(graph, end)
+        dirs = directions(graph, end, reach)
+        link = [i for i, (b, _) in enumerate(end_slots) if b == bid]
+        legs.append([dirs[i] for i in range(3) if i != link[0]])
+    (a0, a1), (b0, b1) = legs
+    # A pass enters along -a and leaves along b: straight when a and b are opposite.
+    bend = min(max(float(np.dot(a0, b0)), float(np.dot(a1, b1))), max(float(np.dot(a0, b1)), float(np.dot(a1, b0))))
+    if bend > -np.cos(np.radians(CROSSING_PASS_MAX_BEND)):
+        return False
+    # The branch between the halves runs through ink laid down twice: the widest (paper, Fig. 4).
+    link = _min_radius(graph.branches[bid])
+    if any(_min_radius(graph.branches[b]) > link for b in graph.incident[node] if b != bid):
+        return False
+    half_angle = 0.5 * np.arccos(np.clip(float(np.dot(a0, a1)), -1.0, 1.0))
+    return graph.branches[bid].length <= CROSSING_JOIN_SLACK * stroke_width / max(np.sin(half_angle), 1e-3)
+
+
+# Each of the two passes through a crossing seen as two junctions bends by less than this
+# (degrees) across the pair; a spike's base next to another junction does not continue
+# straight into one of its branches.
+CROSSING_PASS_MAX_BEND = 30.0
+# The measured stroke width falls short of the ink's (anti-aliased edges) and the branches'
+# directions, measured a few widths out, open wider than the crossing itself: slack on the
+# shared ink's length w / sin(a / 2).
+CROSSING_JOIN_SLACK = 1.5
 
 
 def _t_stub(graph: MedialGraph, node: int, reach: float, stroke_width: float) -> tuple[int, float] | None:

@@ -8,17 +8,17 @@ from skimage.measure import find_contours
 from vectorize.stroke import edge_lengths
 
 
-def outline_rings(gray: np.ndarray, level: float, spacing: float) -> list[np.ndarray]:
-    """Closed outline rings of the ink, resampled every `spacing` px: list of (N, 2) x, y arrays.
+def padded_contours(gray: np.ndarray, level: float) -> list[np.ndarray]:
+    """`skimage.measure.find_contours` of `gray` (H, W) padded with a row and a column of
+    paper (1.0) on every side, at `level`: the same (K, 2) row, column arrays in the padded
+    image's frame, in the same order, from less of the image.
 
-    The image is padded with paper so that ink touching the border still gives closed
-    rings. Rings shorter than a few samples (isolated pixels) are dropped.
+    Marching squares finds a contour only in squares with a corner at or below the level:
+    the rows and columns past the last such pixel, and one more, are left out (their squares
+    have none, and the squares before them come in the same order). The first rows and
+    columns stay: a contour point is its square's row or column plus a fraction, and the same
+    sum from a cropped row number would round differently.
     """
-    # Marching squares finds a contour only in squares with a corner at or below the level:
-    # the rows and columns past the last such pixel, and one more, are left out (their
-    # squares have none, and the squares before them come in the same order). The first
-    # rows and columns stay: a contour point is its square's row or column plus a fraction,
-    # and the same sum from a cropped row number would round differently.
     dark = gray <= level
     rows, cols = np.flatnonzero(dark.any(axis=1)), np.flatnonzero(dark.any(axis=0))
     if not rows.size:
@@ -27,8 +27,17 @@ def outline_rings(gray: np.ndarray, level: float, spacing: float) -> list[np.nda
     padded = np.ones((bottom + 1, right + 1), dtype=gray.dtype)
     part = gray[:bottom, :right]
     padded[1:1 + part.shape[0], 1:1 + part.shape[1]] = part
+    return find_contours(padded, level)
+
+
+def outline_rings(gray: np.ndarray, level: float, spacing: float) -> list[np.ndarray]:
+    """Closed outline rings of the ink, resampled every `spacing` px: list of (N, 2) x, y arrays.
+
+    The image is padded with paper so that ink touching the border still gives closed
+    rings. Rings shorter than a few samples (isolated pixels) are dropped.
+    """
     rings = []
-    for contour in find_contours(padded, level):
+    for contour in padded_contours(gray, level):
         xy = contour[:, ::-1] - 1.0  # (row, col) -> (x, y), undo the padding
         if len(xy) < 4:
             continue
