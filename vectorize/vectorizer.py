@@ -25,6 +25,7 @@ from vectorize.junctions.intersections import Junction, JunctionVerdict, ranked_
 from vectorize.options import InputFrame, VectorizeOptions, VectorizeReport, VectorizeResult
 from vectorize.raster.binarize import downscaled_gray, ink_image, ink_threshold, paper_gray
 from vectorize.raster.outline import outline_rings
+from vectorize.route.retrace_paths import turn_prices, turns_at
 from vectorize.route.route_ends import end_costs
 from vectorize.route.route_inspection import connect_pairings, plan_routes
 from vectorize.route.traversal import Ordering, order_strokes, turn_backs
@@ -153,6 +154,7 @@ def _trace(graph: MedialGraph, simple: Simplified, ordering: Ordering, junctions
                      if n not in simple.retraced and not foot_is_retraced(graph, n, f, stroke_width)}
     sharp_points = [graph.positions[n] for n in simple.retraced]
     crossing_of = dict(zip(simple.crossings, ordering.choice))
+    decided = {**{n: p for n, p in crossing_of.items() if n not in ordering.undecided}, **simple.through}
     # Uncertain zone around each degree-4 node: where the two strokes' inks still overlap.
     zones = []
     for node in simple.crossings:
@@ -199,7 +201,8 @@ def _trace(graph: MedialGraph, simple: Simplified, ordering: Ordering, junctions
             turns_back = (index + 1 < len(passes) and passes[index + 1].branch == step.branch
                           and passes[index + 1].start != step.start) or index in turned
             tip = np.zeros(len(points), dtype=bool)
-            tip[-1] = far_node in simple.y_tips or turns_back
+            tip[-1] = far_node in simple.y_tips or turns_back or (
+                index + 1 < len(passes) and turns_at(graph, decided, step, passes[index + 1]))
             fork = np.zeros(len(points), dtype=bool)
             fork[-1] = graph.degree(far_node) >= 3
             if index == 0:
@@ -303,10 +306,10 @@ def _single_route(graph: MedialGraph, simple: Simplified, ranked: dict, costs: d
     dirs = {n: directions(graph, n, 2.5 * w) for n in graph.incident if graph.degree(n) >= 3}
     end_cost = {**end_costs(graph, simple, dirs, w), **(start_at or {})}
     routes = plan_routes(graph, {**simple.through, **pairing}, stroke_width=w, directions=dirs, end_cost=end_cost,
-                         weight=weight)
+                         weight=weight, turn_price=turn_prices(ranked, costs, pairing, w))
     choice = tuple(pairing.get(n, ranked[n][0]) for n in simple.crossings)
     return Ordering(tuple(r.passes for r in routes), tuple(r.closed for r in routes), choice,
-                    sum(r.odd_nodes for r in routes)), tried
+                    sum(r.odd_nodes for r in routes), tuple(n for n in simple.crossings if n not in pairing)), tried
 
 
 def _refuse_noise(count: int, what: str, limit: int, threshold: float, given: bool) -> None:

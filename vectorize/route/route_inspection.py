@@ -7,8 +7,9 @@ the cheapest set of branches to draw twice is a minimum-weight matching of the o
 over shortest-path distances (Edmonds and Johnson's route inspection), in which two of them
 may be left for the pen to start and end at (`route_matching`: one exact matching decides
 both). Every decided junction (a crossing or a touch at
-a degree-4 node, or a cluster where three passes cross) is a set of through-paths here, so
-retraced paths go through it the way the pairing says and the walk never turns there.
+a degree-4 node, or a cluster where three passes cross) is a set of through-paths here: the
+walk never turns there, and a retraced path goes through it the way the pairing says unless
+turning there saves more than the turn's price (`retrace_paths`).
 
 The walk itself is Fleury's rule (never cross a bridge of what is left while there is
 another way) with the smoothest exit first: at a junction the pen goes as straight as the
@@ -22,10 +23,11 @@ from dataclasses import dataclass
 
 import numpy as np
 from scipy.sparse import coo_matrix
-from scipy.sparse.csgraph import connected_components, dijkstra
+from scipy.sparse.csgraph import connected_components
 
 from vectorize.axis.graph import MedialGraph
 from vectorize.axis.simplify import slots
+from vectorize.route.retrace_paths import RetracePaths
 from vectorize.route.route_matching import match_odd
 from vectorize.route.traversal import Pass
 
@@ -266,7 +268,8 @@ def _first_steps(pred: np.ndarray, sources: np.ndarray) -> np.ndarray:
 
 
 def plan_routes(graph: MedialGraph, pairings: dict, *, stroke_width: float, directions: dict,
-                end_cost: dict[int, float] | None = None, weight: dict[int, float] | None = None) -> list[Route]:
+                end_cost: dict[int, float] | None = None, weight: dict[int, float] | None = None,
+                turn_price: dict | None = None) -> list[Route]:
     """One stroke per piece of the graph over all its branches, retracing as little as it can.
 
     pairings: node -> slot pairs of its through-paths (decided junctions); directions: node
@@ -274,8 +277,10 @@ def plan_routes(graph: MedialGraph, pairings: dict, *, stroke_width: float, dire
     end_cost: px added when the pen starts or ends at a node (default 0): makes some nodes,
     such as the tip of a sharp corner's spur, poor places to start. weight: branch id ->
     factor on its length when retraces are chosen (default 1; a user's "draw this twice"
-    makes it small, "once" large). A graph that is one piece under the pairings (see
-    `connect_pairings`) gives exactly one route.
+    makes it small, "once" large). turn_price: decided node -> {(slot, slot): px} where a
+    retraced path may turn there and what that costs (`retrace_paths.turn_prices`; default:
+    nowhere). A graph that is one piece under the pairings (see `connect_pairings`) gives
+    exactly one route.
     """
     chain_list = chains(graph, pairings)
     nodes = sorted({c.u for c in chain_list if c.u >= 0} | {c.v for c in chain_list if c.v >= 0})
@@ -287,18 +292,18 @@ def plan_routes(graph: MedialGraph, pairings: dict, *, stroke_width: float, dire
     groups: dict[int, list[Chain]] = {}
     for c in open_chains:
         groups.setdefault(int(label[where[c.u]]), []).append(c)
-    routes = [_route(graph, group, stroke_width, directions, end_cost or {}, weight or {})
+    partner = _partners(pairings)
+    routes = [_route(graph, group, stroke_width, directions, end_cost or {}, weight or {}, partner, turn_price or {})
               for _, group in sorted(groups.items())]
     routes += [Route(c.passes, True, 0.0) for c in chain_list if c.u < 0]
     return routes
 
 
 def _route(graph: MedialGraph, chain_list: list[Chain], stroke_width: float, directions: dict,
-           end_cost: dict[int, float], weight: dict[int, float]) -> Route:
-    """The route over one connected piece of chains (none of them closed on its own)."""
-    # What retracing each chain costs: its length, with the branches' weights.
-    cost_of = [c.length if not weight else sum(graph.branches[p.branch].length * weight.get(p.branch, 1.0)
-                                               for p in c.passes) for c in chain_list]
+           end_cost: dict[int, float], weight: dict[int, float], partner: dict[int, dict[int, int]],
+           turn_price: dict) -> Route:
+    """The route over one connected piece of chains (none of them closed on its own);
+    partner: decided node -> {slot: partner slot}; turn_price: `retrace_paths.turn_prices`."""
     nodes = sorted({c.u for c in chain_list if c.u >= 0} | {c.v for c in chain_list if c.v >= 0})
     where = {n: i for i, n in enumerate(nodes)}
     degree = np.zeros(len(nodes), dtype=int)
@@ -322,69 +327,43 @@ def _route(graph: MedialGraph, chain_list: list[Chain], stroke_width: float, dir
         a, b = (i for i in range(3) if i != slot)
         return 0.25 * stroke_width * turn(node, a, b)
 
-    # Shortest paths between odd nodes over the cheapest chain between each pair of nodes.
-    best_chain: dict[tuple[int, int], int] = {}
-    for k, c in enumerate(chain_list):
-        if c.u < 0 or c.u == c.v:
-            continue
-        key = (min(where[c.u], where[c.v]), max(where[c.u], where[c.v]))
-        if key not in best_chain or cost_of[k] < cost_of[best_chain[key]]:
-            best_chain[key] = k
-    odd = [i for i in range(len(nodes)) if degree[i] % 2]
+    odd = [nodes[i] for i in range(len(nodes)) if degree[i] % 2]
     pairs_out: list[tuple[int, int]] = []
     ends: list[int] = []
-    paths: list[list[int]] = []
+    chain_list = list(chain_list)
+    retraced = 0.0
     if odd:
-        keys = list(best_chain)
-        weights = [max(cost_of[best_chain[k]], 1e-6) for k in keys]
-        rows = [k[0] for k in keys]
-        cols = [k[1] for k in keys]
-        matrix = coo_matrix((weights, (rows, cols)), shape=(len(nodes), len(nodes))).tocsr()
-        dist, pred = dijkstra(matrix, directed=False, indices=odd, return_predecessors=True)
-
-        row_of = {a: r for r, a in enumerate(odd)}
-
-        def path(a: int, b: int) -> list[int]:
-            """Chain indices along the shortest path from odd node a to node b."""
-            row = row_of[a]
-            seq = [b]
-            while seq[-1] != a:
-                seq.append(int(pred[row, seq[-1]]))
-            seq.reverse()
-            return [best_chain[(min(x, y), max(x, y))] for x, y in zip(seq[:-1], seq[1:])]
-
-        def penalty(node_index: int, neighbour: int) -> float:
-            """leave_penalty of the path leaving odd node `node_index` towards `neighbour`."""
-            c = chain_list[best_chain[(min(node_index, neighbour), max(node_index, neighbour))]]
-            return leave_penalty(nodes[node_index], c.u_slot if where[c.u] == node_index else c.v_slot)
-
-        # The path from odd[i] to odd[j] leaves odd[i] towards first[i, odd[j]] and reaches
-        # odd[j] from pred[i, odd[j]]: its two end slots, without walking it.
-        first = _first_steps(pred, np.array(odd))
+        # What retracing each branch costs: its length, with the branch's weight.
+        cost_of = {p.branch: graph.branches[p.branch].length * weight.get(p.branch, 1.0)
+                   for c in chain_list for p in c.passes}
+        paths = RetracePaths(graph, cost_of, partner, cost_of, odd, directions, stroke_width, turn_price)
+        # The path from odd[i] to odd[j] leaves and reaches them by the slots its first and last
+        # steps say (from the predecessors, without walking it).
+        first = _first_steps(paths.pred, np.array(paths.sources))
         m = len(odd)
         cost = np.full((m, m), np.inf)
         for i in range(m):
             for j in range(i + 1, m):
-                dij = dist[i, odd[j]]
+                dij = paths.dist[i, paths.sources[j]]
                 if np.isfinite(dij):
-                    dij += penalty(odd[i], int(first[i, odd[j]])) + penalty(odd[j], int(pred[i, odd[j]]))
+                    out, into = paths.first_slots(first, i, j)
+                    dij += leave_penalty(odd[i], out) + leave_penalty(odd[j], into)
                 cost[i, j] = cost[j, i] = dij
-        ends_cost = np.array([end_cost.get(nodes[i], 0.0) for i in odd])
+        ends_cost = np.array([end_cost.get(n, 0.0) for n in odd])
         pairs_out, ends = match_odd(cost, ends_cost)
-        paths = [path(odd[i], odd[j]) for i, j in pairs_out]
+        for i, j in pairs_out:
+            for passes, (u, u_slot), (v, v_slot) in paths.legs(i, j):
+                length = sum(graph.branches[p.branch].length for p in passes)
+                chain_list.append(Chain(passes, u, u_slot, v, v_slot, length))
+                retraced += length
     multi = _Multigraph(chain_list)
     for k, c in enumerate(chain_list):
         if c.u >= 0:
             multi.add(k)
-    retraced = 0.0
-    for p in paths:
-        for k in p:
-            multi.add(k)
-            retraced += chain_list[k].length
     if ends:
         # Start at the free end if one of the two is one: the walk then reaches every
         # junction along a branch and can go on as straight as the drawing allows.
-        start = min((nodes[odd[i]] for i in ends), key=lambda n: (len(multi.at[n]), n))
+        start = min((odd[i] for i in ends), key=lambda n: (len(multi.at[n]), n))
     else:
         # A closed walk: begin at the top-left node (any node would do).
         start = min(nodes, key=lambda n: (float(graph.positions[n].sum()), n))

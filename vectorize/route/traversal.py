@@ -27,12 +27,14 @@ class Pass:
 @dataclass(frozen=True)
 class Ordering:
     """Strokes as sequences of branch passes; `choice` is the pairing used per crossing;
-    `odd_nodes`: odd-degree nodes route inspection paired or left as ends (single-line mode)."""
+    `odd_nodes`: odd-degree nodes route inspection paired or left as ends (single-line mode);
+    `undecided`: crossings the single line left undecided (its walk may turn there any way)."""
 
     strokes: tuple[tuple[Pass, ...], ...]
     closed: tuple[bool, ...]
     choice: tuple
     odd_nodes: int = 0
+    undecided: tuple = ()
 
 
 class Walker:
