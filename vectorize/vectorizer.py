@@ -186,7 +186,7 @@ def _trace(graph: MedialGraph, simple: Simplified, ordering: Ordering, junctions
     not_twins = {bid for bid, b in graph.branches.items() if b.a == b.b} | foot_branches
     zone_nodes = {node for node, _, _ in zones}
     for passes, closed in zip(ordering.strokes, ordering.closed):
-        parts, keeps, tips, spans, radii, owners = [], [], [], [], [], []
+        parts, keeps, tips, spans, radii, owners, forks = [], [], [], [], [], [], []
         count = 0  # traced points so far
         # Where the pen turns back at a junction it goes up to the node and returns: its
         # points there are the line, not uncertain ink of passes running through.
@@ -210,9 +210,14 @@ def _trace(graph: MedialGraph, simple: Simplified, ordering: Ordering, junctions
             tip = np.zeros(len(points), dtype=bool)
             tip[-1] = far_node in simple.y_tips or turns_back or (
                 index + 1 < len(passes) and turns_at(graph, decided, step, passes[index + 1]))
+            fork = np.zeros(len(points), dtype=bool)
+            fork[-1] = graph.degree(far_node) >= 3
+            if index == 0:
+                fork[0] = graph.degree(branch.a if step.start == "a" else branch.b) >= 3
             parts.append(points)
             radii.append(radius)
             owners.append(np.full(len(points), index))
+            forks.append(fork)
             keeps.append(tip | (not on_foot))
             tips.append(tip)
         twins = twin_spans([p.branch for p in passes], [p.start for p in passes], spans, not_twins)
@@ -229,7 +234,8 @@ def _trace(graph: MedialGraph, simple: Simplified, ordering: Ordering, junctions
             turning = [i for i, at in turned.items() if at == node]
             near = (dist < reach) & ~np.isin(owner, turning + [i + 1 for i in turning])
             keep[near] &= crossing & (dist[near] < 1e-6)
-        result.append((TracedPoints(xy=xy, keep=keep, split=split, radius=np.concatenate(radii)), closed, twins))
+        result.append((TracedPoints(xy=xy, keep=keep, split=split, radius=np.concatenate(radii),
+                                    junction=np.concatenate(forks)), closed, twins))
     return result
 
 

@@ -41,7 +41,8 @@ class TracedPoints:
     xy: (N, 2) px; keep: (N,) bool, keep the point for the fit; split: (N,) bool, split the
     fit there; corner: (N,) bool or None (none), a corner (split, and the joint goes where
     the two sides' tangents meet); radius: (N,) px, the medial axis's distance to the
-    outline at each point (half the ink width), or None (unknown).
+    outline at each point (half the ink width), or None (unknown); junction: (N,) bool or
+    None (none), the point is a node of the axis where three or more branches meet.
     """
 
     xy: np.ndarray
@@ -49,6 +50,7 @@ class TracedPoints:
     split: np.ndarray
     corner: np.ndarray | None = None
     radius: np.ndarray | None = None
+    junction: np.ndarray | None = None
 
     def __len__(self) -> int:
         return len(self.xy)
@@ -336,6 +338,7 @@ def fit_stroke(traced: TracedPoints, *, closed: bool, sigma: float, stroke_width
     keep = np.array(traced.keep, dtype=bool)
     split = np.array(traced.split, dtype=bool)
     corner = np.zeros(len(xy), dtype=bool)
+    junction = np.zeros(len(xy), dtype=bool) if traced.junction is None else np.array(traced.junction, dtype=bool)
     found = sharp_corners(xy, stroke_width, closed=closed)
     corner[found[keep[found] & ~split[found]]] = True
     if traced.corner is not None:
@@ -348,13 +351,14 @@ def fit_stroke(traced: TracedPoints, *, closed: bool, sigma: float, stroke_width
         # Where a closed line starts cannot be read from the ink; start at its top-left
         # sharp feature, as a pen usually does: then it is a chain of open pieces.
         if np.allclose(xy[0], xy[-1]):
-            xy, keep, split, corner = xy[:-1], keep[:-1], split[:-1], corner[:-1]
+            xy, keep, split, corner, junction = xy[:-1], keep[:-1], split[:-1], corner[:-1], junction[:-1]
             split_at = np.flatnonzero(split)
         shift = int(split_at[np.argmin(xy[split_at].sum(axis=1))])
-        xy, keep, split, corner = (np.roll(a, -shift, axis=0) for a in (xy, keep, split, corner))
+        xy, keep, split, corner, junction = (np.roll(a, -shift, axis=0) for a in (xy, keep, split, corner, junction))
         twins = rolled(twins, shift, len(xy))
         xy = np.vstack([xy, xy[:1]])
         keep, split, corner = np.append(keep, keep[0]), np.append(split, split[0]), np.append(corner, corner[0])
+        junction = np.append(junction, junction[0])
         closed = False
         twins = valid_twins(xy, twins)
     # Around a corner the axis is off the centre line for about a stroke width: leave it out.
@@ -425,7 +429,9 @@ def fit_stroke(traced: TracedPoints, *, closed: bool, sigma: float, stroke_width
                 point = xy[at]
             # Where the ink shows the pen went further than the tangents say (a narrow cusp
             # whose axis stops short), the tip goes there; the sides' handles follow it.
-            tip = _tip_in_ink(xy, arc, at, guard, stroke_width, closed) if guard is not None else None
+            # Not at a junction: beyond it lies the ink of the other branches, not a tip.
+            tip = (_tip_in_ink(xy, arc, at, guard, stroke_width, closed)
+                   if guard is not None and not junction[at] else None)
             # Only a tip beyond the corner point by more than the invariant's slack moves it: a
             # sharp corner whose sides' tangents meet in the ink is already where the pen turned.
             if tip is not None and np.linalg.norm(tip - xy[at]) > np.linalg.norm(point - xy[at]) + MARGIN:
