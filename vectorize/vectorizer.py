@@ -196,7 +196,7 @@ def _trace(graph: MedialGraph, simple: Simplified, ordering: Ordering, junctions
             # By end, not by node: a loop starts and ends at the same node.
             points = branch.points if step.start == "a" else branch.points[::-1]
             radius = branch.radii if step.start == "a" else branch.radii[::-1]
-            far_node = branch.b if step.start == "a" else branch.a
+            far_node = branch.node(step.end)
             points = points if index == 0 else points[1:]
             radius = radius if index == 0 else radius[1:]
             spans.append((max(count - 1, 0), count + len(points) - 1))
@@ -213,7 +213,7 @@ def _trace(graph: MedialGraph, simple: Simplified, ordering: Ordering, junctions
             fork = np.zeros(len(points), dtype=bool)
             fork[-1] = graph.degree(far_node) >= 3
             if index == 0:
-                fork[0] = graph.degree(branch.a if step.start == "a" else branch.b) >= 3
+                fork[0] = graph.degree(branch.node(step.start)) >= 3
             parts.append(points)
             radii.append(radius)
             owners.append(np.full(len(points), index))

@@ -31,6 +31,10 @@ class Branch:
 
     # Cached: pruning asks every leaf for these on every round, and a branch's arrays are
     # never changed once made (stages replace branches instead).
+    def node(self, end: str) -> int:
+        """The node at end "a" or "b"."""
+        return self.a if end == "a" else self.b
+
     @cached_property
     def edge_lengths(self) -> np.ndarray:
         """(M-1,) px: the length of each edge (read only: shared with derived branches)."""

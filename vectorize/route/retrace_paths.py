@@ -55,26 +55,25 @@ def turns_at(graph: MedialGraph, decided: dict, step: Pass, after: Pass) -> bool
     """Whether the line turns where `step` ends and `after` begins: at a decided junction
     (decided: node -> its slot pairs), out by a branch end its pairing does not join to the
     one it came in by (a retraced path's turn). The fit splits there, as at a cusp."""
-    branch = graph.branches[step.branch]
-    node, end = (branch.b, "b") if step.start == "a" else (branch.a, "a")
+    node = graph.branches[step.branch].node(step.end)
     if node not in decided:
         return False
     node_slots = slots(graph, node)
-    into, out = node_slots.index((step.branch, end)), node_slots.index((after.branch, after.start))
+    into, out = node_slots.index((step.branch, step.end)), node_slots.index((after.branch, after.start))
     return not any({into, out} == set(pair) for pair in decided[node])
 
 
 class RetracePaths:
     """Shortest paths between the odd nodes of one piece of the graph (module doc).
 
-    graph: the branch graph; branch_ids: the piece's branches; partner: decided node ->
-    {slot: partner slot}; cost_of: branch id -> px its retrace costs; odd: the odd nodes
+    graph: the branch graph; partner: decided node -> {slot: partner slot}; cost_of: the
+    piece's branches, branch id -> px its retrace costs; odd: the odd nodes
     (graph ids, undecided); directions: node -> (D, 2) unit tangents per slot (nodes of
     degree >= 3; missing ones count as a right-angle turn); stroke_width: px; prices:
     `turn_prices` (decided nodes left out, or pairs, allow no turn).
     """
 
-    def __init__(self, graph: MedialGraph, branch_ids, partner: dict[int, dict[int, int]], cost_of: dict[int, float],
+    def __init__(self, graph: MedialGraph, partner: dict[int, dict[int, int]], cost_of: dict[int, float],
                  odd: list[int], directions: dict, stroke_width: float, prices: dict) -> None:
         self.graph = graph
         self.decided = partner
@@ -95,7 +94,7 @@ class RetracePaths:
             if key not in best or cost < best[key][0]:
                 best[key] = (cost, bid, end)
 
-        for bid in sorted(branch_ids):
+        for bid in sorted(cost_of):
             branch = graph.branches[bid]
             link(vertex(branch.a, self.slot(branch.a, bid, "a")), vertex(branch.b, self.slot(branch.b, bid, "b")),
                  cost_of[bid], bid, "a")
@@ -150,13 +149,12 @@ class RetracePaths:
         for p in self.path(i, j):
             branch = self.graph.branches[p.branch]
             if begin is None:
-                node = branch.a if p.start == "a" else branch.b
+                node = branch.node(p.start)
                 begin = (node, self.slot(node, p.branch, p.start))
             current.append(p)
-            far_end = "b" if p.start == "a" else "a"
-            far = branch.b if far_end == "b" else branch.a
+            far = branch.node(p.end)
             if far not in self.decided:
-                result.append((tuple(current), begin, (far, self.slot(far, p.branch, far_end))))
+                result.append((tuple(current), begin, (far, self.slot(far, p.branch, p.end))))
                 current, begin = [], None
         return result
 
@@ -170,6 +168,5 @@ class RetracePaths:
         return self._slot(out, start=True), self._slot(into, start=False)
 
     def _slot(self, p: Pass, *, start: bool) -> int:
-        branch = self.graph.branches[p.branch]
-        end = p.start if start else ("b" if p.start == "a" else "a")
-        return self.slot(branch.a if end == "a" else branch.b, p.branch, end)
+        end = p.start if start else p.end
+        return self.slot(self.graph.branches[p.branch].node(end), p.branch, end)

@@ -33,7 +33,7 @@ from vectorize.route.traversal import Pass
 
 
 def _back(p: Pass) -> Pass:
-    return Pass(p.branch, "b" if p.start == "a" else "a")
+    return Pass(p.branch, p.end)
 
 
 @dataclass(frozen=True)
@@ -336,7 +336,7 @@ def _route(graph: MedialGraph, chain_list: list[Chain], stroke_width: float, dir
         # What retracing each branch costs: its length, with the branch's weight.
         cost_of = {p.branch: graph.branches[p.branch].length * weight.get(p.branch, 1.0)
                    for c in chain_list for p in c.passes}
-        paths = RetracePaths(graph, cost_of, partner, cost_of, odd, directions, stroke_width, turn_price)
+        paths = RetracePaths(graph, partner, cost_of, odd, directions, stroke_width, turn_price)
         # The path from odd[i] to odd[j] leaves and reaches them by the slots its first and last
         # steps say (from the predecessors, without walking it).
         first = _first_steps(paths.pred, np.array(paths.sources))

@@ -23,6 +23,11 @@ class Pass:
     branch: int
     start: str
 
+    @property
+    def end(self) -> str:
+        """The end the pass arrives at ("a" or "b")."""
+        return "b" if self.start == "a" else "a"
+
 
 @dataclass(frozen=True)
 class Ordering:
@@ -151,7 +156,7 @@ class Walker:
                     back_out = self._exit(node, entry, used, pairing)
                     if back_out is not None:
                         back, _ = self._walk(node, back_out, used, pairing)
-                        path = [Pass(p.branch, "b" if p.start == "a" else "a") for p in reversed(back)] + path
+                        path = [Pass(p.branch, p.end) for p in reversed(back)] + path
                 strokes.append(path)
                 closed.append(is_loop)
         return strokes, closed
@@ -185,8 +190,8 @@ def turn_backs(graph: MedialGraph, passes, nodes, reach: float) -> dict[int, int
     for i in range(len(passes) - 1):
         step, after = passes[i], passes[i + 1]
         branch = graph.branches[step.branch]
-        node = branch.b if step.start == "a" else branch.a
-        arrive, leave = (step.branch, "b" if step.start == "a" else "a"), (after.branch, after.start)
+        node = branch.node(step.end)
+        arrive, leave = (step.branch, step.end), (after.branch, after.start)
         if node not in nodes or arrive == leave or step.branch == after.branch:
             continue  # the same branch back is a retrace, handled as one
         out = reach + graph.spans.get(node, 0.0)
