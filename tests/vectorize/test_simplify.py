@@ -36,3 +36,44 @@ def test_a_crossing_next_to_the_line_end_is_a_crossing_not_a_spike(tail, width):
     near = [n for n in simple.crossings if np.linalg.norm(graph.positions[n] - crossing) < 2 * width]
     spikes = [n for n in simple.y_feet if np.linalg.norm(graph.positions[n] - crossing) < 4 * width]
     assert len(near) == 1 and not spikes
+
+
+def _cursive_stretch(seed: int, index: int, center: tuple[float, float], half: float):
+    """The stretch of a cursive set line's pen path from its first to its last point within
+    `half` px of `center`, moved onto a small page: (Drawing, the ground-truth crossing
+    nearest `center` on that page (2,) px)."""
+    from benchmarks.sets.cursive import cursive_drawing
+    from vectorize.drawing import Drawing
+    from vectorize.stroke import Stroke
+
+    gt = cursive_drawing(seed, index)
+    points = gt.drawing.strokes[0].sample_evenly(1.0)
+    inside = np.flatnonzero(np.all(np.abs(points - np.array(center)) < half, axis=1))
+    path = points[inside.min():inside.max() + 1]
+    shift = 20.0 - path.min(axis=0)
+    crossings = np.asarray(gt.intersections, dtype=float).reshape(-1, 2)
+    crossing = crossings[np.argmin(np.linalg.norm(crossings - np.array(center), axis=1))] + shift
+    size = path.max(axis=0) + shift + 20.0
+    return Drawing((Stroke.from_polyline(path + shift),), float(size[0]), float(size[1]), "px", gt.width), crossing
+
+
+@pytest.mark.parametrize("seed, index, center, half", [
+    (0, 39, (308.0, 497.0), 50.0),  # "unhealthily", 6.25 px: the output crossed 15.2 px away
+    (0, 0, (400.0, 508.0), 45.0),  # "inauthentically", 4.75 px: 6.0 px away
+])
+def test_an_h_stem_drawn_back_up_through_its_loop_crossing_still_crosses(seed, index, center, half):
+    """A cursive h: the way in crosses the ascender loop's way down, which runs on as the
+    stem, drawn down to the baseline and back up to the arch. Stem, loop and the way in
+    share one band: the axis shows the crossing as two junctions, the lower one holding the
+    stem's free end. That junction is a spike's base and a crossing's half at once; read as
+    a spike only, the crossing is never made and the curve turns back in the band. The
+    output must cross where the ground truth does (within the benchmark's 5 px)."""
+    from benchmarks.common.render import render
+    from benchmarks.metrics.table1 import MATCH_DISTANCE, drawing_polylines, polyline_intersections
+
+    drawing, crossing = _cursive_stretch(seed, index, center, half)
+    result = vectorize_image(render(drawing), VectorizeOptions(classifier="cnn"))
+    assert result.report.strokes == 1
+    found = polyline_intersections(*drawing_polylines(result.drawing))
+    points = np.vstack([found.crossings, found.multiple])
+    assert len(points) and np.linalg.norm(points - crossing, axis=1).min() <= MATCH_DISTANCE

@@ -312,25 +312,21 @@ def _v_spike(graph: MedialGraph, node: int, reach: float) -> bool:
 
 def _crossing_halves(graph: MedialGraph, node: int, bid: int, reach: float, stroke_width: float) -> bool:
     """Whether `node` and the degree-3 junction at the other end of branch `bid` are the two
-    halves of one crossing that closes a loop: two of the four other branch ends are one
-    loop's, the two passes run straight through both junctions (each bends by at most
-    `CROSSING_PASS_MAX_BEND`), the branch between them is the widest at `node`, and it is no
-    longer than the ink two lines crossing at that angle share (w / sin(a / 2), a the angle
-    between the passes, with `CROSSING_JOIN_SLACK`).
+    halves of one crossing: the two passes run straight through both junctions (each bends
+    by at most `CROSSING_PASS_MAX_BEND`), the branch between them is the widest at `node`,
+    and it is no longer than the ink two lines crossing at that angle share (w / sin(a / 2),
+    a the angle between the passes, with `CROSSING_JOIN_SLACK`).
 
     Where a crossing lies a few widths from the line's end (a loop's exit stroke crossing
     its way in: the last letter's loop, an e at a word's end), the short exit ends free
-    and reads like a spike off a straight line (a T) unless the crossing is seen whole.
+    and reads like a spike off a straight line (a T) unless the crossing is seen whole. So
+    does a stem drawn down through a crossing and back up (an h's or l's stem below the
+    point where its ascender loop crosses the way in): it is a spike, but its base is a
+    crossing's too, and the route retraces it through the crossing (`route.retrace_paths`
+    may turn there at a price).
     """
     other = graph.branches[bid].other(node)
     if other == node or graph.degree(other) != 3:
-        return False
-    # Two of the four other branch ends are one loop's: the passes through the crossing are
-    # the way into and out of that loop. (A stem drawn down and back up through a crossing,
-    # three passes in one band, also looks straight here, but its stub is a spike: the
-    # route would otherwise pair its free end the long way round.)
-    outer = [b for end in (node, other) for b in graph.incident[end] if b != bid]
-    if len(set(outer)) == len(outer):
         return False
     legs = []
     for end in (node, other):
