@@ -77,3 +77,29 @@ def test_an_h_stem_drawn_back_up_through_its_loop_crossing_still_crosses(seed, i
     found = polyline_intersections(*drawing_polylines(result.drawing))
     points = np.vstack([found.crossings, found.multiple])
     assert len(points) and np.linalg.norm(points - crossing, axis=1).min() <= MATCH_DISTANCE
+
+
+@pytest.mark.parametrize("seed, index, center, half", [
+    (1, 34, (931.0, 505.0), 30.0),  # "lunchtime": the last e, its way in bending into the loop
+    (1, 15, (939.0, 530.0), 35.0),  # "lady": the last y's loop crossing its way out
+    (1, 30, (941.0, 532.0), 35.0),  # "candy": the same
+    (1, 15, (314.0, 491.0), 40.0),  # "hatted": an h's loop, its arch leaving where it closes
+    (0, 1, (97.0, 492.0), 40.0),  # "the": the same
+])
+def test_a_junction_closing_a_loop_is_a_crossing_half(seed, index, center, half):
+    """Lines 2-2.5 px wide (measured 1.5 px): beside the junction holding a loop's two ends
+    (or a loop through the next junction) lies one holding a free end: the line's end past
+    the last letter's loop, or an h's stem. Read alone the loop's junction cannot be resolved
+    (a loop is entered and left at a crossing or touch), so the two are one crossing, also
+    where the way in bends into the loop and the shared ink runs longer than the measured
+    width predicts. In the closed reading (every free end may be a spike)."""
+    from benchmarks.common.render import render
+
+    drawing, crossing = _cursive_stretch(seed, index, center, half)
+    stages = vectorize_image(render(drawing), VectorizeOptions(keep_stages=True)).stages
+    graph = stages["pruned"].copy()
+    simple = simplify(graph, stroke_width=stages["ink"].stroke_width, multi=False, ends=0)
+    width = drawing.stroke_width
+    near = [n for n in simple.crossings if np.linalg.norm(graph.positions[n] - crossing) < 2 * width]
+    assert len(near) == 1
+    assert not [n for n in simple.unresolved if np.linalg.norm(graph.positions[n] - crossing) < 3 * width]
