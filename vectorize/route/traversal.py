@@ -221,7 +221,7 @@ def half_turns(graph: MedialGraph, passes) -> dict[int, int]:
     down the band and up the same points again. The band must still be drawn: a half no
     pass runs through keeps its first turn to the node.
     """
-    ends = []  # (i, node, half arriving, half leaving) per junction of passes at a merged node
+    ends = []  # (i, node, half arriving, half leaving, points shared) per turn at a merged node
     for i in range(len(passes) - 1):
         step, after = passes[i], passes[i + 1]
         node = graph.branches[step.branch].node(step.end)
