@@ -103,3 +103,78 @@ def test_a_junction_closing_a_loop_is_a_crossing_half(seed, index, center, half)
     near = [n for n in simple.crossings if np.linalg.norm(graph.positions[n] - crossing) < 2 * width]
     assert len(near) == 1
     assert not [n for n in simple.unresolved if np.linalg.norm(graph.positions[n] - crossing) < 3 * width]
+
+W = 4.0  # px stroke width of the constructed graphs below
+
+
+def _join(graph, a: int, b: int, *via, radius: float = W / 2) -> int:
+    from vectorize.axis.graph import Branch
+
+    points = np.array([graph.positions[a], *via, graph.positions[b]], dtype=float)
+    return graph.add_branch(Branch(a, b, points, np.full(len(points), radius), np.ones(len(points) - 1)))
+
+
+def _two_forks(far_fork_opens: str):
+    """Two forks joined by a wide branch, neither with a free branch: fork A at the foot of an
+    arm drawn up and back down beside itself (two strands up to its top, then a hook), fork B
+    `far_fork_opens` "up" (a next letter's stem rising from the line between them: the
+    branch from A runs down and along the line, as from a u's arm to a k) or "down" (a
+    crossing's other half: the branch runs straight on down). Returns the graph and A, B."""
+    from vectorize.axis.graph import MedialGraph
+
+    graph = MedialGraph()
+    node = lambda x, y: graph.add_node(np.array([x, y], float), W / 2)  # noqa: E731
+    lead, top_a, top_b, hook = node(-120.0, 10.0), node(-2.0, -60.0), node(2.0, -62.0), node(0.0, -80.0)
+    fork_a = node(0.0, 0.0)
+    _join(graph, lead, top_a, (-60.0, 30.0), (-20.0, -20.0))
+    _join(graph, fork_a, top_a, (-3.0, -30.0))
+    _join(graph, fork_a, top_b, (3.0, -30.0))
+    _join(graph, top_a, top_b)
+    _join(graph, top_b, hook)
+    if far_fork_opens == "up":
+        fork_b = node(40.0, 8.0)
+        _join(graph, fork_a, fork_b, (2.0, 10.0), (20.0, 12.0), radius=0.7 * W)
+        tip, out = node(70.0, -80.0), node(110.0, -30.0)
+        _join(graph, fork_b, tip, (55.0, -40.0))
+        _join(graph, fork_b, out, (75.0, -10.0))
+    else:
+        fork_b = node(0.0, 12.0)
+        _join(graph, fork_a, fork_b, radius=0.7 * W)
+        tip, out = node(-25.0, 80.0), node(25.0, 80.0)
+        _join(graph, fork_b, tip, (-8.0, 40.0))
+        _join(graph, fork_b, out, (8.0, 40.0))
+    _join(graph, tip, out, (90.0, -100.0) if far_fork_opens == "up" else (0.0, 120.0))
+    _join(graph, out, node(200.0, 0.0))
+    return graph, fork_a, fork_b
+
+
+def test_two_forks_that_open_the_same_way_are_not_one_crossing():
+    """The two halves of a crossing open away from each other: a pass runs in at one and out
+    at the other. Two forks whose branches all leave the same way (a cursive u's arm drawn up
+    and back beside itself, 23 widths along the line from the next letter's stem) were merged
+    into one degree-4 node, and the line between them was drawn three times
+    (the_mad_hatted_duke_met_a_lady-0-26: 1.027 times the route-inspection optimum)."""
+    graph, fork_a, fork_b = _two_forks("up")
+    simple = simplify(graph, stroke_width=W, multi=False)
+    assert fork_a in graph.incident and fork_b in graph.incident
+    assert not simple.crossings
+    # The same forks facing each other along the branch between them are one crossing.
+    graph, fork_a, fork_b = _two_forks("down")
+    simple = simplify(graph, stroke_width=W, multi=False)
+    assert fork_a not in graph.incident and fork_b not in graph.incident
+    assert len(simple.crossings) == 1
+
+
+def test_a_cursive_line_is_not_drawn_three_times_between_two_letters():
+    # "the mad hatted duke met a lady" (benchmarks/sets/cursive.py, seed 0): the u's arm and the
+    # k's stem were one node, and the line between them was drawn three times: 1.027 times the
+    # shortest line over the ink.
+    from benchmarks.common.render import render_truth, to_uint8
+    from benchmarks.metrics.ink import excursion, excursion_bound
+    from benchmarks.sets.cursive import cursive_drawing
+
+    gt = cursive_drawing(0, 26)
+    result = vectorize_image(to_uint8(render_truth(gt)), VectorizeOptions(classifier="cnn"))
+    assert result.report.strokes == 1
+    assert result.drawing.length <= 1.02 * gt.meta["route_min"]
+    assert excursion(gt.drawing, result.drawing) <= excursion_bound(gt.width)

@@ -212,7 +212,8 @@ def simplify(graph: MedialGraph, *, stroke_width: float, multi: bool, ends: int 
             return float(np.dot(dirs[a], dirs[b])) > np.cos(np.radians(CROSSING_HALF_MAX_ANGLE))
 
         options = [(bid, far) for bid, far in options if other_ok(far)
-                   and graph.branches[bid].length < 40.0 * stroke_width and opens_a_v(bid)]
+                   and graph.branches[bid].length < 40.0 * stroke_width and opens_a_v(bid)
+                   and _facing(graph, node, far, bid, reach)]
         widest = max(options, key=lambda o: _min_radius(graph.branches[o[0]]), default=None)
         foot_bid = node_slots[foot_slot(dirs)][0]
         foot = next((o for o in options if o[0] == foot_bid), None)
@@ -297,6 +298,21 @@ CROSSING_HALF_MAX_ANGLE = 125.0
 # The two sides of a V-shaped spike leave its junction at an acute angle; a T (90 degrees
 # each way) would otherwise pass the paper's foot test by a coin toss.
 V_SPIKE_MAX_ANGLE = 75.0
+
+
+def _opening(graph: MedialGraph, node: int, bid: int, reach: float) -> np.ndarray:
+    """The sum of the unit tangents at `node` of its branch ends other than branch `bid`'s."""
+    dirs = directions(graph, node, reach)
+    return sum((d for (b, _), d in zip(slots(graph, node), dirs) if b != bid), np.zeros(2))
+
+
+def _facing(graph: MedialGraph, node: int, other: int, bid: int, reach: float) -> bool:
+    """Whether the junctions `node` and `other`, joined by branch `bid`, open away from each
+    other, as the two halves of a crossing do: each pass runs in at one and out at the other,
+    bending less than a right angle across the pair. Two forks whose branches leave the same
+    way (a u's arm and the next letter's stem, both rising from the line between them) are two
+    junctions of the line: a pass from one to the other would turn back."""
+    return float(np.dot(_opening(graph, node, bid, reach), _opening(graph, other, bid, reach))) < 0.0
 
 
 def _v_spike(graph: MedialGraph, node: int, reach: float) -> bool:
