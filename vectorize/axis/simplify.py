@@ -329,9 +329,10 @@ def _v_spike(graph: MedialGraph, node: int, reach: float) -> bool:
 def _crossing_halves(graph: MedialGraph, node: int, bid: int, reach: float, stroke_width: float) -> bool:
     """Whether `node` and the degree-3 junction at the other end of branch `bid` are the two
     halves of one crossing: the two passes run straight through both junctions (each bends
-    by at most `CROSSING_PASS_MAX_BEND`), the branch between them is the widest at `node`,
-    and it is no longer than the ink two lines crossing at that angle share (w / sin(a / 2),
-    a the angle between the passes, with `CROSSING_JOIN_SLACK`).
+    by at most `CROSSING_PASS_MAX_BEND`, `CROSSING_LOOP_MAX_BEND` where they close a loop),
+    the branch between them is the widest at `node`, and it is no longer than the ink two
+    lines crossing at that angle share ((w + `CROSSING_EDGE_BLUR`) / sin(a / 2), a the angle
+    between the passes, with `CROSSING_JOIN_SLACK`).
 
     Where a crossing lies a few widths from the line's end (a loop's exit stroke crossing
     its way in: the last letter's loop, an e at a word's end), the short exit ends free
