@@ -2,8 +2,11 @@
 
 from __future__ import annotations
 
+import sys
 import time
 from dataclasses import replace
+from functools import partial
+from importlib import import_module
 from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
@@ -388,7 +391,10 @@ def _axis(image: np.ndarray, options: VectorizeOptions, clock: _Clock, cache: St
     samples = sum(len(ring) for ring in rings)
     _refuse_noise(samples, "outline samples", MAX_OUTLINE_SAMPLES if len(rings) > LONG_LINE_OUTLINES
                   else MAX_LONG_LINE_SAMPLES, ink.threshold, options.threshold is not None)
-    graph = medial_axis(rings, ink.gray, ink.threshold)
+    # A process's first call imports the fitting stage's libraries (scipy.interpolate and
+    # scipy.optimize, ~0.1 s, holding the GIL) while qhull triangulates in another thread.
+    later = None if "vectorize.fit.fitting" in sys.modules else partial(import_module, "vectorize.fit.fitting")
+    graph = medial_axis(rings, ink.gray, ink.threshold, beside=later)
     clock.lap("medial axis")
     return ink, rings, graph
 

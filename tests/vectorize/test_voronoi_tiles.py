@@ -3,6 +3,7 @@ the whole exact diagram: the same kept ridges, the same graph, on real and made 
 
 from __future__ import annotations
 
+import threading
 from pathlib import Path
 
 import numpy as np
@@ -121,6 +122,39 @@ def test_tiles_are_used_and_a_too_small_margin_falls_back(monkeypatch):
     monkeypatch.setattr(medial, "empty_circle_bound", lambda *args: 3.0)
     assert _segments(medial_axis(rings, gray, level, tiles=2)) == whole
     assert calls[-1] is None
+
+
+@pytest.mark.parametrize("cores", [1, 2, 3])
+def test_work_beside_qhull_runs_once_in_this_thread_and_keeps_the_graph(monkeypatch, cores):
+    """`beside` (a first call's imports of the later stages) runs once, in the calling
+    thread; with a core to spare qhull works in another thread meanwhile (the whole
+    triangulation on two cores, tiles on more), with the same graph as without it."""
+    rings, gray, level = _made("blob")
+    whole = _arrays(medial_axis(rings, gray, level, tiles=1))
+    monkeypatch.setattr(medial, "idle_cores", lambda: cores)
+    parts, triangulations, beside = [], [], []
+    part, triangulate = voronoi.voronoi_part, voronoi.jittered_delaunay
+
+    def recorded_part(*args, **kwargs):
+        parts.append(threading.get_ident())
+        return part(*args, **kwargs)
+
+    def recorded_triangulation(*args, **kwargs):
+        triangulations.append(threading.get_ident())
+        return triangulate(*args, **kwargs)
+
+    monkeypatch.setattr(medial, "voronoi_part", recorded_part)
+    monkeypatch.setattr(medial, "jittered_delaunay", recorded_triangulation)
+    graph = medial_axis(rings, gray, level, beside=lambda: beside.append(threading.get_ident()))
+    assert _arrays(graph) == whole
+    this = threading.get_ident()
+    assert beside == [this]
+    if cores == 1:  # `beside` first, then the whole diagram here
+        assert parts == [this] and triangulations == []
+    elif cores == 2:  # qhull elsewhere, the diagram made of its triangulation here
+        assert parts == [this] and len(triangulations) == 1 and this not in triangulations
+    else:  # a tile per spare core, each in a thread of its own
+        assert len(parts) == 2 and this not in parts and triangulations == []
 
 
 @pytest.mark.parametrize("source", ["loops.png", "touch-drawing.png", "blob", "tiny"])

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
@@ -9,7 +10,7 @@ from scipy.ndimage import map_coordinates
 
 from onestroke.errors import VectorizeError
 from vectorize.axis.graph import Branch, MedialGraph
-from vectorize.axis.voronoi import empty_circle_bound, sides, tile_slabs, voronoi_part
+from vectorize.axis.voronoi import empty_circle_bound, jittered_delaunay, sides, tile_slabs, voronoi_part
 from onestroke.cores import idle_cores
 from vectorize.stroke import edge_lengths, lengths
 
@@ -28,7 +29,8 @@ def _inside(gray: np.ndarray, level: float, xy: np.ndarray) -> np.ndarray:
     return ok & (values < level)
 
 
-def medial_axis(rings: list[np.ndarray], gray: np.ndarray, level: float, *, tiles: int | None = None) -> MedialGraph:
+def medial_axis(rings: list[np.ndarray], gray: np.ndarray, level: float, *, tiles: int | None = None,
+                beside: Callable[[], object] | None = None) -> MedialGraph:
     """Inside Voronoi ridges of the outline samples as a graph of branches.
 
     A ridge is kept when both its vertices lie inside the ink and its two generating samples
@@ -38,7 +40,10 @@ def medial_axis(rings: list[np.ndarray], gray: np.ndarray, level: float, *, tile
     tiles: how many tiles to compute the diagram in, one thread each (1: whole; None: one
     per core from `TILED_SAMPLES` samples on, while the machine has a core to spare); it
     falls back to the whole diagram where the ink's widest part would make the tiles
-    overlap too much.
+    overlap too much. beside: work for this thread while qhull works (it holds the GIL, qhull
+    does not): with a core to spare, qhull triangulates in another thread meanwhile (tiles:
+    one per core but this thread's, each made in a thread of its own); else `beside` is
+    done first.
     """
     if not rings:
         raise VectorizeError("the ink has no outline to work from")
@@ -52,10 +57,10 @@ def medial_axis(rings: list[np.ndarray], gray: np.ndarray, level: float, *, tile
     following[firsts + sizes - 1] = firsts
     span = float(np.max(sides(samples))) + 1.0
 
-    def inside_ridges(chosen=None, slab=(-np.inf, np.inf), core=(-np.inf, np.inf), axis=0):
+    def inside_ridges(chosen=None, slab=(-np.inf, np.inf), core=(-np.inf, np.inf), axis=0, delaunay=None):
         """This tile's kept ridges (key pairs, sample pairs) and their vertices' (keys,
         centres, radii); None when an inside vertex of its core does not fit its slab."""
-        part = voronoi_part(samples, chosen, span=span, axis=axis, slab=slab)
+        part = voronoi_part(samples, chosen, span=span, axis=axis, slab=slab, delaunay=delaunay)
         p, q = part.ridge_points[:, 0], part.ridge_points[:, 1]
         keep = (following[p] != q) & (following[q] != p)  # not two neighbours on one ring
         ends = part.ridges[keep]
@@ -74,23 +79,39 @@ def medial_axis(rings: list[np.ndarray], gray: np.ndarray, level: float, *, tile
         number = np.cumsum(used) - 1
         return (number[ends], part.ridge_points[keep], part.key[used], part.center[used], part.radius[used])
 
-    parts = None
+    # Threads only pay with idle cores (on a busy machine they would also add the tiles'
+    # overlap).
+    cores = idle_cores() if tiles is None or beside is not None else 1
     if tiles is None:
-        # Threads only pay with idle cores (on a busy machine they would also add the tiles'
-        # overlap).
-        tiles = min(idle_cores(), MAX_TILES) if len(samples) >= TILED_SAMPLES else 1
+        spare = cores - 1 if beside is not None and cores > 1 else cores
+        tiles = min(spare, MAX_TILES) if len(samples) >= TILED_SAMPLES else 1
+    slabs = None
     if tiles > 1:
         spacing = max(float(np.max(edge_lengths(np.concatenate([ring, ring[:1]])))) for ring in rings)
         bound = empty_circle_bound(samples, gray, level, spacing)
         # A kept ridge's two circles lie within twice the bound of its midpoint: a tile
         # widened by that finds every ridge whose midpoint is in its core.
         slabs = tile_slabs(samples, 2.0 * bound, tiles) if np.isfinite(bound) else None
-        if slabs is not None:
-            with ThreadPoolExecutor(max_workers=len(slabs)) as pool:
-                parts = list(pool.map(lambda slab: inside_ridges(*slab), slabs))
-            if any(part is None for part in parts):
-                parts = None
-    if parts is None:
+    jobs = slabs if slabs is not None else [()]  # () : the whole diagram
+    overlap = beside is not None and cores > 1
+    if beside is not None and not overlap:
+        beside()
+    if len(jobs) > 1:  # each tile in a thread of its own
+        with ThreadPoolExecutor(max_workers=len(jobs)) as pool:
+            running = [pool.submit(inside_ridges, *job) for job in jobs]
+            if overlap:
+                beside()
+            parts = [job.result() for job in running]
+    elif overlap:
+        # Only qhull in the other thread: the rest of the diagram's making holds the GIL,
+        # as `beside` does, and would wait for it there.
+        with ThreadPoolExecutor(max_workers=1) as pool:
+            triangulating = pool.submit(jittered_delaunay, samples)
+            beside()
+            parts = [inside_ridges(delaunay=triangulating.result())]
+    else:
+        parts = [inside_ridges()]
+    if any(part is None for part in parts):  # a tile's inside vertex did not fit its slab
         parts = [inside_ridges()]
     # One vertex per name (a vertex found in two tiles has the same bits in both), in the
     # order of its coordinates (x, then y); ridges in the order of their vertices.

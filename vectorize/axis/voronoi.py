@@ -63,13 +63,27 @@ class VoronoiPart:
     ridge_points: np.ndarray
 
 
+def jittered_delaunay(samples: np.ndarray) -> Delaunay:
+    """qhull's Delaunay triangulation of all `samples` (N, 2) px moved by their jitter, as
+    `voronoi_part` makes it for the whole diagram (qhull lets go of the GIL while it works)."""
+    return Delaunay(samples + _jitter(samples.shape), qhull_options=QHULL_OPTIONS)
+
+
+def _jitter(shape: tuple) -> np.ndarray:
+    """Each sample's move (px), a fixed draw for all samples: a sample moves the same in
+    every tile."""
+    return np.random.default_rng(JITTER_SEED).uniform(-JITTER, JITTER, shape)
+
+
 def voronoi_part(samples: np.ndarray, chosen: np.ndarray | None = None, *, span: float | None = None,
-                 axis: int = 0, slab: tuple[float, float] = (-np.inf, np.inf)) -> VoronoiPart:
+                 axis: int = 0, slab: tuple[float, float] = (-np.inf, np.inf),
+                 delaunay: Delaunay | None = None) -> VoronoiPart:
     """The Voronoi diagram of `samples[chosen]` ((N, 2) px; `chosen` ascending indices, None:
     all), built from qhull's Delaunay triangulation, whose dual it is.
 
     span: the whole drawing's extent in px (for SAME_CENTER; default: these samples'); slab:
-    the tile's widened bounds (lo, hi) along `axis` for `VoronoiPart.fits`.
+    the tile's widened bounds (lo, hi) along `axis` for `VoronoiPart.fits`; delaunay: the
+    whole diagram's jittered triangulation when it is made already (`jittered_delaunay`).
     `scipy.spatial.Voronoi` runs the same qhull triangulation and then builds its ridges as
     Python lists, which costs as much again.
     """
@@ -81,9 +95,8 @@ def voronoi_part(samples: np.ndarray, chosen: np.ndarray | None = None, *, span:
     # of cocircular quadruples. Points moved by JITTER px triangulate fast, and that
     # triangulation is kept when it is one of the exact points' (any triangulation of a
     # cocircular group is: the group is one vertex).
-    # Drawn for all samples, so a sample moves the same in every tile.
-    jitter = np.random.default_rng(JITTER_SEED).uniform(-JITTER, JITTER, samples.shape)[chosen]
-    mesh = _triangulation(points, jitter, span)
+    jitter = _jitter(samples.shape)[chosen]
+    mesh = _triangulation(points, jitter, span, delaunay)
     if mesh is None:
         mesh = _triangulation(points, None, span)
     triples, centers, radius, first, second, ridge_points, same = mesh
@@ -125,16 +138,19 @@ def voronoi_part(samples: np.ndarray, chosen: np.ndarray | None = None, *, span:
                        ridge_points=chosen[ridge_points])
 
 
-def _triangulation(points: np.ndarray, jitter: np.ndarray | None, span: float) -> tuple | None:
-    """qhull's Delaunay triangulation of `points` (moved by `jitter` when given), its
-    triangles' circumcentres and radii at the exact points and its inner edges; None when
-    the jittered triangulation is not a Delaunay triangulation of the exact points.
+def _triangulation(points: np.ndarray, jitter: np.ndarray | None, span: float,
+                   tri: Delaunay | None = None) -> tuple | None:
+    """qhull's Delaunay triangulation of `points` (moved by `jitter` when given; `tri`: that
+    triangulation made already), its triangles' circumcentres and radii at the exact points
+    and its inner edges; None when the jittered triangulation is not a Delaunay
+    triangulation of the exact points.
 
     Returns (corner triples in ascending order (T, 3), centres (T, 2), radii (T,), each
     inner edge's two triangles first (E,) < second (E,), its samples (E, 2), whether its
     triangles' centres are one vertex (E,)).
     """
-    tri = Delaunay(points if jitter is None else points + jitter, qhull_options=QHULL_OPTIONS)
+    if tri is None or jitter is None:
+        tri = Delaunay(points if jitter is None else points + jitter, qhull_options=QHULL_OPTIONS)
     simplices, neighbors = tri.simplices, tri.neighbors
     # Each corner triple in ascending order: the same triangle gives the same circumcentre
     # bits in every tile.
