@@ -101,5 +101,7 @@ def test_generated_data_holds_every_shape_with_the_right_labels():
     assert np.all(seen["loop_crossing"] == 1) and np.all(seen["bent_crossing"] == 1)
     assert set(seen["short_branch"].tolist()) == {0, 1}
     assert np.all(data.angle[data.shape == SHAPES.index("loop_crossing")] >= 15.0)
+    assert set(data.label[data.context].tolist()) == {0, 1} and 0.2 < data.context.mean() < 0.5
     prefix = generate(8, seed=5)  # the first chunk's seed makes its first samples
     assert np.array_equal(prefix.x, data.x[:8]) and np.array_equal(prefix.shape, data.shape[:8])
+    assert np.array_equal(prefix.context, data.context[:8])

@@ -41,7 +41,8 @@ class SynthSet:
 
     x: (N, 2, S, S) uint8 crops (ink strength x 255); label: (N,) int64, 1 = crossing;
     subtype: (N,) int64 index into SUBTYPES; angle: (N,) crossing angle in degrees (0 for
-    touchings); width: (N,) stroke width in render px; shape: (N,) int64 index into SHAPES.
+    touchings); width: (N,) stroke width in render px; shape: (N,) int64 index into SHAPES;
+    context: (N,) bool, the branches curl on into letters (cursive context).
     """
 
     x: np.ndarray
@@ -50,6 +51,7 @@ class SynthSet:
     angle: np.ndarray
     width: np.ndarray
     shape: np.ndarray
+    context: np.ndarray
 
 
 # ----------------------------------------------------------------------------- curves
@@ -238,8 +240,8 @@ def _smooth_noise(rng: np.random.Generator, shape: tuple[int, int], sigma: float
     return n / max(float(n.std()), 1e-6)
 
 
-def _render_sample(rng: np.random.Generator, spec: CropSpec) -> tuple[np.ndarray, int, int, float, float, int]:
-    """One sample: (crop (2, S, S) float32, label, subtype, angle_deg, width_px, shape)."""
+def _render_sample(rng: np.random.Generator, spec: CropSpec) -> tuple[np.ndarray, int, int, float, float, int, bool]:
+    """One sample: (crop (2, S, S) float32, label, subtype, angle_deg, width_px, shape, context)."""
     w = float(np.exp(rng.uniform(np.log(1.8), np.log(5.0))))
     half = int(np.ceil(0.5 * spec.far_span * np.sqrt(2.0) * w * 1.2 + 3.0))
     size = 2 * half + 1
@@ -369,22 +371,24 @@ def _render_sample(rng: np.random.Generator, spec: CropSpec) -> tuple[np.ndarray
     # Rendering put pixel (i, j)'s centre at (j + 0.5, i + 0.5); the crop (like the medial
     # axis) puts it at (j, i).
     crop = crop_junctions(gray.astype(np.float32), (center + jitter - 0.5)[None], w_est, spec)[0]
-    return crop, int(crossing), subtype, float(angle), w, form
+    return crop, int(crossing), subtype, float(angle), w, form, bool(context)
 
 
 def _chunk(args: tuple[int, int, int, CropSpec]) -> tuple[np.ndarray, ...]:
     seed, index, count, spec = args
     rng = np.random.default_rng(np.random.SeedSequence([seed, index]))
-    xs, ys, st, an, wd, sh = [], [], [], [], [], []
+    xs, ys, st, an, wd, sh, cx = [], [], [], [], [], [], []
     for _ in range(count):
-        crop, label, subtype, angle, w, shape = _render_sample(rng, spec)
+        crop, label, subtype, angle, w, shape, context = _render_sample(rng, spec)
         xs.append(np.round(crop * 255.0).astype(np.uint8))
         ys.append(label)
         st.append(subtype)
         an.append(angle)
         wd.append(w)
         sh.append(shape)
-    return np.stack(xs), np.array(ys), np.array(st), np.array(an), np.array(wd), np.array(sh)
+        cx.append(context)
+    return (np.stack(xs), np.array(ys), np.array(st), np.array(an), np.array(wd), np.array(sh),
+            np.array(cx, dtype=bool))
 
 
 def seeded_chunks(make_chunk, n: int, chunk: int, *, seed: int, spec, workers: int) -> list:
@@ -401,6 +405,6 @@ def generate(n: int, *, seed: int, spec: CropSpec = CropSpec(), workers: int = 1
     """`n` samples, half crossings and half touchings in expectation; seeded and
     independent of `workers` (each chunk of CHUNK samples has its own seed)."""
     parts = seeded_chunks(_chunk, n, CHUNK, seed=seed, spec=spec, workers=workers)
-    x, y, st, an, wd, sh = (np.concatenate([p[i] for p in parts]) for i in range(6))
+    x, y, st, an, wd, sh, cx = (np.concatenate([p[i] for p in parts]) for i in range(7))
     return SynthSet(x=x, label=y.astype(np.int64), subtype=st.astype(np.int64),
-                    angle=an.astype(np.float64), width=wd.astype(np.float64), shape=sh.astype(np.int64))
+                    angle=an.astype(np.float64), width=wd.astype(np.float64), shape=sh.astype(np.int64), context=cx)

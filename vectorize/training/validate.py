@@ -33,5 +33,7 @@ def evaluate_onnx(model_path: str | os.PathLike, *, count: int, seed: int, worke
         "per_subtype": {name: share(data.subtype == i) for i, name in enumerate(SUBTYPES)},
         "per_shape": {f"{name} ({kind})": share((data.shape == i) & (data.label == label))
                       for i, name in enumerate(SHAPES) if i
-                      for label, kind in ((1, "crossing"), (0, "touching")) if label or name == "short_branch"},
+                      for label, kind in ((1, "crossing"), (0, "touching")) if label or name == "short_branch"}
+        | {f"cursive context ({kind})": share(data.context & (data.label == label))
+           for label, kind in ((1, "crossing"), (0, "touching"))},
     }
