@@ -21,7 +21,7 @@ from vectorize.axis.simplify import Simplified, directions, simplify, slots
 from vectorize.drawing import Drawing
 from vectorize.fit.ink_guard import InkGuard, guard_margin
 from vectorize.fit.ink_width import edge_offset, ink_widths
-from vectorize.fit.retraces import Twin, foot_is_retraced, twin_spans
+from vectorize.fit.retraces import Twin, foot_is_retraced, trimmed_twins, twin_spans
 from vectorize.junctions.classifiers import make_classifier, shipped_pass_scorer
 from vectorize.junctions.crossing_point import crossing_point
 from vectorize.junctions.intersections import (Junction, JunctionVerdict, lone_junctions, ranked_pairings,
@@ -32,7 +32,7 @@ from vectorize.raster.outline import outline_rings
 from vectorize.route.retrace_paths import turn_prices, turns_at
 from vectorize.route.route_ends import end_costs
 from vectorize.route.route_inspection import connect_pairings, plan_routes
-from vectorize.route.traversal import Ordering, order_strokes, turn_backs
+from vectorize.route.traversal import Ordering, half_turns, order_strokes, turn_backs
 from vectorize.stroke import Stroke, lengths
 
 if TYPE_CHECKING:  # the studio's refinement is imported where edits or a session ask for it
@@ -194,14 +194,17 @@ def _trace(graph: MedialGraph, simple: Simplified, ordering: Ordering, junctions
         # Where the pen turns back at a junction it goes up to the node and returns: its
         # points there are the line, not uncertain ink of passes running through.
         turned = turn_backs(graph, passes, zone_nodes, stroke_width)
+        # A turn within one half of a merged node's band turns where its two branches part.
+        cut = half_turns(graph, passes)
         for index, step in enumerate(passes):
             branch = graph.branches[step.branch]
             # By end, not by node: a loop starts and ends at the same node.
             points = branch.points if step.start == "a" else branch.points[::-1]
             radius = branch.radii if step.start == "a" else branch.radii[::-1]
             far_node = branch.node(step.end)
-            points = points if index == 0 else points[1:]
-            radius = radius if index == 0 else radius[1:]
+            head = 0 if index == 0 else 1 + cut.get(index - 1, 0)
+            tail = len(points) - cut.get(index, 0)
+            points, radius = points[head:tail], radius[head:tail]
             spans.append((max(count - 1, 0), count + len(points) - 1))
             if not len(points):
                 continue
@@ -229,6 +232,8 @@ def _trace(graph: MedialGraph, simple: Simplified, ordering: Ordering, junctions
                            closed, twins))
             continue
         xy, keep, split = np.concatenate(parts), np.concatenate(keeps), np.concatenate(tips)
+        if cut:
+            twins = trimmed_twins(xy, twins, [spans[i][1] for i in cut])
         for base in sharp_points:
             split[np.all(xy == base, axis=1)] = True
         owner = np.concatenate(owners)

@@ -26,6 +26,9 @@ def test_sharp_touch_needs_a_sharp_touching_turn_and_a_straight_crossing():
     # An e's entry (measured in incidentally-0-12): straight through bends 10 and 21 degrees,
     # touching 35 and 66.
     assert sharp_touch(_unit([129.0, 84.0, -86.0, -30.0]))
+    # The same on a line 2 px wide (hand_me_the_lamp_the_tent_and_the_kettle-1-31, measured
+    # 1.5 px): straight through bends 35 and 20 degrees, touching 25 and 81.
+    assert sharp_touch(_unit([126.3, 80.6, -78.9, -18.5]))
     # Two arcs touching tangentially: both pairings smooth.
     assert not sharp_touch(_unit([8.0, 172.0, -8.0, 188.0]))
     # A cusp's tip on a line: going straight through bends as sharply as touching.

@@ -11,7 +11,7 @@ from benchmarks.metrics.table1 import drawing_polylines, polyline_intersections
 from benchmarks.common.render import render
 from vectorize import VectorizeOptions, vectorize_image
 from vectorize.drawing import Drawing
-from vectorize.fit.retraces import retraced_runs
+from vectorize.fit.retraces import Twin, retraced_runs, trimmed_twins, valid_twins
 from vectorize.stroke import Stroke
 
 SIZE = 400
@@ -90,3 +90,18 @@ def test_retraced_runs_pair_a_spike_out_and_back_and_a_path_drawn_twice():
     branches = [0, 1, 2, 2, 1, 3, 5, 4, 5, 6]
     starts = ["a", "a", "a", "b", "b", "a", "a", "a", "a", "a"]
     assert retraced_runs(branches, starts) == [((1, 2), (3, 4), True), ((6, 6), (8, 8), False)]
+
+
+def test_a_twin_cut_short_at_a_turn_keeps_what_both_passes_still_share():
+    # Out along points 0-9 and back: the way back was cut where two branches part (its points
+    # 3, 2, 1 left out, `half_turns`), so it meets the way out only from its two ends on.
+    out = np.c_[np.arange(10.0), np.arange(10.0) ** 1.5]
+    back = np.r_[out[::-1][:6], out[::-1][9:]]  # points 9..4, then 0
+    xy = np.r_[out, back]
+    twin = Twin((0, 9), (10, 16), True)
+    assert not valid_twins(xy, [twin])
+    parts = trimmed_twins(xy, [twin], [15])
+    assert parts == [Twin((4, 9), (10, 15), True)]  # point 0 alone is no stretch
+    assert valid_twins(xy, parts) == parts
+    # A twin over no cut is left to `valid_twins` as it is.
+    assert trimmed_twins(xy, [twin], [30]) == [twin]

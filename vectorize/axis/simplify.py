@@ -212,7 +212,8 @@ def simplify(graph: MedialGraph, *, stroke_width: float, multi: bool, ends: int 
             return float(np.dot(dirs[a], dirs[b])) > np.cos(np.radians(CROSSING_HALF_MAX_ANGLE))
 
         options = [(bid, far) for bid, far in options if other_ok(far)
-                   and graph.branches[bid].length < 40.0 * stroke_width and opens_a_v(bid)]
+                   and graph.branches[bid].length < 40.0 * stroke_width and opens_a_v(bid)
+                   and _facing(graph, node, far, bid, reach)]
         widest = max(options, key=lambda o: _min_radius(graph.branches[o[0]]), default=None)
         foot_bid = node_slots[foot_slot(dirs)][0]
         foot = next((o for o in options if o[0] == foot_bid), None)
@@ -299,6 +300,21 @@ CROSSING_HALF_MAX_ANGLE = 125.0
 V_SPIKE_MAX_ANGLE = 75.0
 
 
+def _opening(graph: MedialGraph, node: int, bid: int, reach: float) -> np.ndarray:
+    """The sum of the unit tangents at `node` of its branch ends other than branch `bid`'s."""
+    dirs = directions(graph, node, reach)
+    return sum((d for (b, _), d in zip(slots(graph, node), dirs) if b != bid), np.zeros(2))
+
+
+def _facing(graph: MedialGraph, node: int, other: int, bid: int, reach: float) -> bool:
+    """Whether the junctions `node` and `other`, joined by branch `bid`, open away from each
+    other, as the two halves of a crossing do: each pass runs in at one and out at the other,
+    bending less than a right angle across the pair. Two forks whose branches leave the same
+    way (a u's arm and the next letter's stem, both rising from the line between them) are two
+    junctions of the line: a pass from one to the other would turn back."""
+    return float(np.dot(_opening(graph, node, bid, reach), _opening(graph, other, bid, reach))) < 0.0
+
+
 def _v_spike(graph: MedialGraph, node: int, reach: float) -> bool:
     """The paper's Y-junction: the foot of a degree-3 node (opposite its smallest angle,
     which must be acute) ends in a free end."""
@@ -312,26 +328,29 @@ def _v_spike(graph: MedialGraph, node: int, reach: float) -> bool:
 
 def _crossing_halves(graph: MedialGraph, node: int, bid: int, reach: float, stroke_width: float) -> bool:
     """Whether `node` and the degree-3 junction at the other end of branch `bid` are the two
-    halves of one crossing that closes a loop: two of the four other branch ends are one
-    loop's, the two passes run straight through both junctions (each bends by at most
-    `CROSSING_PASS_MAX_BEND`), the branch between them is the widest at `node`, and it is no
-    longer than the ink two lines crossing at that angle share (w / sin(a / 2), a the angle
+    halves of one crossing: the two passes run straight through both junctions (each bends
+    by at most `CROSSING_PASS_MAX_BEND`, `CROSSING_LOOP_MAX_BEND` where they close a loop),
+    the branch between them is the widest at `node`, and it is no longer than the ink two
+    lines crossing at that angle share ((w + `CROSSING_EDGE_BLUR`) / sin(a / 2), a the angle
     between the passes, with `CROSSING_JOIN_SLACK`).
 
     Where a crossing lies a few widths from the line's end (a loop's exit stroke crossing
     its way in: the last letter's loop, an e at a word's end), the short exit ends free
-    and reads like a spike off a straight line (a T) unless the crossing is seen whole.
+    and reads like a spike off a straight line (a T) unless the crossing is seen whole. So
+    does a stem drawn down through a crossing and back up (an h's or l's stem below the
+    point where its ascender loop crosses the way in): it is a spike, but its base is a
+    crossing's too, and the route retraces it through the crossing (`route.retrace_paths`
+    may turn there at a price).
     """
     other = graph.branches[bid].other(node)
     if other == node or graph.degree(other) != 3:
         return False
-    # Two of the four other branch ends are one loop's: the passes through the crossing are
-    # the way into and out of that loop. (A stem drawn down and back up through a crossing,
-    # three passes in one band, also looks straight here, but its stub is a spike: the
-    # route would otherwise pair its free end the long way round.)
-    outer = [b for end in (node, other) for b in graph.incident[end] if b != bid]
-    if len(set(outer)) == len(outer):
-        return False
+    # The two passes close a loop through the pair when one junction's two other branches
+    # end at one node (a loop's two ends, or a loop through the next junction: an h's loop
+    # where its arch leaves). Such a junction cannot be resolved alone: a loop is entered
+    # and left at a crossing or touch.
+    closes_loop = any(len({graph.branches[b].other(end) for b in graph.incident[end] if b != bid}) == 1
+                      for end in (node, other))
     legs = []
     for end in (node, other):
         end_slots = slots(graph, end)
@@ -341,24 +360,32 @@ def _crossing_halves(graph: MedialGraph, node: int, bid: int, reach: float, stro
     (a0, a1), (b0, b1) = legs
     # A pass enters along -a and leaves along b: straight when a and b are opposite.
     bend = min(max(float(np.dot(a0, b0)), float(np.dot(a1, b1))), max(float(np.dot(a0, b1)), float(np.dot(a1, b0))))
-    if bend > -np.cos(np.radians(CROSSING_PASS_MAX_BEND)):
+    if bend > -np.cos(np.radians(CROSSING_LOOP_MAX_BEND if closes_loop else CROSSING_PASS_MAX_BEND)):
         return False
     # The branch between the halves runs through ink laid down twice: the widest (paper, Fig. 4).
     link = _min_radius(graph.branches[bid])
     if any(_min_radius(graph.branches[b]) > link for b in graph.incident[node] if b != bid):
         return False
     half_angle = 0.5 * np.arccos(np.clip(float(np.dot(a0, a1)), -1.0, 1.0))
-    return graph.branches[bid].length <= CROSSING_JOIN_SLACK * stroke_width / max(np.sin(half_angle), 1e-3)
+    shared = (stroke_width + CROSSING_EDGE_BLUR) / max(np.sin(half_angle), 1e-3)
+    return graph.branches[bid].length <= CROSSING_JOIN_SLACK * shared
 
 
 # Each of the two passes through a crossing seen as two junctions bends by less than this
 # (degrees) across the pair; a spike's base next to another junction does not continue
 # straight into one of its branches.
 CROSSING_PASS_MAX_BEND = 30.0
+# ... and by less than this where they close a loop: a cursive e's way in bends into its
+# loop (21-43 degrees measured over 2.5 widths on the cursive set's e's).
+CROSSING_LOOP_MAX_BEND = 45.0
 # The measured stroke width falls short of the ink's (anti-aliased edges) and the branches'
 # directions, measured a few widths out, open wider than the crossing itself: slack on the
 # shared ink's length w / sin(a / 2).
 CROSSING_JOIN_SLACK = 1.5
+# px added to the measured width for the shared ink: where two lines overlap, their
+# anti-aliased edges add their grey, and the ink passes the threshold up to half a pixel
+# further out on each side than along one line (lines 2-2.5 px wide measure 1.5 px).
+CROSSING_EDGE_BLUR = 1.0
 
 
 def _t_stub(graph: MedialGraph, node: int, reach: float, stroke_width: float) -> tuple[int, float] | None:

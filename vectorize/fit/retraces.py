@@ -122,6 +122,29 @@ def twin_spans(branches: Sequence[int], starts: Sequence[str], spans: Sequence[t
     return twins
 
 
+def trimmed_twins(xy: np.ndarray, twins: Sequence[Twin], cuts: Sequence[int]) -> list[Twin]:
+    """The twins cut to the points both ranges still hold where a pass was cut short at one of
+    the point indices `cuts` (`route.traversal.half_turns`: a turn made where two branches
+    part, not at the node): what matches from each of the twin's two ends on, as one or two
+    twins. Twins over no cut are left as they are."""
+    result = []
+    for t in twins:
+        (lo1, hi1), (lo2, hi2) = t.first, t.second
+        if valid_twins(xy, [t]) or not any(lo1 <= c <= hi1 or lo2 <= c <= hi2 for c in cuts):
+            result.append(t)
+            continue
+        # Point k from the later range's start is point a(k) of the earlier range; from its end, b(k).
+        a = (lambda k: hi1 - k) if t.reverse else (lambda k: lo1 + k)
+        b = (lambda k: lo1 + k) if t.reverse else (lambda k: hi1 - k)
+        size = min(hi1 - lo1, hi2 - lo2) + 1
+        head = next((k for k in range(size) if not np.array_equal(xy[lo2 + k], xy[a(k)])), size)
+        tail = next((k for k in range(size - head) if not np.array_equal(xy[hi2 - k], xy[b(k)])), size - head)
+        for second, one, two in (((lo2, lo2 + head - 1), a(0), a(head - 1)), ((hi2 - tail + 1, hi2), b(tail - 1), b(0))):
+            if second[1] > second[0]:
+                result.append(Twin((min(one, two), max(one, two)), second, t.reverse))
+    return result
+
+
 def valid_twins(xy: np.ndarray, twins: Sequence[Twin]) -> list[Twin]:
     """The twins whose two ranges really hold the same points (after any re-indexing)."""
     result = []

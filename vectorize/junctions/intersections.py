@@ -135,9 +135,11 @@ def lone_junctions(centers: np.ndarray, spans: np.ndarray, reach: float) -> np.n
 
 
 # Degrees. Touches: the touching pairing bends <= 28; cursive e entries bend 21-30 going
-# straight through and 66-80 touching (six at seed 0).
+# straight through and 66-80 touching (six at seed 0), and on lines 2 px wide (measured
+# 1.5 px, the directions read 2.5 widths out) up to 35-43 going straight
+# (hand_me_the_lamp_the_tent_and_the_kettle-1-31, uncle_hank_decided_at_lunchtime-1-34).
 TOUCH_MAX_BEND = 45.0
-STRAIGHT_MAX_BEND = 35.0
+STRAIGHT_MAX_BEND = 45.0
 
 
 def _normal(first: tuple[int, int], second: tuple[int, int]) -> Pairing:

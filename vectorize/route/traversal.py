@@ -13,7 +13,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from vectorize.axis.graph import MedialGraph
-from vectorize.axis.simplify import Simplified, Slot, directions, slot_direction, slots
+from vectorize.axis.simplify import Simplified, Slot, directions, slot_direction, slot_points, slots
 from vectorize.junctions.intersections import Pairing
 
 @dataclass(frozen=True)
@@ -197,4 +197,47 @@ def turn_backs(graph: MedialGraph, passes, nodes, reach: float) -> dict[int, int
         out = reach + graph.spans.get(node, 0.0)
         if float(slot_direction(graph, arrive, out) @ slot_direction(graph, leave, out)) > 0.0:
             result[i] = node
+    return result
+
+
+def _shared_points(graph: MedialGraph, one: Slot, two: Slot) -> int:
+    """How many points two branch ends at one node have in common from the node on (a merged
+    node's branches on one side share the half of the old joining branch they lead along)."""
+    p, q = slot_points(graph, one), slot_points(graph, two)
+    n = min(len(p), len(q))
+    same = np.all(p[:n] == q[:n], axis=1)
+    return int(n if same.all() else np.argmin(same))
+
+
+def half_turns(graph: MedialGraph, passes) -> dict[int, int]:
+    """Where a stroke turns back within one half of a merged node's shared ink and need not go
+    to the node: {i: points} for passes i, i + 1 that meet at a merged node (`graph.spans`) by
+    two branches sharing that half (its first `points` + 1 points, node included), to be cut
+    off both passes so that the line turns where the two branches part (the old junction).
+
+    A merged node stands for a band of ink two passes share between two junctions, and a
+    pass through it runs the band's length. A pass that turns back within one half (a d's
+    stem drawn down, then up to where the connecting stroke met the bowl's top) only goes
+    down the band and up the same points again. The band must still be drawn: a half no
+    pass runs through keeps its first turn to the node.
+    """
+    ends = []  # (i, node, half arriving, half leaving, points shared) per turn at a merged node
+    for i in range(len(passes) - 1):
+        step, after = passes[i], passes[i + 1]
+        node = graph.branches[step.branch].node(step.end)
+        if graph.spans.get(node, 0.0) <= 0.0:
+            continue
+        arrive, leave = (step.branch, step.end), (after.branch, after.start)
+        if arrive == leave:
+            continue  # the same branch end back: a retrace to the node, drawn as one
+        shared = _shared_points(graph, arrive, leave)
+        ends.append((i, node, tuple(slot_points(graph, arrive)[1]), tuple(slot_points(graph, leave)[1]), shared))
+    through = {(node, half) for _, node, h_in, h_out, _ in ends if h_in != h_out for half in (h_in, h_out)}
+    result, drawn = {}, set(through)
+    for i, node, h_in, h_out, shared in ends:
+        if h_in != h_out or shared < 2:
+            continue
+        if (node, h_in) in drawn:
+            result[i] = shared - 1
+        drawn.add((node, h_in))
     return result
