@@ -73,7 +73,11 @@ def run_pool(todo: Todo, job: BatchJob, workers: int) -> Iterator[tuple[BatchIte
     def hand_out(slot: int) -> None:
         if queue:
             item, needed = queue.popleft()
-            with _interrupts_ignored():  # the first submit starts the process
+            # Only the submit that starts the worker's process ignores Ctrl-C (the process
+            # inherits that): an ignored Ctrl-C is lost, and the later submits come right
+            # after a drawing is written, when a user is most likely to press it.
+            starting = not getattr(pool[slot], "_processes", None)  # private, as in _kill
+            with _interrupts_ignored() if starting else contextlib.nullcontext():
                 future = pool[slot].submit(process_file, item.name, job, path=str(item.source), extensions=needed)
             running[future] = (slot, item, needed)
 

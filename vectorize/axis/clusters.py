@@ -50,8 +50,14 @@ def straightest_pairs(dirs: np.ndarray) -> tuple[Pairs, float]:
         cost = sum(1.0 + float(np.dot(dirs[a], dirs[b])) for a, b in pairs)
         if cost < best_cost:
             best, best_cost = pairs, cost
-    bend = max(float(np.degrees(np.arccos(np.clip(-np.dot(dirs[a], dirs[b]), -1.0, 1.0)))) for a, b in best)
-    return best, bend
+    return best, max(pass_bends(dirs, best))
+
+
+def pass_bends(dirs: np.ndarray, pairs) -> list[float]:
+    """Degrees each pass of `pairs` (slot pairs) turns by at the node (0 = straight through);
+    dirs: (D, 2) unit tangents leaving it."""
+    d = np.asarray(dirs, dtype=float)
+    return [float(np.degrees(np.arccos(np.clip(-np.dot(d[a], d[b]), -1.0, 1.0)))) for a, b in pairs]
 
 
 def _merge_cluster(graph: MedialGraph, nodes: list[int], inner: list[int]) -> int:

@@ -16,6 +16,8 @@ from typing import Protocol
 
 import numpy as np
 
+from vectorize.axis.clusters import pass_bends
+
 
 # A configuration pairs the four branch slots 0..3 into two passes through the node.
 Pairing = tuple[tuple[int, int], tuple[int, int]]
@@ -99,12 +101,6 @@ def touching_pairings(directions: np.ndarray) -> tuple[Pairing, Pairing]:
     a, b, c, e = (int(i) for i in order)
     options = [_normal((a, b), (c, e)), _normal((b, c), (e, a))]
     return tuple(sorted(options, key=lambda p: turn_cost(d, p)))  # type: ignore[return-value]
-
-
-def pass_bends(directions: np.ndarray, pairing: Pairing) -> list[float]:
-    """Degrees each pass of `pairing` turns by at the node (0 = straight through)."""
-    d = np.asarray(directions, dtype=float)
-    return [float(np.degrees(np.arccos(np.clip(-np.dot(d[a], d[b]), -1.0, 1.0)))) for a, b in pairing]
 
 
 def sharp_touch(directions: np.ndarray) -> bool:

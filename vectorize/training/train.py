@@ -140,8 +140,6 @@ def model_card(meta: dict) -> str:
     v = meta["validation"]
     rows = "\n".join(f"| {name.replace('_', ' ')} | {v['per_subtype'][name]['n']} | "
                      f"{v['per_subtype'][name]['accuracy']:.4f} |" for name in SUBTYPES)
-    rows += "".join(f"\n| {name.replace('_', ' ')} | {share['n']} | {share['accuracy']:.4f} |"
-                    for name, share in v.get("per_shape", {}).items())
     return f"""# Crossing-vs-touching classifier (`crossing_cnn.onnx`)
 
 A small CNN that tells, at a degree-4 node of a single-line drawing's medial axis,
@@ -169,9 +167,7 @@ whether the two strokes cross (go straight over) or touch and turn back.
 {rows}
 
 Shallow crossings are those under 15 degrees; near touches leave a gap of 0.15-0.9
-stroke widths that the ink still bridges. Bent crossings: one stroke bends by 20-80
-degrees within a few widths of the crossing; short branch: a branch ends 3-6 widths past
-the junction.
+stroke widths that the ink still bridges.
 """
 
 

@@ -9,11 +9,11 @@ import os
 
 import numpy as np
 
-from vectorize.training.synth import SHAPES, SUBTYPES, generate
+from vectorize.training.synth import SUBTYPES, generate
 
 
 def evaluate_onnx(model_path: str | os.PathLike, *, count: int, seed: int, workers: int = 1) -> dict:
-    """Overall, per-class, per-sub-type and per-shape accuracy with 8-fold test-time augmentation."""
+    """Overall, per-class and per-sub-type accuracy with 8-fold test-time augmentation."""
     from vectorize.junctions.cnn_classifier import CnnClassifier
 
     data = generate(count, seed=seed, workers=workers)
@@ -31,9 +31,4 @@ def evaluate_onnx(model_path: str | os.PathLike, *, count: int, seed: int, worke
         "accuracy": round(float(right.mean()), 4),
         "per_class": {"crossing": share(data.label == 1), "touching": share(data.label == 0)},
         "per_subtype": {name: share(data.subtype == i) for i, name in enumerate(SUBTYPES)},
-        "per_shape": {f"{name} ({kind})": share((data.shape == i) & (data.label == label))
-                      for i, name in enumerate(SHAPES) if i
-                      for label, kind in ((1, "crossing"), (0, "touching")) if label or name == "short_branch"}
-        | {f"cursive context ({kind})": share(data.context & (data.label == label))
-           for label, kind in ((1, "crossing"), (0, "touching"))},
     }
