@@ -372,6 +372,7 @@ def _route(graph: MedialGraph, chain_list: list[Chain], stroke_width: float, dir
     else:
         # A closed walk: begin at the top-left node (any node would do).
         start = min(nodes, key=lambda n: (float(graph.positions[n].sum()), n))
+
     def walked(e: int, end: str) -> tuple[Pass, ...]:
         chain = chain_list[multi.edges[e]]
         return chain.passes if end == "u" else tuple(_back(p) for p in reversed(chain.passes))
