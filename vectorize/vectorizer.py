@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import sys
 import time
+from collections import Counter
 from dataclasses import replace
 from functools import partial
 from importlib import import_module
@@ -149,6 +150,42 @@ def _pairing_costs(verdict: JunctionVerdict) -> tuple[float, float, float]:
     return tuple(float(np.log(ranked[0]) - np.log(x)) for x in ranked)  # type: ignore[return-value]
 
 
+def _is_shared_stub(graph: MedialGraph, node: int, bid: int, walks: Counter, stroke_width: float) -> bool:
+    """Whether branch `bid` at crossing `node` is a stub the crossing's two passes share: at
+    most `SHARED_STUB_WIDTHS` stroke widths long, to another junction, walked twice."""
+    branch = graph.branches[bid]
+    far = branch.b if branch.a == node else branch.a
+    return (branch.a != branch.b and walks[bid] >= 2 and graph.degree(far) >= 3
+            and branch.length <= SHARED_STUB_WIDTHS * stroke_width)
+
+
+def _shared_stub_reach(graph: MedialGraph, node: int, walks: Counter, stroke_width: float) -> float:
+    """How far (px) the uncertain zone of a crossing at `node` reaches over its shared stubs
+    (`_is_shared_stub`): to the far junction and half a width past it (where the two passes
+    part, their inks still overlap); 0 without such a stub.
+
+    A cursive l or h whose loop closes a stub away from the crossing (the_kitten_ate_the_
+    mauled_candy-1-30's "th": the loop's two ends meet 3 px, 1.5 widths, above the crossing
+    of the way in and the way down): both passes run over the stub, and with the zone
+    ending before the far junction each kept both junctions' points, so the fitted passes
+    ran together over the stub, 0.1-0.3 px apart, instead of crossing.
+    """
+    reach = 0.0
+    for bid, _ in slots(graph, node):
+        if _is_shared_stub(graph, node, bid, walks, stroke_width):
+            branch = graph.branches[bid]
+            far = branch.b if branch.a == node else branch.a
+            reach = max(reach, float(np.linalg.norm(graph.positions[far] - graph.positions[node])) + 0.5 * stroke_width)
+    return reach
+
+
+# Stroke widths. Branches from a crossing to another junction that the route walks twice
+# measured 0.77-2.42 widths (9 lengths; the kitten's 1.98) and then 3.05 and up (h and l bases
+# whose way in and stem share a band, 4.1, `route_inspection.shared_bands`; stems drawn down
+# and back, 12 and up) over the cursive set at seed 1: a longer band keeps its own points.
+SHARED_STUB_WIDTHS = 2.5
+
+
 def _trace(graph: MedialGraph, simple: Simplified, ordering: Ordering, junctions: dict,
            verdicts: dict, stroke_width: float) -> list[tuple[TracedPoints, bool, list[Twin]]]:
     """Turn branch passes into point lists flagged for filtering (paper 3.4), with the
@@ -166,6 +203,7 @@ def _trace(graph: MedialGraph, simple: Simplified, ordering: Ordering, junctions
     crossing_of = dict(zip(simple.crossings, ordering.choice))
     decided = {**{n: p for n, p in crossing_of.items() if n not in ordering.undecided}, **simple.through}
     # Uncertain zone around each degree-4 node: where the two strokes' inks still overlap.
+    walks = Counter(step.branch for passes in ordering.strokes for step in passes)
     zones = []
     for node in simple.crossings:
         junction = junctions[node]
@@ -177,6 +215,8 @@ def _trace(graph: MedialGraph, simple: Simplified, ordering: Ordering, junctions
         # The shared ink of a merged node (its span) is uncertain too: both strokes' points
         # there lie on one averaged centre line.
         reach = max(reach, graph.spans.get(node, 0.0) + 0.5 * stroke_width)
+        if verdicts[node].is_crossing:
+            reach = max(reach, _shared_stub_reach(graph, node, walks, stroke_width))
         reach = float(np.clip(reach, graph.radii[node], 12.0 * stroke_width))
         zones.append((node, reach, verdicts[node].is_crossing))
     for node in simple.through:
@@ -187,6 +227,10 @@ def _trace(graph: MedialGraph, simple: Simplified, ordering: Ordering, junctions
     # Not retraced stretches: a loop (its direction cannot be told from where it starts) and
     # the foot of a V-spike (each side of the V runs to the tip on its own ink).
     not_twins = {bid for bid, b in graph.branches.items() if b.a == b.b} | foot_branches
+    # A crossing's stub (`_shared_stub_reach`) is the two crossing passes' shared ink, not one
+    # line drawn twice: its points lie in the zone and each pass runs straight through.
+    not_twins |= {bid for node, reach, crossing in zones if crossing
+                  for bid, _ in slots(graph, node) if _is_shared_stub(graph, node, bid, walks, stroke_width)}
     zone_nodes = {node for node, _, _ in zones}
     for passes, closed in zip(ordering.strokes, ordering.closed):
         parts, keeps, tips, spans, radii, owners, forks = [], [], [], [], [], [], []
