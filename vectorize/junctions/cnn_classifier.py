@@ -19,7 +19,7 @@ import numpy as np
 
 from onestroke.errors import VectorizeError
 from vectorize.junctions.intersections import Junction, JunctionVerdict
-from vectorize.junctions.junction_crop import CropSpec, crop_junctions, dihedral_copies
+from vectorize.junctions.junction_crop import CropSpec, crop_junctions, crop_own_ink, dihedral_copies
 
 DEFAULT_MODEL = Path(__file__).parents[1] / "models" / "crossing_cnn.onnx"
 
@@ -98,10 +98,17 @@ class CnnClassifier:
 
     def classify(self, gray: np.ndarray, junctions: Sequence[Junction],
                  stroke_width: float) -> list[JunctionVerdict]:
-        """One verdict per junction; gray (H, W) float32 in [0, 1], 1 = paper."""
+        """One verdict per junction; gray (H, W) float32 in [0, 1], 1 = paper. A junction
+        with `ink` is cropped from an image holding that ink alone."""
         if not junctions:
             return []
         centers = np.array([j.crop_center for j in junctions], dtype=float)
-        crops = crop_junctions(gray, centers, stroke_width, self.spec)
+        own = [i for i, j in enumerate(junctions) if j.ink is not None]
+        if len(own) == len(junctions):
+            crops = crop_own_ink(gray, centers, [j.ink for j in junctions], stroke_width, self.spec)
+        else:
+            crops = crop_junctions(gray, centers, stroke_width, self.spec)
+            if own:
+                crops[own] = crop_own_ink(gray, centers[own], [junctions[i].ink for i in own], stroke_width, self.spec)
         mean, share = self.predict_crops(crops)
         return [JunctionVerdict(p_crossing=float(m), confidence=float(s)) for m, s in zip(mean, share)]
