@@ -4,24 +4,28 @@
 
 Reproducible from the seed on CPU (data, initialisation, batch order and augmentation all
 derive from it). Writes the ONNX model, its metadata JSON and the model card (Markdown)
-with the validation figures measured on freshly generated crops of another seed.
+with the validation figures measured on freshly generated crops of another seed. The three
+files appear together when the command succeeds; until then the model is exported and
+validated in a hidden folder beside `--out`, so an interrupted run leaves the old trio as it was.
 Needs the `train` extra (PyTorch); the vectorizer itself only ever loads the ONNX file.
 """
 
 from __future__ import annotations
 
+import contextlib
 import hashlib
 import json
 import os
+import tempfile
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from pathlib import Path
 
 import numpy as np
 import torch
 from torch import nn
 
-from onestroke.atomic import atomic_write_bytes, atomic_write_text
+from onestroke.atomic import all_or_nothing, atomic_write_bytes, atomic_write_text
 from vectorize.junctions.junction_crop import CropSpec
 from vectorize.training.model import CrossingNet, Probability
 from vectorize.training.synth import SUBTYPES, generate
@@ -172,6 +176,25 @@ stroke widths that the ink still bridges.
 
 
 DEFAULT_OUT = Path(__file__).parents[1] / "models" / "crossing_cnn.onnx"
+MODEL_FILES = (".json", ".md")  # written beside the model, with its own suffix replaced
+
+
+@contextlib.contextmanager
+def staged_model(out: Path) -> Iterator[Path]:
+    """A path, in a hidden folder beside `out`, to export, validate and describe a model at.
+
+    When the block ends, the model and its .json and .md replace `out`'s together; if it
+    fails (Ctrl-C during hours of training or the validation after it), none of them does,
+    so a model and metadata that disagree (the vectorizer refuses such a model) never appear.
+    """
+    out.parent.mkdir(parents=True, exist_ok=True)
+    with tempfile.TemporaryDirectory(prefix=f".{out.name}.", dir=out.parent) as folder:
+        staged = Path(folder) / out.name
+        yield staged
+        with all_or_nothing():
+            atomic_write_bytes(out, staged.read_bytes())
+            for suffix in MODEL_FILES:
+                atomic_write_bytes(out.with_suffix(suffix), staged.with_suffix(suffix).read_bytes())
 
 
 def train_and_export(*, seed: int = 0, samples: int = 36_000, epochs: int = 8, batch: int = 128,
@@ -182,16 +205,15 @@ def train_and_export(*, seed: int = 0, samples: int = 36_000, epochs: int = 8, b
     on `validation` fresh crops of another seed; returns the metadata (validation included).
     `log` receives the training's progress lines."""
     spec = CropSpec()
-    out = Path(out)
-    out.parent.mkdir(parents=True, exist_ok=True)
     net, facts = train(seed=seed, samples=samples, epochs=epochs, batch=batch, lr=lr, workers=workers,
                        log=log)
     facts["cpu"] = f"{os.cpu_count()} CPU cores"
-    data = export_onnx(net, out, spec)
-    measured = evaluate_onnx(out, count=validation, seed=seed + VALIDATION_SEED_OFFSET, workers=workers)
-    meta = base_meta("train-classifier", {"seed": seed, "samples": samples, "epochs": epochs, "batch": batch,
-                                          "lr": lr, "validation": validation}, spec, net, data, facts)
-    meta["validation"] = measured
-    atomic_write_text(out.with_suffix(".json"), json.dumps(meta, indent=2) + "\n")
-    atomic_write_text(out.with_suffix(".md"), model_card(meta))
+    with staged_model(Path(out)) as staged:
+        data = export_onnx(net, staged, spec)
+        measured = evaluate_onnx(staged, count=validation, seed=seed + VALIDATION_SEED_OFFSET, workers=workers)
+        meta = base_meta("train-classifier", {"seed": seed, "samples": samples, "epochs": epochs, "batch": batch,
+                                              "lr": lr, "validation": validation}, spec, net, data, facts)
+        meta["validation"] = measured
+        atomic_write_text(staged.with_suffix(".json"), json.dumps(meta, indent=2) + "\n")
+        atomic_write_text(staged.with_suffix(".md"), model_card(meta))
     return meta

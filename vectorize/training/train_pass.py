@@ -8,7 +8,7 @@ the weights that combine the image's log-odds with continuation are fitted on sc
 seed + 500 (a conditional-logit model over the 15 pairings of each node), and the pairing
 accuracy of continuation alone, the image alone and both is measured on scenes of seed +
 1000 (`vectorize.training.pass_eval`). Writes the model, its metadata (.json) and model
-card (.md). Needs the `train` extra (PyTorch); the vectorizer only loads the ONNX file.
+card (.md), all three together or none (`vectorize.training.train.staged_model`). Needs the `train` extra (PyTorch); the vectorizer only loads the ONNX file.
 """
 
 from __future__ import annotations
@@ -26,7 +26,7 @@ from onestroke.atomic import atomic_write_text
 from vectorize.junctions.pass_crop import PassCropSpec
 from vectorize.training.model import pass_net
 from vectorize.training.pass_eval import evaluate_pairing, fit_combination
-from vectorize.training.train import base_meta, crop_tensors, export_onnx, fit, seeded_start
+from vectorize.training.train import base_meta, crop_tensors, export_onnx, fit, seeded_start, staged_model
 from vectorize.training.triple_synth import generate_passes
 
 CALIBRATION_SEED_OFFSET, VALIDATION_SEED_OFFSET = 500, 1000
@@ -108,16 +108,15 @@ def train_and_export_pass(*, seed: int = 0, scenes: int = 1000, epochs: int = 4,
     measure pairing accuracy on `validation` scenes; writes .json and .md beside `out` and
     returns the metadata."""
     spec = PassCropSpec()
-    out = Path(out)
-    out.parent.mkdir(parents=True, exist_ok=True)
     net, facts = train_pass(seed=seed, scenes=scenes, epochs=epochs, batch=batch, lr=lr, workers=workers, log=log)
     facts["cpu"] = f"{os.cpu_count()} CPU cores"
-    data = export_onnx(net, out, spec, channels=4, output="p_pass")
-    meta = base_meta("train-pass-scorer", {"seed": seed, "scenes": scenes, "epochs": epochs, "batch": batch,
-                                           "lr": lr, "calibration": calibration, "validation": validation},
-                     spec, net, data, facts)
-    return calibrate_and_validate(out, meta, calibration=calibration, validation=validation, workers=workers,
-                                  log=log)
+    with staged_model(Path(out)) as staged:
+        data = export_onnx(net, staged, spec, channels=4, output="p_pass")
+        meta = base_meta("train-pass-scorer", {"seed": seed, "scenes": scenes, "epochs": epochs, "batch": batch,
+                                               "lr": lr, "calibration": calibration, "validation": validation},
+                         spec, net, data, facts)
+        return calibrate_and_validate(staged, meta, calibration=calibration, validation=validation,
+                                      workers=workers, log=log)
 
 
 def calibrate_and_validate(out: Path, meta: dict, *, calibration: int, validation: int, workers: int,
