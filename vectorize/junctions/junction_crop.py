@@ -215,10 +215,14 @@ def masked_window(gray: np.ndarray, ink: np.ndarray, margin: float, align: int =
     rows, cols = np.nonzero(part < 1.0)  # only ink can be masked away
     px, py = (cols + x0).astype(float), (rows + y0).astype(float)
     keep = np.zeros(len(rows), dtype=bool)
-    for start in range(0, len(xy), 64):  # (pixels x 64) at a time bounds the memory
-        c, rr = xy[start:start + 64], r[start:start + 64]
-        d2 = (px[:, None] - c[None, :, 0]) ** 2 + (py[:, None] - c[None, :, 1]) ** 2
-        keep |= (d2 <= rr[None, :] ** 2).any(axis=1)
+    for start in range(0, len(xy), 32):
+        # The discs come along lines, so 32 in a row lie close together: only the pixels
+        # in their bounding box are tested against them.
+        c, rr = xy[start:start + 32], r[start:start + 32]
+        lo_c, hi_c = (c - rr[:, None]).min(axis=0), (c + rr[:, None]).max(axis=0)
+        near = np.flatnonzero((px >= lo_c[0]) & (px <= hi_c[0]) & (py >= lo_c[1]) & (py <= hi_c[1]))
+        d2 = (px[near, None] - c[None, :, 0]) ** 2 + (py[near, None] - c[None, :, 1]) ** 2
+        keep[near] |= (d2 <= rr[None, :] ** 2).any(axis=1)
     window[rows[keep] + y0 - lo[1], cols[keep] + x0 - lo[0]] = part[rows[keep], cols[keep]]
     return window, lo.astype(float)
 
