@@ -40,3 +40,22 @@ def alpha_loop(n=600):
 def v_spike():
     """Out along a line and back at a slight angle: an out-and-back spike with a sharp tip."""
     return np.array([[60.0, 200.0], [330.0, 200.0], [80.0, 240.0]])
+
+
+def cursive_stretch(seed: int, index: int, center: tuple[float, float], half: float):
+    """The stretch of a cursive set line's pen path from its first to its last point within
+    `half` px of `center`, moved onto a small page: (Drawing, the ground-truth crossing
+    nearest `center` on that page (2,) px)."""
+    from benchmarks.sets.cursive import cursive_drawing
+    from vectorize.drawing import Drawing
+    from vectorize.stroke import Stroke
+
+    gt = cursive_drawing(seed, index)
+    points = gt.drawing.strokes[0].sample_evenly(1.0)
+    inside = np.flatnonzero(np.all(np.abs(points - np.array(center)) < half, axis=1))
+    path = points[inside.min():inside.max() + 1]
+    shift = 20.0 - path.min(axis=0)
+    crossings = np.asarray(gt.intersections, dtype=float).reshape(-1, 2)
+    crossing = crossings[np.argmin(np.linalg.norm(crossings - np.array(center), axis=1))] + shift
+    size = path.max(axis=0) + shift + 20.0
+    return Drawing((Stroke.from_polyline(path + shift),), float(size[0]), float(size[1]), "px", gt.width), crossing

@@ -392,7 +392,8 @@ def _axis(image: np.ndarray, options: VectorizeOptions, clock: _Clock, cache: St
     clock.lap("binarize")
     w = ink.stroke_width
     spacing = float(np.clip(w / 8.0, 0.3, 1.0))
-    rings = outline_rings(ink.gray, ink.threshold, spacing)
+    # Straight sides sampled every half width: the axis between them zigzags by <= w / 32.
+    rings = outline_rings(ink.gray, ink.threshold, spacing, sparse=w / 2.0)
     clock.lap("outline")
     _refuse_noise(len(rings), "outlines (pieces and holes)", MAX_OUTLINES, ink.threshold,
                   options.threshold is not None)

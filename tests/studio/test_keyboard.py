@@ -147,7 +147,11 @@ def _keyboard_walk(page, drawing, tmp_path):
     _shot(page, "2-split")
 
     # 3. Start at the other end: its row's "start here".
-    _tab_to(page, {"row": "end:736,241", "action": "start here"})
+    # The row's key is the end's position rounded to px, which moves with the medial axis.
+    end = page.evaluate(f"""{STATE}.graph.ends.reduce((best, e) =>
+        Math.hypot(e[0] - 736, e[1] - 241) < Math.hypot(best[0] - 736, best[1] - 241) ? e : best)""")
+    assert np.hypot(end[0] - 736, end[1] - 241) < 3, end
+    _tab_to(page, {"row": f"end:{int(np.floor(end[0] + 0.5))},{int(np.floor(end[1] + 0.5))}", "action": "start here"})
     page.keyboard.press("Enter")
     settle(page, 3)
     first = page.evaluate(f"{STATE}.strokes[0].points[0]")

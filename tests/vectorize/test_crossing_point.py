@@ -78,3 +78,44 @@ def test_touch_crop_stays_within_the_trained_reach():
         assert np.linalg.norm(junction.crop_center - junction.center) <= 3 * w + 1e-6
         assert not stages["verdicts"][node].is_crossing
     assert found == len(touch)
+
+
+def _curved_crossing(keep_every: int):
+    """Two passes crossing near (0.75, 1.3) px: one straight through the node (0, 0) at 60
+    degrees, one curving (y = 1 + 6 sin(x / 15) px); their four branches start at the node
+    and have a point every 0.25 px, of which, on the two branches to the right, only every
+    `keep_every`-th is kept past 8 px (as the medial axis has a point per Voronoi vertex:
+    dense on curves, sparse along straight sides sampled sparsely). Returns the graph and
+    its node."""
+    from vectorize.axis.graph import Branch, MedialGraph
+
+    graph = MedialGraph()
+    node = graph.add_node(np.zeros(2), 2.0)
+    t = np.arange(0.0, 40.0 + 1e-9, 0.25)
+    straight = np.array([np.cos(np.radians(60.0)), np.sin(np.radians(60.0))])
+    for side in (1.0, -1.0):
+        kept = np.flatnonzero((t <= 8.0) | (np.arange(len(t)) % (keep_every if side > 0 else 1) == 0))
+        for points in (side * t[:, None] * straight, np.column_stack([side * t, 1.0 + 6.0 * np.sin(side * t / 15.0)])):
+            points = points[kept]
+            points[0] = 0.0  # every branch starts at the node
+            end = graph.add_node(points[-1], 2.0)
+            graph.add_branch(Branch(node, end, points, np.full(len(points), 2.0), np.ones(len(points) - 1)))
+    return graph, node
+
+
+def test_the_crossing_estimate_does_not_depend_on_how_densely_the_axis_is_sampled():
+    """cursive-technically-1-16 (seed 1): with the outline's straight sides sampled every w/2
+    instead of w/8, the estimate at an e's touch on an h moved 1.5 px and the CNN's answer
+    went from 0.15 to 0.74 (a crossing the ground truth does not have). The parabolas are
+    fitted to the branches resampled evenly, so thinning their points leaves the estimate
+    in place (fitted to the points themselves, it moved 0.1 px here)."""
+    from vectorize.axis.simplify import directions
+    from vectorize.junctions.crossing_point import crossing_point
+
+    width = 4.0
+    estimates = []
+    for keep_every in (1, 10):
+        graph, node = _curved_crossing(keep_every)
+        estimates.append(crossing_point(graph, node, directions(graph, node, 2.5 * width), width))
+    assert np.linalg.norm(estimates[0] - (0.75, 1.3)) < 0.1
+    assert np.linalg.norm(estimates[1] - estimates[0]) < 0.01

@@ -51,3 +51,39 @@ def test_contours_of_random_blobs_and_exact_levels():
         level = float(gray[gray < 1].min()) if (gray < 1).any() and rng.random() < 0.3 else 0.5  # a pixel at the level
         assert _same(padded_contours(gray, level), _whole_page(gray, level))
     assert padded_contours(np.ones((5, 5), np.float32), 0.5) == []
+
+
+def _bar_and_ring(width: float) -> np.ndarray:
+    """Gray page (1 = paper) with a straight bar and a ring of ink (radius 15 px), each `width` px wide."""
+    yy, xx = np.mgrid[0:200, 0:300].astype(float)
+    bar = np.maximum.reduce([np.abs(yy - 50.3) - width / 2, 20 - xx, xx - 280])
+    ring = np.abs(np.hypot(xx - 150, yy - 140) - 15) - width / 2
+    return np.clip(np.minimum(bar, ring) + 0.5, 0.0, 1.0)
+
+
+def test_straight_outline_is_sampled_sparsely_and_curves_densely():
+    """Along the bar's straight sides samples are ~`sparse` apart; around the ring and the
+    bar's ends `spacing` apart as without `sparse`; every sample lies on the contour."""
+    import shapely
+    from shapely import LinearRing
+
+    from vectorize.raster.outline import outline_rings
+
+    gray = _bar_and_ring(8.0)
+    dense = outline_rings(gray, 0.5, 1.0)
+    sparse = outline_rings(gray, 0.5, 1.0, sparse=4.0)
+    assert len(dense) == len(sparse) == 3  # the bar, the ring's outside and inside
+    steps = [np.sort(np.hypot(*np.diff(np.vstack([r, r[:1]]), axis=0).T)) for r in sparse]
+    bar = max(range(3), key=lambda k: np.ptp(sparse[k][:, 0]) / max(np.ptp(sparse[k][:, 1]), 1))
+    # The bar (~260 x 8 px): its two long sides at ~4 px, its ends at ~1 px.
+    assert len(dense[bar]) > 520
+    assert abs(len(sparse[bar]) - (2 * 260 / 4 + 2 * 8)) <= 6
+    assert np.median(steps[bar]) == pytest.approx(4.0, abs=0.2)
+    assert steps[bar][:10].max() < 1.2
+    for k in range(3):
+        if k != bar:  # the ring's circles are curved everywhere: as dense as before
+            assert abs(len(sparse[k]) - len(dense[k])) <= 2
+            assert steps[k].max() < 1.1
+    for ring, contour in zip(sparse, dense):
+        # (The dense ring's chords cut the contour's corners by up to ~0.25 px.)
+        assert shapely.distance(LinearRing(contour), shapely.points(ring)).max() < 0.3

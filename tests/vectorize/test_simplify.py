@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 from scipy.optimize import brentq
 
-from tests.drawings import render_polylines
+from tests.drawings import cursive_stretch, render_polylines
 from vectorize import VectorizeOptions, vectorize_image
 from vectorize.axis.simplify import simplify
 
@@ -38,25 +38,6 @@ def test_a_crossing_next_to_the_line_end_is_a_crossing_not_a_spike(tail, width):
     assert len(near) == 1 and not spikes
 
 
-def _cursive_stretch(seed: int, index: int, center: tuple[float, float], half: float):
-    """The stretch of a cursive set line's pen path from its first to its last point within
-    `half` px of `center`, moved onto a small page: (Drawing, the ground-truth crossing
-    nearest `center` on that page (2,) px)."""
-    from benchmarks.sets.cursive import cursive_drawing
-    from vectorize.drawing import Drawing
-    from vectorize.stroke import Stroke
-
-    gt = cursive_drawing(seed, index)
-    points = gt.drawing.strokes[0].sample_evenly(1.0)
-    inside = np.flatnonzero(np.all(np.abs(points - np.array(center)) < half, axis=1))
-    path = points[inside.min():inside.max() + 1]
-    shift = 20.0 - path.min(axis=0)
-    crossings = np.asarray(gt.intersections, dtype=float).reshape(-1, 2)
-    crossing = crossings[np.argmin(np.linalg.norm(crossings - np.array(center), axis=1))] + shift
-    size = path.max(axis=0) + shift + 20.0
-    return Drawing((Stroke.from_polyline(path + shift),), float(size[0]), float(size[1]), "px", gt.width), crossing
-
-
 @pytest.mark.parametrize("seed, index, center, half", [
     (0, 39, (308.0, 497.0), 50.0),  # "unhealthily", 6.25 px: the output crossed 15.2 px away
     (0, 0, (400.0, 508.0), 45.0),  # "inauthentically", 4.75 px: 6.0 px away
@@ -71,7 +52,7 @@ def test_an_h_stem_drawn_back_up_through_its_loop_crossing_still_crosses(seed, i
     from benchmarks.common.render import render
     from benchmarks.metrics.table1 import MATCH_DISTANCE, drawing_polylines, polyline_intersections
 
-    drawing, crossing = _cursive_stretch(seed, index, center, half)
+    drawing, crossing = cursive_stretch(seed, index, center, half)
     result = vectorize_image(render(drawing), VectorizeOptions(classifier="cnn"))
     assert result.report.strokes == 1
     found = polyline_intersections(*drawing_polylines(result.drawing))
@@ -95,7 +76,7 @@ def test_a_junction_closing_a_loop_is_a_crossing_half(seed, index, center, half)
     width predicts. In the closed reading (every free end may be a spike)."""
     from benchmarks.common.render import render
 
-    drawing, crossing = _cursive_stretch(seed, index, center, half)
+    drawing, crossing = cursive_stretch(seed, index, center, half)
     stages = vectorize_image(render(drawing), VectorizeOptions(keep_stages=True)).stages
     graph = stages["pruned"].copy()
     simple = simplify(graph, stroke_width=stages["ink"].stroke_width, multi=False, ends=0)
@@ -178,3 +159,38 @@ def test_a_cursive_line_is_not_drawn_three_times_between_two_letters():
     assert result.report.strokes == 1
     assert result.drawing.length <= 1.02 * gt.meta["route_min"]
     assert excursion(gt.drawing, result.drawing) <= excursion_bound(gt.width)
+
+
+def _split_x(pairing: str):
+    """An X of four straight arms 60 px long (at 30, 150, 210 and 330 degrees) whose centre
+    came out of qhull as two vertices 0.02 px apart: pairing "v" gives each vertex two
+    neighbouring arms (30 and 330, 150 and 210), "line" two opposite ones (30 and 210, 150
+    and 330). Returns the graph and the centre (2,) px."""
+    from vectorize.axis.graph import MedialGraph
+
+    graph = MedialGraph()
+    centre = np.array([100.0, 100.0])
+    first, second = graph.add_node(centre, W / 2), graph.add_node(centre + (0.02, 0.0), W / 2)
+    _join(graph, first, second)
+    arms = {30: first, 330: first, 150: second, 210: second} if pairing == "v" else \
+        {30: first, 210: first, 150: second, 330: second}
+    for angle, at in arms.items():
+        end = centre + 60.0 * np.array([np.cos(np.radians(angle)), np.sin(np.radians(angle))])
+        _join(graph, at, graph.add_node(end, W / 2), (graph.positions[at] + end) / 2)
+    return graph, centre
+
+
+@pytest.mark.parametrize("multi", [False, True])
+@pytest.mark.parametrize("pairing", ["v", "line"])
+def test_a_vertex_split_in_two_is_one_crossing_whichever_arms_it_pairs(pairing, multi):
+    """Which arms each half of a split Voronoi vertex holds depends on how the outline was
+    sampled (cursive-unethically-1-38, seed 1: sampled every w/8 the split paired the arms as
+    a V and the two merged into the h's crossing; with straight sides sampled every w/2 it
+    paired opposite arms, the halves did not merge and the crossing was read as a touch 10 px
+    up). Either way it is one degree-4 node where the vertex is (this X's halves were read as
+    two spikes' bases before, in both pairings)."""
+    graph, centre = _split_x(pairing)
+    simple = simplify(graph, stroke_width=W, multi=multi)
+    assert len(simple.crossings) == 1
+    assert np.linalg.norm(graph.positions[simple.crossings[0]] - centre) < 0.05
+    assert not simple.unresolved and not simple.y_feet

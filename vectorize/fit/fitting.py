@@ -351,8 +351,12 @@ def fit_stroke(traced: TracedPoints, *, closed: bool, sigma: float, stroke_width
         # Where a closed line starts cannot be read from the ink; start at its top-left
         # sharp feature, as a pen usually does: then it is a chain of open pieces.
         if np.allclose(xy[0], xy[-1]):
+            last_corner = bool(corner[-1])
             xy, keep, split, corner, junction = xy[:-1], keep[:-1], split[:-1], corner[:-1], junction[:-1]
             split_at = np.flatnonzero(split)
+            if not split_at.size:  # the only split was the repeated point: it is the first
+                split[0], corner[0] = True, corner[0] or last_corner
+                split_at = np.zeros(1, dtype=np.int64)
         shift = int(split_at[np.argmin(xy[split_at].sum(axis=1))])
         xy, keep, split, corner, junction = (np.roll(a, -shift, axis=0) for a in (xy, keep, split, corner, junction))
         twins = rolled(twins, shift, len(xy))

@@ -27,18 +27,26 @@ from vectorize.junctions.intersections import crossing_pairing
 # span): past the first width, where the medial axis bends into the junction, and short
 # enough that a quadratic follows a curving stroke.
 WINDOW = (1.0, 4.0)
+# The fit's samples along each branch, in stroke widths (the outline's densest spacing).
+FIT_STEP = 1.0 / 8.0
 # Samples of the second pass (the crossing is interpolated between two of them).
 SAMPLES = 200
 # Largest move along a touch's contact that the classifier's training crops include (widths).
 MAX_SHIFT = 3.0
 
 
-def _window(graph: MedialGraph, slot: tuple[int, str], lo: float, hi: float) -> np.ndarray:
-    """The slot's branch points between `lo` and `hi` px of arc from the node: (K, 2)."""
+def _window(graph: MedialGraph, slot: tuple[int, str], lo: float, hi: float, step: float) -> np.ndarray:
+    """The slot's branch between `lo` and `hi` px of arc from the node, every `step` px: (K, 2).
+
+    Evenly by arc length, not the branch's own points: the medial axis has a point per
+    Voronoi vertex, dense along curves and sparse along straight sides (`outline_rings`'
+    `sparse`), and a least-squares fit to its points would weigh the curves more.
+    """
     bid, end = slot
     branch = graph.branches[bid]
     points, arc = (branch.points, branch.arc) if end == "a" else (branch.points[::-1], branch.arc_back)
-    return points[(arc >= lo) & (arc <= hi)]
+    at = np.arange(lo, min(hi, float(arc[-1])) + 1e-9, step)
+    return np.column_stack([np.interp(at, arc, points[:, 0]), np.interp(at, arc, points[:, 1])])
 
 
 def _pass_fit(centre: np.ndarray, first: np.ndarray, second: np.ndarray):
@@ -69,7 +77,7 @@ def crossing_point(graph: MedialGraph, node: int, dirs: np.ndarray, stroke_width
     span = graph.spans.get(node, 0.0)
     node_slots = slots(graph, node)
     lo, hi = span + WINDOW[0] * stroke_width, span + WINDOW[1] * stroke_width
-    windows = [_window(graph, s, lo, hi) for s in node_slots]
+    windows = [_window(graph, s, lo, hi, FIT_STEP * stroke_width) for s in node_slots]
     if len(windows) != 4 or min(len(p) for p in windows) < 3:
         return centre
     fits = [_pass_fit(centre, windows[a], windows[b]) for a, b in crossing_pairing(dirs)]
