@@ -13,7 +13,8 @@ from benchmarks.metrics.table1 import (
     ambiguous_junctions,
     evaluate,
     hidden_crossings,
-    match_points,
+    match_outside_dont_care,
+    matched_pairs,
     order_score,
     order_tolerance,
     polyline_intersections,
@@ -189,9 +190,28 @@ def test_a_crossing_whose_loop_holds_no_paper_is_not_a_crossing_of_the_drawing()
 
 def test_matching_within_five_pixels():
     gt = np.array([[100, 100], [300, 300.0]])
-    assert match_points(gt, gt + [3, 3]) == 2
-    assert match_points(gt, gt + [4, 4]) == 0  # 5.7 px away
-    assert match_points(gt, np.array([[101, 100], [102, 100.0]])) == 1  # one-to-one
+    assert len(matched_pairs(gt, gt + [3, 3])) == 2
+    assert matched_pairs(gt, gt + [4, 4]) == []  # 5.7 px away
+    assert len(matched_pairs(gt, np.array([[101, 100], [102, 100.0]]))) == 1  # one-to-one
+
+
+def test_a_crossing_on_the_edge_of_a_dont_care_zone_is_matched_on_both_sides():
+    """cursive kitten-0-1: the output crosses 1.1 px from the true crossing, but only the
+    output's point lay within the 5 px reach of a touch (4.6 px; the true one 5.26 px), so the
+    true crossing counted as undetected and the line as wrong."""
+    import shapely
+
+    touch = [shapely.Point(0.0, 0.0).buffer(1.0)]
+    true = np.array([[6.26, 0.0], [200.0, 0.0]])
+    out = np.array([[5.6, 0.9], [200.5, 0.0]])   # 5.6 + 0.9 away -> 4.67 px from the zone
+    assert match_outside_dont_care(true, out, touch, 5.0) == (2, 2, 2)
+    # the mirror case: the true crossing just inside, the output's just outside
+    assert match_outside_dont_care(out, true, touch, 5.0) == (2, 2, 2)
+    # both inside: neither counts, as before; an unmatched output crossing in the zone is not
+    # hallucinated, an unmatched true one in it not required
+    assert match_outside_dont_care(np.array([[3.0, 0.0]]), np.array([[3.5, 0.5]]), touch, 5.0) == (0, 0, 0)
+    assert match_outside_dont_care(np.array([[3.0, 0.0]]), np.array([[50.0, 0.0]]), touch, 5.0) == (0, 1, 0)
+    assert match_outside_dont_care(np.array([[50.0, 0.0]]), np.array([[3.0, 0.0]]), touch, 5.0) == (1, 0, 0)
 
 
 def test_output_intersections_at_a_touch_are_not_hallucinated(touch_gt):
