@@ -27,6 +27,7 @@ from vectorize.junctions.classifiers import make_classifier, shipped_pass_scorer
 from vectorize.junctions.crossing_point import crossing_point
 from vectorize.junctions.intersections import (Junction, JunctionVerdict, lone_junctions, ranked_pairings,
                                               sharp_touch)
+from vectorize.junctions.junction_ink import own_ink, own_ink_reach
 from vectorize.options import InputFrame, VectorizeOptions, VectorizeReport, VectorizeResult
 from vectorize.raster.binarize import downscaled_gray, ink_image, ink_threshold, paper_gray
 from vectorize.raster.outline import outline_rings
@@ -94,8 +95,10 @@ def _junctions(graph: MedialGraph, nodes, stroke_width: float) -> list[Junction]
             band = r[(dist > 1.5 * stroke_width) & (dist < 3.5 * stroke_width)]
             radii.extend(band.tolist())
         width = 2.0 * float(np.median(radii)) if radii else stroke_width
+        # The classifier sees only the junction's own ink (`vectorize.junctions.junction_ink`).
+        ink = own_ink(graph, node, own_ink_reach(dirs, stroke_width), stroke_width)
         result.append(Junction(center=graph.positions[node].copy(), directions=dirs, width=width,
-                               crossing=crossing_point(graph, node, dirs, stroke_width)))
+                               crossing=crossing_point(graph, node, dirs, stroke_width), ink=ink))
     return result
 
 

@@ -32,12 +32,16 @@ class Junction:
     four branches pointing away from the node; width: local stroke width in px;
     crossing: (2,) px where the two straight-through passes are estimated to cross
     (`vectorize.junctions.crossing_point`), where image classifiers centre their crops; None: center.
+    ink: (K, 3) x, y, radius px of discs covering the junction's own ink
+    (`vectorize.junctions.junction_ink.own_ink`): an image classifier sees only that ink on
+    paper; None: the whole image.
     """
 
     center: np.ndarray
     directions: np.ndarray
     width: float
     crossing: np.ndarray | None = None
+    ink: np.ndarray | None = None
 
     @property
     def crop_center(self) -> np.ndarray:

@@ -180,6 +180,70 @@ def crop_junctions(gray: np.ndarray, centers: np.ndarray, stroke_width: float,
     return np.clip(out, 0.0, 1.0).astype(np.float32)
 
 
+def _block_factors(stroke_width: float, spec: CropSpec) -> list[int]:
+    """The block-reduction factors `_sample_filtered` uses for the orienting window and
+    both crops at this stroke width."""
+    n_axis_ratio = 6.0 * spec.axis_sigma * stroke_width / 33  # `principal_angles`' sampling
+    ratios = [n_axis_ratio, spec.near_span * stroke_width / spec.size, spec.far_span * stroke_width / spec.size]
+    return [max(1, int(np.floor(r))) for r in ratios]
+
+
+def masked_window(gray: np.ndarray, ink: np.ndarray, margin: float, align: int = 1) -> tuple[np.ndarray, np.ndarray]:
+    """The part of `gray` covered by discs, everything else paper.
+
+    Parameters
+    ----------
+    gray : (H, W) float in [0, 1], 1 = paper.
+    ink : (K, 3) disc centres x, y and radii, px (`vectorize.junctions.junction_ink.own_ink`).
+    margin : px added to every radius (the anti-aliased edge beyond the outline).
+    align : the window's corner lies on multiples of this many px (block grids stay put).
+
+    Returns
+    -------
+    window : (h, w) float32, 1 outside the discs and outside `gray`.
+    corner : (2,) x, y px of the window's pixel (0, 0) in `gray`.
+    """
+    xy, r = ink[:, :2], ink[:, 2] + margin
+    lo = np.floor((xy - r[:, None]).min(axis=0) / align).astype(int) * align
+    hi = np.ceil((xy + r[:, None]).max(axis=0)).astype(int) + 1
+    window = np.ones((hi[1] - lo[1], hi[0] - lo[0]), dtype=np.float32)
+    h, w = gray.shape
+    x0, y0, x1, y1 = max(lo[0], 0), max(lo[1], 0), min(hi[0], w), min(hi[1], h)
+    if x1 <= x0 or y1 <= y0:
+        return window, lo.astype(float)
+    part = gray[y0:y1, x0:x1]
+    rows, cols = np.nonzero(part < 1.0)  # only ink can be masked away
+    px, py = (cols + x0).astype(float), (rows + y0).astype(float)
+    keep = np.zeros(len(rows), dtype=bool)
+    for start in range(0, len(xy), 32):
+        # The discs come along lines, so 32 in a row lie close together: only the pixels
+        # in their bounding box are tested against them.
+        c, rr = xy[start:start + 32], r[start:start + 32]
+        lo_c, hi_c = (c - rr[:, None]).min(axis=0), (c + rr[:, None]).max(axis=0)
+        near = np.flatnonzero((px >= lo_c[0]) & (px <= hi_c[0]) & (py >= lo_c[1]) & (py <= hi_c[1]))
+        d2 = (px[near, None] - c[None, :, 0]) ** 2 + (py[near, None] - c[None, :, 1]) ** 2
+        keep[near] |= (d2 <= rr[None, :] ** 2).any(axis=1)
+    window[rows[keep] + y0 - lo[1], cols[keep] + x0 - lo[0]] = part[rows[keep], cols[keep]]
+    return window, lo.astype(float)
+
+
+def crop_own_ink(gray: np.ndarray, centers: np.ndarray, inks: list[np.ndarray], stroke_width: float,
+                 spec: CropSpec = CropSpec(), margin: float = 1.5) -> np.ndarray:
+    """`crop_junctions` of each junction with only its own ink on paper.
+
+    inks: per junction (K, 3) discs x, y, radius px of its ink (the rest of the image is
+    masked to paper); margin: px added to every radius. The crops are those of the masked
+    image: windows are aligned to the crops' block grids. Returns (N, 2, size, size) float32.
+    """
+    gray, centers = checked_crop_input(gray, centers, stroke_width)
+    align = int(np.lcm.reduce(_block_factors(stroke_width, spec)))
+    out = np.zeros((len(centers), 2, spec.size, spec.size), dtype=np.float32)
+    for i, (center, ink) in enumerate(zip(centers, inks)):
+        window, corner = masked_window(gray, np.asarray(ink, dtype=float).reshape(-1, 3), margin, align)
+        out[i] = crop_junctions(window, (center - corner)[None], stroke_width, spec)[0]
+    return out
+
+
 def dihedral_copies(crops: np.ndarray) -> np.ndarray:
     """The 8 rotations-by-90-degrees and flips of each crop: (N, C, S, S) -> (8, N, C, S, S)."""
     copies = []
