@@ -168,7 +168,7 @@ def _shared_stub_reach(graph: MedialGraph, node: int, walks: Counter, stroke_wid
     part, their inks still overlap); 0 without such a stub.
 
     A cursive l or h whose loop closes a stub away from the crossing (the_kitten_ate_the_
-    mauled_candy-1-30's "th": the loop's two ends meet 3 px, 1.5 widths, above the crossing
+    mauled_candy-1-30's "th": the loop's two ends meet 3 px (1.98 widths) above the crossing
     of the way in and the way down): both passes run over the stub, and with the zone
     ending before the far junction each kept both junctions' points, so the fitted passes
     ran together over the stub, 0.1-0.3 px apart, instead of crossing.
