@@ -13,8 +13,8 @@ def test_an_l_loop_closing_a_stub_above_its_crossing_is_crossed():
     over that stub. Before, the crossing's zone ended short of the stub's far junction, both
     fitted passes kept its point and ran together 0.1-0.3 px apart, touching in 55 points
     (whether the metric then found a crossing within 5 px depended on the noise: not at
-    7e3a111, by chance at 691d66f). The whole line, as the benchmark gives it: cut stretches
-    of it (40-100 px around the crossing) made a different junction and crossed before too."""
+    7e3a111, by chance at 691d66f). The whole line, as the benchmark gives it: stretches cut
+    from it with `cursive_stretch` (40-100 px around the crossing) crossed on the old code too."""
     from benchmarks.common.render import render_truth, to_uint8
     from benchmarks.metrics.table1 import MATCH_DISTANCE, drawing_polylines, polyline_intersections
     from benchmarks.sets.cursive import cursive_drawing
