@@ -153,6 +153,13 @@ def _pairing_costs(verdict: JunctionVerdict) -> tuple[float, float, float]:
     return tuple(float(np.log(ranked[0]) - np.log(x)) for x in ranked)  # type: ignore[return-value]
 
 
+# Stroke widths. Branches from a crossing to another junction that the route walks twice
+# measured 0.77-2.42 widths (9 lengths; the kitten's 1.98) and then 3.05 and up (h and l bases
+# whose way in and stem share a band, 4.1, `route_inspection.shared_bands`; stems drawn down
+# and back, 12 and up) over the cursive set at seed 1: a longer band keeps its own points.
+SHARED_STUB_WIDTHS = 2.5
+
+
 def _is_shared_stub(graph: MedialGraph, node: int, bid: int, walks: Counter, stroke_width: float) -> bool:
     """Whether branch `bid` at crossing `node` is a stub the crossing's two passes share: at
     most `SHARED_STUB_WIDTHS` stroke widths long, to another junction, walked twice."""
@@ -180,13 +187,6 @@ def _shared_stub_reach(graph: MedialGraph, node: int, walks: Counter, stroke_wid
             far = branch.b if branch.a == node else branch.a
             reach = max(reach, float(np.linalg.norm(graph.positions[far] - graph.positions[node])) + 0.5 * stroke_width)
     return reach
-
-
-# Stroke widths. Branches from a crossing to another junction that the route walks twice
-# measured 0.77-2.42 widths (9 lengths; the kitten's 1.98) and then 3.05 and up (h and l bases
-# whose way in and stem share a band, 4.1, `route_inspection.shared_bands`; stems drawn down
-# and back, 12 and up) over the cursive set at seed 1: a longer band keeps its own points.
-SHARED_STUB_WIDTHS = 2.5
 
 
 def _trace(graph: MedialGraph, simple: Simplified, ordering: Ordering, junctions: dict,

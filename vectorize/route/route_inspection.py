@@ -408,6 +408,14 @@ def _route(graph: MedialGraph, chain_list: list[Chain], stroke_width: float, dir
     return Route(tuple(passes), not ends, retraced, len(odd))
 
 
+# Stroke widths: two passes at an angle a share ink over about w / sin(a / 2), 6 widths at
+# a = 19 degrees; passes closer to parallel than that head along the band's own axis anyway.
+# The bands at the base of the cursive h's measured 4.1 widths (handy_lady_tidy_attic-0-11,
+# mail_the_ticket_at_ten-0-7); an l's stem drawn down and back up between two junctions,
+# 11 widths, is left to its axis.
+BAND_MAX_WIDTHS = 6.0
+
+
 def shared_bands(graph: MedialGraph, passes, stroke_width: float) -> set[int]:
     """Branches between two junctions, at most `BAND_MAX_WIDTHS` stroke widths long, that the
     route walks twice (passes: every pass of the route): bands of ink two passes share, such
@@ -423,14 +431,6 @@ def shared_bands(graph: MedialGraph, passes, stroke_width: float) -> set[int]:
                 and graph.degree(branch.a) >= 3 and graph.degree(branch.b) >= 3):
             result.add(bid)
     return result
-
-
-# Stroke widths: two passes at an angle a share ink over about w / sin(a / 2), 6 widths at
-# a = 19 degrees; passes closer to parallel than that head along the band's own axis anyway.
-# The bands at the base of the cursive h's measured 4.1 widths (handy_lady_tidy_attic-0-11,
-# mail_the_ticket_at_ten-0-7); an l's stem drawn down and back up between two junctions,
-# 11 widths, is left to its axis.
-BAND_MAX_WIDTHS = 6.0
 
 
 def connect_pairings(graph: MedialGraph, ranked: dict, costs: dict, *, fixed: dict | None = None,
