@@ -105,27 +105,3 @@ def test_training_smoke_run(tmp_path, monkeypatch):
     assert meta["validation"]["n"] == 128
     p, _ = CnnClassifier(out).predict_crops(generate(16, seed=9).x.astype(np.float32) / 255.0)
     assert p.shape == (16,) and np.all((p >= 0) & (p <= 1))
-
-
-def test_an_interrupted_training_leaves_the_old_model_and_its_metadata(tmp_path, monkeypatch):
-    """A Ctrl-C in the validation after export used to leave the new .onnx beside the old
-    .json, a pair the vectorizer refuses as damaged. Now the old trio stays byte for byte and
-    no temporary file is left."""
-    pytest.importorskip("torch")
-    import shutil
-
-    from vectorize.training import train
-
-    out = tmp_path / "crossing_cnn.onnx"
-    for suffix in (".onnx", ".json", ".md"):
-        shutil.copy(DEFAULT_MODEL.with_suffix(suffix), out.with_suffix(suffix))
-    before = {p.name: p.read_bytes() for p in tmp_path.iterdir()}
-
-    def interrupted(*args, **kwargs):
-        raise KeyboardInterrupt
-
-    monkeypatch.setattr(train, "evaluate_onnx", interrupted)
-    with pytest.raises(KeyboardInterrupt):
-        train.train_and_export(seed=3, samples=256, epochs=1, batch=64, validation=128, out=out)
-    assert {p.name: p.read_bytes() for p in tmp_path.iterdir()} == before
-    CnnClassifier(out)  # model and metadata still agree

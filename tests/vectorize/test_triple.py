@@ -85,30 +85,6 @@ def test_pass_scorer_training_is_reproducible_from_its_seed():
     assert not all(np.array_equal(a[k].numpy(), c[k].numpy()) for k in a)
 
 
-def test_an_interrupted_pass_scorer_training_leaves_the_old_model_and_its_metadata(tmp_path, monkeypatch):
-    """A fault in the calibration or validation after export leaves the old trio byte for
-    byte (the new .onnx beside the old .json would be refused as damaged)."""
-    pytest.importorskip("torch")
-    import shutil
-
-    from vectorize.training import train_pass
-
-    out = tmp_path / "pass_cnn.onnx"
-    for suffix in (".onnx", ".json", ".md"):
-        shutil.copy(DEFAULT_MODEL.with_suffix(suffix), out.with_suffix(suffix))
-    before = {p.name: p.read_bytes() for p in tmp_path.iterdir()}
-
-    def interrupted(*args, **kwargs):
-        raise KeyboardInterrupt
-
-    monkeypatch.setattr(train_pass, "evaluate_pairing", interrupted)
-    with pytest.raises(KeyboardInterrupt):
-        train_pass.train_and_export_pass(seed=3, scenes=12, epochs=1, batch=64, calibration=8, validation=8,
-                                         out=out)
-    assert {p.name: p.read_bytes() for p in tmp_path.iterdir()} == before
-    PassScorer(out)  # model and metadata still agree
-
-
 @pytest.mark.slow
 def test_train_pass_scorer_command_exports_a_model_onnxruntime_runs(tmp_path):
     pytest.importorskip("torch")
@@ -131,4 +107,3 @@ def test_train_pass_scorer_command_exports_a_model_onnxruntime_runs(tmp_path):
     feet = np.array([[np.cos(a), np.sin(a)] for a in np.radians([0, 180, 60, 240, 120, 300])])
     p = scorer.pass_probabilities(scene.gray, scene.center[None], [feet], scene.width)
     assert p.shape == (1, 15) and np.all((p >= 0) & (p <= 1))
-
