@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import sys
 import time
-from collections import Counter
 from dataclasses import replace
 from functools import partial
 from importlib import import_module
@@ -33,7 +32,7 @@ from vectorize.raster.binarize import downscaled_gray, ink_image, ink_threshold,
 from vectorize.raster.outline import outline_rings
 from vectorize.route.retrace_paths import turn_prices, turns_at
 from vectorize.route.route_ends import end_costs
-from vectorize.route.route_inspection import connect_pairings, plan_routes
+from vectorize.route.route_inspection import connect_pairings, plan_routes, shared_bands
 from vectorize.route.traversal import Ordering, half_turns, order_strokes, turn_backs
 from vectorize.stroke import Stroke, lengths
 
@@ -160,18 +159,10 @@ def _pairing_costs(verdict: JunctionVerdict) -> tuple[float, float, float]:
 SHARED_STUB_WIDTHS = 2.5
 
 
-def _is_shared_stub(graph: MedialGraph, node: int, bid: int, walks: Counter, stroke_width: float) -> bool:
-    """Whether branch `bid` at crossing `node` is a stub the crossing's two passes share: at
-    most `SHARED_STUB_WIDTHS` stroke widths long, to another junction, walked twice."""
-    branch = graph.branches[bid]
-    far = branch.b if branch.a == node else branch.a
-    return (branch.a != branch.b and walks[bid] >= 2 and graph.degree(far) >= 3
-            and branch.length <= SHARED_STUB_WIDTHS * stroke_width)
-
-
-def _shared_stub_reach(graph: MedialGraph, node: int, walks: Counter, stroke_width: float) -> float:
+def _shared_stub_reach(graph: MedialGraph, node: int, stubs: set[int], stroke_width: float) -> float:
     """How far (px) the uncertain zone of a crossing at `node` reaches over its shared stubs
-    (`_is_shared_stub`): to the far junction and half a width past it (where the two passes
+    (`stubs`: branches between two junctions, at most `SHARED_STUB_WIDTHS` long, that the
+    route walks twice): to the far junction and half a width past it (where the two passes
     part, their inks still overlap); 0 without such a stub.
 
     A cursive l or h whose loop closes a stub away from the crossing (the_kitten_ate_the_
@@ -180,13 +171,9 @@ def _shared_stub_reach(graph: MedialGraph, node: int, walks: Counter, stroke_wid
     ending before the far junction each kept both junctions' points, so the fitted passes
     ran together over the stub, 0.1-0.3 px apart, instead of crossing.
     """
-    reach = 0.0
-    for bid, _ in slots(graph, node):
-        if _is_shared_stub(graph, node, bid, walks, stroke_width):
-            branch = graph.branches[bid]
-            far = branch.b if branch.a == node else branch.a
-            reach = max(reach, float(np.linalg.norm(graph.positions[far] - graph.positions[node])) + 0.5 * stroke_width)
-    return reach
+    fars = [graph.branches[bid].other(node) for bid, _ in slots(graph, node) if bid in stubs]
+    return max((float(np.linalg.norm(graph.positions[far] - graph.positions[node])) + 0.5 * stroke_width
+                for far in fars), default=0.0)
 
 
 def _trace(graph: MedialGraph, simple: Simplified, ordering: Ordering, junctions: dict,
@@ -206,7 +193,8 @@ def _trace(graph: MedialGraph, simple: Simplified, ordering: Ordering, junctions
     crossing_of = dict(zip(simple.crossings, ordering.choice))
     decided = {**{n: p for n, p in crossing_of.items() if n not in ordering.undecided}, **simple.through}
     # Uncertain zone around each degree-4 node: where the two strokes' inks still overlap.
-    walks = Counter(step.branch for passes in ordering.strokes for step in passes)
+    stubs = shared_bands(graph, [step for passes in ordering.strokes for step in passes], stroke_width,
+                         max_widths=SHARED_STUB_WIDTHS)
     zones = []
     for node in simple.crossings:
         junction = junctions[node]
@@ -219,7 +207,7 @@ def _trace(graph: MedialGraph, simple: Simplified, ordering: Ordering, junctions
         # there lie on one averaged centre line.
         reach = max(reach, graph.spans.get(node, 0.0) + 0.5 * stroke_width)
         if verdicts[node].is_crossing:
-            reach = max(reach, _shared_stub_reach(graph, node, walks, stroke_width))
+            reach = max(reach, _shared_stub_reach(graph, node, stubs, stroke_width))
         reach = float(np.clip(reach, graph.radii[node], 12.0 * stroke_width))
         zones.append((node, reach, verdicts[node].is_crossing))
     for node in simple.through:
@@ -232,8 +220,7 @@ def _trace(graph: MedialGraph, simple: Simplified, ordering: Ordering, junctions
     not_twins = {bid for bid, b in graph.branches.items() if b.a == b.b} | foot_branches
     # A crossing's stub (`_shared_stub_reach`) is the two crossing passes' shared ink, not one
     # line drawn twice: its points lie in the zone and each pass runs straight through.
-    not_twins |= {bid for node, reach, crossing in zones if crossing
-                  for bid, _ in slots(graph, node) if _is_shared_stub(graph, node, bid, walks, stroke_width)}
+    not_twins |= {bid for node, reach, crossing in zones if crossing for bid, _ in slots(graph, node) if bid in stubs}
     zone_nodes = {node for node, _, _ in zones}
     for passes, closed in zip(ordering.strokes, ordering.closed):
         parts, keeps, tips, spans, radii, owners, forks = [], [], [], [], [], [], []

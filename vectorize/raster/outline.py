@@ -48,7 +48,6 @@ def _sample_places(xy: np.ndarray, arc: np.ndarray, spacing: float, sparse: floa
     key, corner_key = xy[:, 0] + 1j * xy[:, 1], corners[:, 0] + 1j * corners[:, 1]
     at = np.unique(arc[np.isin(key, corner_key)])
     at = np.union1d(at, [0.0, arc[-1]])
-    length = np.diff(at)
     chord = edge_lengths(np.column_stack([np.interp(at, arc, xy[:, 0]), np.interp(at, arc, xy[:, 1])]))
     straight = chord >= STRAIGHT_EDGES * sparse
     # Runs of curved edges are sampled as one stretch (short edges would each round up).

@@ -395,7 +395,7 @@ def _route(graph: MedialGraph, chain_list: list[Chain], stroke_width: float, dir
         # their headings, and each pass keeps the heading it had where it entered the band.
         if len(seq) == 1:
             return far, heading
-        into = graph.branches[last.branch].a if last.start == "a" else graph.branches[last.branch].b
+        into = graph.branches[last.branch].node(last.start)
         if into not in directions:
             return far, None
         before = slots(graph, into).index((seq[-2].branch, seq[-2].end))
@@ -416,8 +416,9 @@ def _route(graph: MedialGraph, chain_list: list[Chain], stroke_width: float, dir
 BAND_MAX_WIDTHS = 6.0
 
 
-def shared_bands(graph: MedialGraph, passes, stroke_width: float) -> set[int]:
-    """Branches between two junctions, at most `BAND_MAX_WIDTHS` stroke widths long, that the
+def shared_bands(graph: MedialGraph, passes, stroke_width: float, *,
+                 max_widths: float = BAND_MAX_WIDTHS) -> set[int]:
+    """Branches between two junctions, at most `max_widths` stroke widths long, that the
     route walks twice (passes: every pass of the route): bands of ink two passes share, such
     as the base of a cursive h or l, where the way in and the stem drawn back up run
     together between the crossing and the loop."""
@@ -427,7 +428,7 @@ def shared_bands(graph: MedialGraph, passes, stroke_width: float) -> set[int]:
     result = set()
     for bid, k in count.items():
         branch = graph.branches[bid]
-        if (k >= 2 and branch.a != branch.b and branch.length <= BAND_MAX_WIDTHS * stroke_width
+        if (k >= 2 and branch.a != branch.b and branch.length <= max_widths * stroke_width
                 and graph.degree(branch.a) >= 3 and graph.degree(branch.b) >= 3):
             result.add(bid)
     return result
