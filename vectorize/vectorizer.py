@@ -272,11 +272,10 @@ def _trace(graph: MedialGraph, simple: Simplified, ordering: Ordering, junctions
         for base in sharp_points:
             split[np.all(xy == base, axis=1)] = True
         owner = np.concatenate(owners)
-        beside = np.isin(owner, [i for i, step in enumerate(passes) if step.branch in simple.beside])
         for node, reach, crossing in zones:
             dist = lengths(xy - graph.positions[node])
             turning = [i for i, at in turned.items() if at == node]
-            near = (dist < reach) & ~np.isin(owner, turning + [i + 1 for i in turning]) & ~beside
+            near = (dist < reach) & ~np.isin(owner, turning + [i + 1 for i in turning])
             keep[near] &= crossing & (dist[near] < 1e-6)
         result.append((TracedPoints(xy=xy, keep=keep, split=split, radius=np.concatenate(radii),
                                     junction=np.concatenate(forks)), closed, twins))
@@ -316,7 +315,7 @@ def _order(graph: MedialGraph, ink, options: VectorizeOptions, ends: int, clock:
         may_cluster = hooks.pop("may_cluster", None)
         through = merge_triple_points(graph, stroke_width=w, may_merge=may_cluster)
         # A stem drawn down and back up through a crossing (an h's base): read as one node too.
-        stems, beside = ({}, frozenset()) if options.multi else merge_stem_clusters(
+        stems = {} if options.multi else merge_stem_clusters(
             graph, stroke_width=w, ends=ends, through=through, may_merge=may_cluster,
             place=lambda trial, node, passes: passes_crossing(trial, node, passes, w))
         simple = simplify(graph, stroke_width=w, multi=options.multi, ends=ends,
@@ -324,7 +323,7 @@ def _order(graph: MedialGraph, ink, options: VectorizeOptions, ends: int, clock:
         # Paired after simplification: merging crossings next to a triple point renumbers its slots.
         through, posterior = _pair_through(graph, [n for n in simple.through if n not in stems], ink.gray, w, options)
         through.update({n: stem_passes(graph, n, w)[0] for n in stems})
-        simple = replace(simple, through=through, through_posterior=posterior, beside=beside,
+        simple = replace(simple, through=through, through_posterior=posterior,
                          crossings=tuple(n for n in simple.crossings if n not in stems),
                          y_tips=simple.y_tips | set(stems.values()))
         clock.lap("simplification")

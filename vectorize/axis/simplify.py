@@ -100,9 +100,6 @@ class Simplified:
     through: dict = field(default_factory=dict)  # node where three passes cross -> slot pairs
     # such a node -> (15,) posterior of the pass scorer over `pass_scorer.PAIRINGS` (slots)
     through_posterior: dict = field(default_factory=dict)
-    # Branches that run beside a decided node, not through it (a stem drawn back up past an
-    # h's crossing, `stem_clusters`): their points near it are not the crossing's uncertain ink.
-    beside: frozenset = frozenset()
 
 
 def _min_radius(branch: Branch) -> float:

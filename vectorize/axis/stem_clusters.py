@@ -37,28 +37,28 @@ HOLE_BRANCH_WIDTHS = 7.0
 
 
 def merge_stem_clusters(graph: MedialGraph, *, stroke_width: float, ends: int, through: dict | None = None,
-                        may_merge=None, place=None) -> tuple[dict[int, int], frozenset[int]]:
+                        may_merge=None, place=None) -> dict[int, int]:
     """Find the clusters of junctions where a stem drawn down and back up meets a crossing
     (module doc) and read each as one crossing and one branch beside it, in place.
 
     ends: free ends the single line is taken to have; a stem's tip is read as a cusp only
     while the drawing has more free ends than that. through: nodes already merged where
     three passes cross (left alone). may_merge(branch) -> False keeps a cluster apart (a
-    user's split edit). place(graph, node, passes) -> (2,) px: where the way in and the
-    loop's way down (`passes`, two slot pairs at `node` merged in `graph`) cross; the
-    crossing node goes there (default: the junctions' centre). Returns (crossing node ->
-    its stem's tip, where the fit splits; the branches drawn back up the stem into the way
-    on). Pair each node's slots with `stem_passes` once simplification is done.
+    user's split edit). place(graph, node, passes) -> (2,) px: an estimate of where the way
+    in and the loop's way down (`passes`, two slot pairs at `node` merged in `graph`) cross
+    (default: the junctions' centre); it picks the band they share. Returns crossing node ->
+    its stem's tip, where the fit splits; the tip's other branch is the stem drawn back up
+    into the way on. Pair each node's slots with `stem_passes` once simplification is done.
     """
     through = through or {}
     if len(graph.nodes_of_degree(1)) <= ends:
-        return {}, frozenset()
+        return {}
     junctions = [n for n in graph.incident if graph.degree(n) >= 3 and n not in through]
     index = {n: i for i, n in enumerate(junctions)}
     short = [bid for bid, b in graph.branches.items()
              if b.a != b.b and b.a in index and b.b in index and b.length <= HOLE_BRANCH_WIDTHS * stroke_width]
     if not short:
-        return {}, frozenset()
+        return {}
     links = coo_matrix((np.ones(len(short)), ([index[graph.branches[b].a] for b in short],
                                               [index[graph.branches[b].b] for b in short])),
                        shape=(len(junctions), len(junctions)))
@@ -66,7 +66,7 @@ def merge_stem_clusters(graph: MedialGraph, *, stroke_width: float, ends: int, t
     groups: dict[int, list[int]] = {}
     for n in junctions:
         groups.setdefault(int(label[index[n]]), []).append(n)
-    tips, ups = {}, set()
+    tips = {}
     for members in groups.values():
         inside = set(members)
         inner = sorted(b for b in short if b in graph.branches and graph.branches[b].a in inside)
@@ -88,13 +88,19 @@ def merge_stem_clusters(graph: MedialGraph, *, stroke_width: float, ends: int, t
             continue
         on_here = slots(trial, node)[passes[2][1]][0]
         on = next(old for old, new in renamed.items() if new == on_here)
-        centre = place(trial, node, passes[:2]) if place is not None else None
-        up = _stem_back_up(graph, stems[0], on, inside, inner, centre if centre is not None else trial.positions[node])
+        # The way in and the way down cross at a shallow angle: their inks merge into one band,
+        # the inner branch nearest the crossing, and they cross at its middle (as
+        # `simplify` merges a crossing's two halves at the middle of the branch between them).
+        estimate = place(trial, node, passes[:2]) if place is not None else trial.positions[node]
+        band = min(inner, key=lambda b: float(np.min(np.hypot(*(graph.branches[b].points - estimate).T))))
+        arc = graph.branches[band].arc
+        centre = graph.branches[band].points[int(np.searchsorted(arc, arc[-1] / 2.0))]
+        up = _stem_back_up(graph, stems[0], on, inside, [b for b in inner if b != band], inner)
         graph.remove_branch(on)
         node = merge_cluster(graph, sorted(members), inner, centre)
+        graph.add_branch(up)
         tips[node] = up.a
-        ups.add(graph.add_branch(up))
-    return tips, frozenset(ups)
+    return tips
 
 
 def stem_passes(graph: MedialGraph, node: int, stroke_width: float) -> tuple[Pairs, float]:
@@ -145,23 +151,20 @@ def _leaving(graph: MedialGraph, node: int, radius: float) -> np.ndarray:
     return np.array(result)
 
 
-def _stem_back_up(graph: MedialGraph, stem: tuple[int, int], on: int, inside: set[int], inner: list[int],
-                  crossing: np.ndarray) -> Branch:
+def _stem_back_up(graph: MedialGraph, stem: tuple[int, int], on: int, inside: set[int], beside: list[int],
+                  inner: list[int]) -> Branch:
     """The stem drawn back up into the way on, as one branch from the stem's tip to the way
-    on's far end: up the stem, along the hole's side away from the crossing (the shortest
-    way between the two feet without the inner branch nearest the crossing) and on.
-    stem: (junction, branch id); on: the way on's branch id."""
+    on's far end: up the stem, along the hole's other side (the shortest way between the two
+    feet over `beside`, the inner branches but the band where the other two passes cross;
+    over all `inner` ones if that is no way) and on. stem: (junction, branch id); on: the
+    way on's branch id."""
     at, bid = stem
-    parts = [graph.branches[bid].oriented_from(graph.branches[bid].other(at))]
-    start = at
     end = next(n for n in (graph.branches[on].a, graph.branches[on].b) if n in inside)
-    nearest = min(inner, key=lambda b: float(np.min(np.hypot(*(graph.branches[b].points - crossing).T))))
-    for skip in ([nearest], []):
-        path = _shortest(graph, [b for b in inner if b not in skip], start, end)
-        if path is not None:
-            break
-    node = start
-    for b in path or []:
+    path = _shortest(graph, beside, at, end)
+    if path is None:
+        path = _shortest(graph, inner, at, end) or []
+    parts, node = [graph.branches[bid].oriented_from(graph.branches[bid].other(at))], at
+    for b in path:
         parts.append(graph.branches[b].oriented_from(node))
         node = graph.branches[b].other(node)
     parts.append(graph.branches[on].oriented_from(end))
