@@ -70,7 +70,7 @@ def vectorize(source: str, output: str, multi: bool, threshold: float | None, bl
         replay = read_edits(edits)
     started = time.perf_counter()
     options = VectorizeOptions(multi=multi, threshold=threshold, blur=blur, classifier=classifier,
-                               keep_stages=debug_dir is not None)
+                               keep_stages=debug_dir is not None, whole_image_confidence=debug_dir is not None)
     with step(f"vectorizing {os.path.basename(source)}") as progress:
         result = vectorize_file(source, options, edits=replay, progress=progress)
     for message in result.report.warnings:
