@@ -10,9 +10,11 @@ a fresh process (PYTHONPATH=TREE, OPENBLAS_NUM_THREADS=1 as the command sets it,
 modules kept in a folder per tree) first imports exactly the third-party modules the command
 loads on that drawing (`startup_ratio.py`'s listing), which the bare import floor imports too;
 then it times (CPU: `time.process_time`) the project's own imports, the CNN's session, one
-first `vectorize_file` call (after the command's heap setting, `fabrication/cli/heap.py`,
-where the tree has it) and three warm calls (their median), with each call's stage CPU. The
-trees alternate per drawing and per round. Printed per tree: the median over drawings of each
+first `vectorize_file` call (after the command's heap and garbage collector settings,
+`fabrication/cli/heap.py`, where the tree has them) and three warm calls (their median),
+with each call's stage CPU. The trees alternate per drawing and per round. The project's
+modules are imported before the collector's setting here, as the command imports them for
+a raster drawing. Printed per tree: the median over drawings of each
 drawing's fastest run (the least disturbed by other work on a shared machine), the median
 over all runs, and the stages' medians. Compare trees only within one run (same load).
 """
@@ -55,6 +57,11 @@ out["session"] = clock() - start
 try:  # the command's heap setting, where the tree has it
     from fabrication.cli.heap import keep_freed_memory
     keep_freed_memory()
+except ImportError:
+    pass
+try:  # and its garbage collector's
+    from fabrication.cli.heap import freeze_loaded_objects
+    freeze_loaded_objects()
 except ImportError:
     pass
 start = clock()

@@ -88,6 +88,10 @@ def _parts_child(source: str, output: str) -> None:
     options = VectorizeOptions()
     make_classifier(options.classifier).session  # noqa: B018 - onnxruntime import and session
     mark("model session")
+    from fabrication.cli.heap import freeze_loaded_objects, keep_freed_memory
+
+    keep_freed_memory()  # the command's heap and garbage collector settings
+    freeze_loaded_objects()
     image, frame = load_image(source, max_size=options.max_size)
     mark("read PNG")
     result = vectorize_image(image, options, frame=frame)

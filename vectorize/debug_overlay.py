@@ -48,7 +48,9 @@ def _draw_graph(draw: ImageDraw.ImageDraw, graph, *, degrees: bool) -> None:
 
 
 def write_debug_images(result: VectorizeResult, folder: str | os.PathLike) -> list[Path]:
-    """Write the stage overlays of a result made with `keep_stages=True`; returns the paths."""
+    """Write the stage overlays of a result made with `keep_stages=True` (and
+    `whole_image_confidence=True` for the confidence the junctions image prints, as --debug
+    asks); returns the paths."""
     stages = result.stages or {}
     folder = make_folder(folder)
     written: list[Path] = []

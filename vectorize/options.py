@@ -36,6 +36,10 @@ class VectorizeOptions:
         the `vectorize.junctions.intersections.IntersectionClassifier` method `classify`.
     max_size: longest side of the working image in px; larger inputs are downscaled.
     seed: seed of every random choice (retry search ties), for reproducible output.
+    whole_image_confidence: the CNN also reads each crossing from the whole image, for the
+        confidence the studio and the --debug overlay show (`JunctionVerdict.confidence`;
+        `cnn_classifier.CnnClassifier.classify`); the verdicts, and so the drawing, are the
+        same either way, and the classification's network work halves without it.
     max_odd_nodes: refuse (`InputError`, after simplification) a graph with more odd-degree
         nodes (loose ends and forks) than this (None: no limit): route inspection's matching
         grows as their cube, multi-stroke mode's strokes with them.
@@ -48,6 +52,7 @@ class VectorizeOptions:
     max_size: int = ranged(1000, MAX_SIZE)
     seed: int = 0
     keep_stages: bool = False
+    whole_image_confidence: bool = False
     max_odd_nodes: int | None = ranged(None, MAX_ODD_NODES)
 
     def __post_init__(self) -> None:

@@ -20,6 +20,16 @@ __all__ = ["InputFrame", "VectorizeOptions", "VectorizeReport", "VectorizeResult
            "vectorize_image"]
 
 
+def import_raster_stages() -> None:
+    """Import the modules a raster drawing's stages use, which `vectorize_file` otherwise
+    imports as it reaches them (reading an SVG of strokes needs none of scipy): for a caller
+    that wants them loaded before the work starts, such as a command that then leaves the
+    loaded objects out of the garbage collector's passes (`fabrication.cli.heap`)."""
+    from vectorize.fit import fitting  # noqa: F401 - imported for its side effect
+    from vectorize import vectorizer  # noqa: F401
+    from vectorize.raster import image_io  # noqa: F401
+
+
 def vectorize_file(path: str | os.PathLike, options: VectorizeOptions = VectorizeOptions(), *,
                    edits=None, cache=None, progress=None) -> VectorizeResult:
     """Vectorize a raster image or read an SVG (strokes as they are; outlines to centre lines).

@@ -332,7 +332,10 @@ def _order(graph: MedialGraph, ink, options: VectorizeOptions, ends: int, clock:
             _refuse_ragged(odd, "loose ends and forks", options, ink.threshold)
         junction_list = _junctions(graph, simple.crossings, w)
         junctions = dict(zip(simple.crossings, junction_list))
-        verdict_list = make_classifier(options.classifier).classify(ink.gray, junction_list, w) if junction_list else []
+        # The whole image is read too only for a confidence that something shows (the studio).
+        shown = {"whole_image": options.whole_image_confidence} if options.classifier == "cnn" else {}
+        verdict_list = make_classifier(options.classifier).classify(ink.gray, junction_list, w, **shown) \
+            if junction_list else []
         if options.classifier == "cnn" and junction_list:
             geometry = make_classifier("geometric").classify(ink.gray, junction_list, w)
             lone = lone_junctions(np.array([j.center for j in junction_list]),

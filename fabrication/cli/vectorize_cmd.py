@@ -54,9 +54,14 @@ def vectorize(source: str, output: str, multi: bool, threshold: float | None, bl
     from vectorize import VectorizeOptions, vectorize_file
     from vectorize.svg_write import write_drawing
 
-    from fabrication.cli.heap import keep_freed_memory
+    from fabrication.cli.heap import freeze_loaded_objects, keep_freed_memory
 
     keep_freed_memory()  # the image's arrays reuse freed heap memory (fabrication/cli/heap.py)
+    if os.path.splitext(source)[1].lower() not in (".svg", ".svgz"):
+        from vectorize.pipeline import import_raster_stages
+
+        import_raster_stages()  # loaded now, so that the garbage collector leaves them alone:
+    freeze_loaded_objects()
 
     placement = None  # the page at the design's size; None: the input's own page (in mm with --inkstitch)
     if any(v is not None for v in (size, width, height)) or rotate:
@@ -70,7 +75,7 @@ def vectorize(source: str, output: str, multi: bool, threshold: float | None, bl
         replay = read_edits(edits)
     started = time.perf_counter()
     options = VectorizeOptions(multi=multi, threshold=threshold, blur=blur, classifier=classifier,
-                               keep_stages=debug_dir is not None)
+                               keep_stages=debug_dir is not None, whole_image_confidence=debug_dir is not None)
     with step(f"vectorizing {os.path.basename(source)}") as progress:
         result = vectorize_file(source, options, edits=replay, progress=progress)
     for message in result.report.warnings:

@@ -84,7 +84,7 @@ class StudioSession:
         if profile:
             self.profiles["command-line"] = (f"command line: {Path(profile).name}", Path(profile))
         self.default_profile = "command-line" if profile else next(iter(self.profiles))
-        self.options = VectorizeOptions(classifier=classifier)
+        self.options = VectorizeOptions(classifier=classifier, whole_image_confidence=True)
         self.cache = StageCache()
         self.lock = threading.Lock()  # one vectorization at a time: the cache is not shared-safe
         self.sender = None

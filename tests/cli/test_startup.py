@@ -27,8 +27,12 @@ try:
     main()
 except SystemExit as done:
     code = done.code
+import gc
+fitting = sys.modules.get("vectorize.fit.fitting")
+collected = {id(o) for o in gc.get_objects()}  # what the collector still goes through
 with open(listing, "w") as fh:
-    json.dump({"exit": code, "modules": sorted(sys.modules)}, fh)
+    json.dump({"exit": code, "modules": sorted(sys.modules), "frozen": gc.get_freeze_count(),
+               "fitting collected": fitting is not None and id(fitting.fit_stroke) in collected}, fh)
 """
 
 # Not on the path of a plain `onestroke vectorize IN.png -o OUT.svg` with stderr in a pipe.
@@ -60,6 +64,9 @@ def test_vectorize_imports_only_what_the_run_uses(tmp_path):
     modules = result["modules"]
     assert _loaded(modules, "vectorize.vectorizer") and _loaded(modules, "scipy.ndimage")  # the listing is real
     assert [name for name in NOT_IMPORTED if _loaded(modules, name)] == []
+    # The libraries and the stages were loaded before the work and then left out of the
+    # garbage collector's passes (`fabrication.cli.heap.freeze_loaded_objects`).
+    assert result["frozen"] > 10_000 and not result["fitting collected"]
 
     # --debug asks for the overlay: then it is imported and its images written.
     debug = tmp_path / "debug"

@@ -157,3 +157,35 @@ def test_a_clean_crossing_keeps_the_confidence_of_the_whole_image():
     assert np.allclose([v.p_crossing for v in verdicts], own_p, atol=1e-6)
     assert all(v.is_crossing and v.confidence == 1.0 for v in verdicts)
     assert own_share.min() < 1.0
+
+
+def test_the_whole_image_is_read_only_for_a_confidence_shown():
+    """Without `whole_image_confidence` (the CLI's default) the CNN reads each junction from
+    its own ink only: the same p_crossing bits and the same SVG, the own ink's vote share as
+    the confidence. The studio and --debug ask for the whole image's reading as well."""
+    from PIL import Image
+
+    from fabrication.studio.session import StudioSession
+    from vectorize import VectorizeOptions, vectorize_image
+    from vectorize.junctions.classifiers import make_classifier
+    from vectorize.svg_write import drawing_to_svg
+
+    loops = Path(__file__).parents[2] / "examples" / "loops.png"
+    image = np.asarray(Image.open(loops).convert("L"))
+    fast = vectorize_image(image, VectorizeOptions(keep_stages=True))
+    shown = vectorize_image(image, VectorizeOptions(keep_stages=True, whole_image_confidence=True))
+    assert drawing_to_svg(fast.drawing) == drawing_to_svg(shown.drawing)
+    fast_v, shown_v = fast.stages["verdicts"], shown.stages["verdicts"]
+    assert len(fast_v) == 3 and fast_v.keys() == shown_v.keys()
+    assert [fast_v[n].p_crossing for n in fast_v] == [shown_v[n].p_crossing for n in fast_v]
+    assert all(v.confidence == 1.0 for v in shown_v.values())
+    assert min(v.confidence for v in fast_v.values()) < 1.0  # 5-7 of 8 votes from the own ink
+
+    cnn = make_classifier("cnn")
+    gray, width = fast.stages["ink"].gray, fast.stages["ink"].stroke_width
+    junctions = list(fast.stages["junctions"].values())
+    junctions.append(dataclasses.replace(junctions[0], ink=None))  # read whole either way
+    own_only, both = cnn.classify(gray, junctions, width, whole_image=False), cnn.classify(gray, junctions, width)
+    assert [v.p_crossing for v in own_only] == [v.p_crossing for v in both]
+    assert own_only[-1] == both[-1]
+    assert StudioSession(loops).options.whole_image_confidence

@@ -96,28 +96,32 @@ class CnnClassifier:
         share = np.where(mean >= 0.5, votes, 1.0 - votes)
         return mean, np.maximum(share, 0.5)
 
-    def classify(self, gray: np.ndarray, junctions: Sequence[Junction],
-                 stroke_width: float) -> list[JunctionVerdict]:
+    def classify(self, gray: np.ndarray, junctions: Sequence[Junction], stroke_width: float, *,
+                 whole_image: bool = True) -> list[JunctionVerdict]:
         """One verdict per junction; gray (H, W) float32 in [0, 1], 1 = paper.
 
         A junction with `ink` is read from an image holding that ink alone
         (`junction_crop.crop_own_ink`): in crowded context (cursive letters beside a
-        crossing) the whole image misleads the model. It is read whole as well, for the
-        confidence only: cut to a few widths, a clean crossing's branches get fewer votes
-        (5-7 of 8 on examples/loops.png, where the whole image gets 8), so where the two
-        readings agree the confidence is the larger vote share.
+        crossing) the whole image misleads the model. With `whole_image` it is read whole as
+        well, for the confidence only: cut to a few widths, a clean crossing's branches get
+        fewer votes (5-7 of 8 on examples/loops.png, where the whole image gets 8), so where
+        the two readings agree the confidence is the larger vote share. Without it the
+        confidence is the own ink's vote share, and the network reads half as many crops;
+        p_crossing is the same either way. A junction without `ink` is read whole.
         """
         if not junctions:
             return []
         centers = np.array([j.crop_center for j in junctions], dtype=float)
-        crops = crop_junctions(gray, centers, stroke_width, self.spec)
         own = [i for i, j in enumerate(junctions) if j.ink is not None]
+        whole = list(range(len(junctions))) if whole_image else [i for i, j in enumerate(junctions) if j.ink is None]
+        parts = [crop_junctions(gray, centers[whole], stroke_width, self.spec)] if whole else []
         if own:
-            own_crops = crop_own_ink(gray, centers[own], [junctions[i].ink for i in own], stroke_width, self.spec)
-            crops = np.concatenate([crops, own_crops])
-        mean, share = self.predict_crops(crops)
-        n = len(junctions)
+            parts.append(crop_own_ink(gray, centers[own], [junctions[i].ink for i in own], stroke_width, self.spec))
+        mean, share = self.predict_crops(np.concatenate(parts))
+        p, confidence = np.zeros(len(junctions)), np.zeros(len(junctions))
+        p[whole], confidence[whole] = mean[:len(whole)], share[:len(whole)]
         for k, i in enumerate(own):
-            agree = (mean[n + k] >= 0.5) == (mean[i] >= 0.5)
-            mean[i], share[i] = mean[n + k], max(share[n + k], share[i]) if agree else share[n + k]
-        return [JunctionVerdict(p_crossing=float(m), confidence=float(s)) for m, s in zip(mean[:n], share[:n])]
+            m, s = mean[len(whole) + k], share[len(whole) + k]
+            agree = whole_image and (m >= 0.5) == (p[i] >= 0.5)
+            p[i], confidence[i] = m, max(s, confidence[i]) if agree else s
+        return [JunctionVerdict(p_crossing=float(m), confidence=float(s)) for m, s in zip(p, confidence)]
