@@ -101,6 +101,20 @@ def merge_cluster(graph: MedialGraph, nodes: list[int], inner: list[int], centre
     return node
 
 
+def linked_groups(graph: MedialGraph, junctions: list[int], links: list[int]) -> list[list[int]]:
+    """The junctions (node ids) in groups joined by the branches `links` (ids of branches
+    between two of them), each group in `junctions` order."""
+    index = {n: i for i, n in enumerate(junctions)}
+    rows = [index[graph.branches[b].a] for b in links]
+    cols = [index[graph.branches[b].b] for b in links]
+    matrix = coo_matrix((np.ones(len(links)), (rows, cols)), shape=(len(junctions), len(junctions)))
+    _, label = connected_components(matrix, directed=False)
+    groups: dict[int, list[int]] = {}
+    for n in junctions:
+        groups.setdefault(int(label[index[n]]), []).append(n)
+    return list(groups.values())
+
+
 def merge_triple_points(graph: MedialGraph, *, stroke_width: float, may_merge=None) -> dict[int, Pairs]:
     """Find clusters of junctions where three passes cross and merge each into one node, in
     place. Returns node -> its three slot pairs (the passes straight through it); pair again
@@ -109,21 +123,14 @@ def merge_triple_points(graph: MedialGraph, *, stroke_width: float, may_merge=No
     may_merge(branch) -> False keeps a cluster apart (a user's split edit).
     """
     junctions = [n for n in graph.incident if graph.degree(n) == 3]
-    index = {n: i for i, n in enumerate(junctions)}
+    known = set(junctions)
     short = [bid for bid, b in graph.branches.items()
-             if b.a != b.b and b.a in index and b.b in index
+             if b.a != b.b and b.a in known and b.b in known
              and b.length < max(CLUSTER_REACH * stroke_width, graph.radii[b.a] + graph.radii[b.b])]
     if not short:
         return {}
-    rows = [index[graph.branches[b].a] for b in short]
-    cols = [index[graph.branches[b].b] for b in short]
-    links = coo_matrix((np.ones(len(short)), (rows, cols)), shape=(len(junctions), len(junctions)))
-    _, label = connected_components(links, directed=False)
-    groups: dict[int, list[int]] = {}
-    for n in junctions:
-        groups.setdefault(int(label[index[n]]), []).append(n)
     result = {}
-    for members in groups.values():
+    for members in linked_groups(graph, junctions, short):
         if len(members) != 4:
             continue
         inside = set(members)

@@ -21,10 +21,9 @@ cusp at its tip.
 from __future__ import annotations
 
 import numpy as np
-from scipy.sparse import coo_matrix
-from scipy.sparse.csgraph import connected_components, dijkstra
+from scipy.sparse.csgraph import dijkstra
 
-from vectorize.axis.clusters import MAX_BEND, Pairs, merge_cluster, pass_bends
+from vectorize.axis.clusters import MAX_BEND, Pairs, linked_groups, merge_cluster, pass_bends
 from vectorize.axis.graph import Branch, MedialGraph
 from vectorize.axis.simplify import slot_points, slots
 
@@ -54,20 +53,13 @@ def merge_stem_clusters(graph: MedialGraph, *, stroke_width: float, ends: int, t
     if len(graph.nodes_of_degree(1)) <= ends:
         return {}
     junctions = [n for n in graph.incident if graph.degree(n) >= 3 and n not in through]
-    index = {n: i for i, n in enumerate(junctions)}
+    known = set(junctions)
     short = [bid for bid, b in graph.branches.items()
-             if b.a != b.b and b.a in index and b.b in index and b.length <= HOLE_BRANCH_WIDTHS * stroke_width]
+             if b.a != b.b and b.a in known and b.b in known and b.length <= HOLE_BRANCH_WIDTHS * stroke_width]
     if not short:
         return {}
-    links = coo_matrix((np.ones(len(short)), ([index[graph.branches[b].a] for b in short],
-                                              [index[graph.branches[b].b] for b in short])),
-                       shape=(len(junctions), len(junctions)))
-    _, label = connected_components(links, directed=False)
-    groups: dict[int, list[int]] = {}
-    for n in junctions:
-        groups.setdefault(int(label[index[n]]), []).append(n)
     tips = {}
-    for members in groups.values():
+    for members in linked_groups(graph, junctions, short):
         inside = set(members)
         inner = sorted(b for b in short if b in graph.branches and graph.branches[b].a in inside)
         # One hole: as many short branches as junctions (a tree has one fewer).
