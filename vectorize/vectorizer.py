@@ -322,7 +322,7 @@ def _order(graph: MedialGraph, ink, options: VectorizeOptions, ends: int, clock:
                           through={**through, **dict.fromkeys(stems, ())}, **hooks)
         # Paired after simplification: merging crossings next to a triple point renumbers its slots.
         through, posterior = _pair_through(graph, [n for n in simple.through if n not in stems], ink.gray, w, options)
-        through.update({n: stem_passes(graph, n, w)[0] for n in stems})
+        through.update({n: stem_passes(graph, n, w, tip)[0] for n, tip in stems.items()})
         simple = replace(simple, through=through, through_posterior=posterior,
                          crossings=tuple(n for n in simple.crossings if n not in stems),
                          y_tips=simple.y_tips | set(stems.values()))

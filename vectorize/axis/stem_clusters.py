@@ -74,9 +74,14 @@ def merge_stem_clusters(graph: MedialGraph, *, stroke_width: float, ends: int, t
         # Five feet: the way in and the way on, the loop's two sides (one branch) and the stem.
         if len(feet) != 5 or len(stems) != 1 or len(loops) != 2:
             continue
+        tip = graph.branches[stems[0][1]].other(stems[0][0])
+        # A foot to a degree-2 node is another cluster's stem drawn back up (its tip): this
+        # cluster then has no way in or no way on of its own, and is left as it is.
+        if any(graph.degree(graph.branches[bid].other(n)) == 2 for n, bid in feet):
+            continue
         trial, renamed = graph.copy(), {}
         node = merge_cluster(trial, sorted(members), inner, renamed=renamed)
-        passes, bend = stem_passes(trial, node, stroke_width)
+        passes, bend = stem_passes(trial, node, stroke_width, tip)
         if bend > MAX_BEND:
             continue
         on_here = slots(trial, node)[passes[2][1]][0]
@@ -96,7 +101,7 @@ def merge_stem_clusters(graph: MedialGraph, *, stroke_width: float, ends: int, t
     return tips
 
 
-def stem_passes(graph: MedialGraph, node: int, stroke_width: float) -> tuple[Pairs, float]:
+def stem_passes(graph: MedialGraph, node: int, stroke_width: float, tip: int) -> tuple[Pairs, float]:
     """The passes through a merged stem cluster (slot pairs) and the largest bend (degrees) of
     the two that cross: the way in up one side of the loop, the loop's other side down the
     stem and, while the way on still ends at the node, the stem back up into it.
@@ -107,13 +112,14 @@ def stem_passes(graph: MedialGraph, node: int, stroke_width: float) -> tuple[Pai
     its side. The turn from the stem into the way on is a cusp's, and is not measured.
     Directions are taken where each branch leaves the cluster's ink (a width beyond its
     span), not along the branches: a loop's two sides run side by side, and further out
-    they meet again at its top.
+    they meet again at its top. tip: the stem's far end (`merge_stem_clusters` returns it);
+    another foot may end at a node of degree 2 too (the tip of the stem before it).
     """
     node_slots = slots(graph, node)
     dirs = _leaving(graph, node, graph.spans.get(node, 0.0) + stroke_width)
     angle = np.arctan2(dirs[:, 1], dirs[:, 0])
     ends = [graph.branches[bid].other(node) for bid, _ in node_slots]
-    stem = [i for i, far in enumerate(ends) if graph.degree(far) <= 2 and far != node]
+    stem = [i for i, far in enumerate(ends) if far == tip]
     loop = [i for i, far in enumerate(ends) if far == node]
     free = [i for i in range(len(node_slots)) if i not in stem and i not in loop]
 
