@@ -18,12 +18,13 @@ from vectorize.axis.graph import MedialGraph
 from vectorize.axis.medial_axis import medial_axis
 from vectorize.axis.pruning import prune, trim_free_ends
 from vectorize.axis.simplify import Simplified, directions, simplify, slots
+from vectorize.axis.stem_clusters import merge_stem_clusters, stem_passes
 from vectorize.drawing import Drawing
 from vectorize.fit.ink_guard import InkGuard, guard_margin
 from vectorize.fit.ink_width import edge_offset, ink_widths
 from vectorize.fit.retraces import Twin, foot_is_retraced, trimmed_twins, twin_spans
 from vectorize.junctions.classifiers import make_classifier, shipped_pass_scorer
-from vectorize.junctions.crossing_point import crossing_point
+from vectorize.junctions.crossing_point import crossing_point, passes_crossing
 from vectorize.junctions.intersections import (Junction, JunctionVerdict, lone_junctions, ranked_pairings,
                                               sharp_touch)
 from vectorize.junctions.junction_ink import own_ink, own_ink_reach
@@ -311,11 +312,20 @@ def _order(graph: MedialGraph, ink, options: VectorizeOptions, ends: int, clock:
         graph, simple, junctions, verdicts = cached
     else:
         hooks = refine.simplify_hooks() if refine is not None else {}
-        through = merge_triple_points(graph, stroke_width=w, may_merge=hooks.pop("may_cluster", None))
-        simple = simplify(graph, stroke_width=w, multi=options.multi, ends=ends, through=through, **hooks)
+        may_cluster = hooks.pop("may_cluster", None)
+        through = merge_triple_points(graph, stroke_width=w, may_merge=may_cluster)
+        # A stem drawn down and back up through a crossing (an h's base): read as one node too.
+        stems = {} if options.multi else merge_stem_clusters(
+            graph, stroke_width=w, ends=ends, through=through, may_merge=may_cluster,
+            place=lambda trial, node, passes: passes_crossing(trial, node, passes, w))
+        simple = simplify(graph, stroke_width=w, multi=options.multi, ends=ends,
+                          through={**through, **dict.fromkeys(stems, ())}, **hooks)
         # Paired after simplification: merging crossings next to a triple point renumbers its slots.
-        through, posterior = _pair_through(graph, simple.through, ink.gray, w, options)
-        simple = replace(simple, through=through, through_posterior=posterior)
+        through, posterior = _pair_through(graph, [n for n in simple.through if n not in stems], ink.gray, w, options)
+        through.update({n: stem_passes(graph, n, w)[0] for n in stems})
+        simple = replace(simple, through=through, through_posterior=posterior,
+                         crossings=tuple(n for n in simple.crossings if n not in stems),
+                         y_tips=simple.y_tips | set(stems.values()))
         clock.lap("simplification")
         if options.max_odd_nodes is not None:  # before the crossings' crops and the route
             odd = sum(1 for n, incident in graph.incident.items() if len(incident) % 2 and n not in simple.through)

@@ -15,6 +15,10 @@ glibc's defaults.
 
 from __future__ import annotations
 
+import gc
+from collections.abc import Iterator
+from contextlib import contextmanager
+
 # mallopt's parameter numbers (glibc's malloc.h)
 M_TRIM_THRESHOLD = -1
 M_MMAP_THRESHOLD = -3
@@ -43,6 +47,24 @@ def freeze_loaded_objects() -> None:
     whole `onestroke vectorize` process took 1.000 -> 0.875 s of CPU (median of 30 runs,
     the 15 drawings of `startup_cost.py --pairs 15` twice, load 6-7, 2026-12-05), the same
     SVG bytes. Garbage cycles alive at this moment stay until the process ends."""
-    import gc
-
     gc.freeze()
+
+
+@contextmanager
+def loading_for_good() -> Iterator[None]:
+    """Imports inside run with the cyclic garbage collector paused, and everything alive at
+    the end is left out of its passes (`freeze_loaded_objects`). A library's import makes
+    thousands of objects that stay and next to no garbage, yet its allocations set off
+    collections that go through all the objects made so far: pausing the collector while
+    scipy, scikit-image and the stages load (the bare import floor of `startup_cost.py
+    --pairs` imports them with it running) took the garbage collection in a command from
+    75-120 to 10-30 ms (3 drawings, gc callbacks) and the command / floor ratio from 1.181
+    to 1.105 wall, 1.167 to 1.128 CPU (median of 45 pairs, load 7, 2026-12-05)."""
+    was_on = gc.isenabled()
+    gc.disable()
+    try:
+        yield
+    finally:
+        freeze_loaded_objects()
+        if was_on:
+            gc.enable()

@@ -51,17 +51,19 @@ def vectorize(source: str, output: str, multi: bool, threshold: float | None, bl
 
         stage_images = [("--debug image", os.path.join(debug_dir, name)) for name in STAGE_IMAGES]
     check_distinct(inputs=[("input", source), ("--edits file", edits)], outputs=[("output", output), *stage_images])
-    from vectorize import VectorizeOptions, vectorize_file
-    from vectorize.svg_write import write_drawing
+    from fabrication.cli.heap import keep_freed_memory, loading_for_good
 
-    from fabrication.cli.heap import freeze_loaded_objects, keep_freed_memory
+    # The libraries load with the garbage collector paused and then stay out of its passes
+    # (fabrication/cli/heap.py); a raster drawing's stages load now for that.
+    with loading_for_good():
+        from vectorize import VectorizeOptions, vectorize_file
+        from vectorize.svg_write import write_drawing
 
-    keep_freed_memory()  # the image's arrays reuse freed heap memory (fabrication/cli/heap.py)
-    if os.path.splitext(source)[1].lower() not in (".svg", ".svgz"):
-        from vectorize.pipeline import import_raster_stages
+        if os.path.splitext(source)[1].lower() not in (".svg", ".svgz"):
+            from vectorize.pipeline import import_raster_stages
 
-        import_raster_stages()  # loaded now, so that the garbage collector leaves them alone:
-    freeze_loaded_objects()
+            import_raster_stages()
+    keep_freed_memory()  # the image's arrays reuse freed heap memory
 
     placement = None  # the page at the design's size; None: the input's own page (in mm with --inkstitch)
     if any(v is not None for v in (size, width, height)) or rotate:

@@ -60,9 +60,13 @@ def pass_bends(dirs: np.ndarray, pairs) -> list[float]:
     return [float(np.degrees(np.arccos(np.clip(-np.dot(d[a], d[b]), -1.0, 1.0)))) for a, b in pairs]
 
 
-def _merge_cluster(graph: MedialGraph, nodes: list[int], inner: list[int]) -> int:
-    """Replace the cluster's junctions and inner branches by one node at their centre."""
-    centre = np.mean([graph.positions[n] for n in nodes], axis=0)
+def merge_cluster(graph: MedialGraph, nodes: list[int], inner: list[int], centre: np.ndarray | None = None,
+                  renamed: dict | None = None) -> int:
+    """Replace the cluster's junctions and inner branches by one node at `centre` (default:
+    the junctions' centre); `renamed` (if given) gets old branch id -> new for the branches
+    that now end at the node."""
+    if centre is None:
+        centre = np.mean([graph.positions[n] for n in nodes], axis=0)
     node = graph.add_node(centre, max(graph.radii[n] for n in nodes))
     graph.spans[node] = float(max(np.linalg.norm(graph.positions[n] - centre) for n in nodes))
     for bid in inner:
@@ -89,10 +93,26 @@ def _merge_cluster(graph: MedialGraph, nodes: list[int], inner: list[int]) -> in
             points, radii = np.vstack([points, pts[::-1][1:]]), np.concatenate([radii, rad[::-1][1:]])
             sins = np.concatenate([sins, np.ones(len(pts) - 1)])
             b = node
-        graph.add_branch(Branch(a, b, points, radii, sins))
+        new = graph.add_branch(Branch(a, b, points, radii, sins))
+        if renamed is not None:
+            renamed[bid] = new
     for n in nodes:
         del graph.incident[n], graph.positions[n], graph.radii[n]
     return node
+
+
+def linked_groups(graph: MedialGraph, junctions: list[int], links: list[int]) -> list[list[int]]:
+    """The junctions (node ids) in groups joined by the branches `links` (ids of branches
+    between two of them), each group in `junctions` order."""
+    index = {n: i for i, n in enumerate(junctions)}
+    rows = [index[graph.branches[b].a] for b in links]
+    cols = [index[graph.branches[b].b] for b in links]
+    matrix = coo_matrix((np.ones(len(links)), (rows, cols)), shape=(len(junctions), len(junctions)))
+    _, label = connected_components(matrix, directed=False)
+    groups: dict[int, list[int]] = {}
+    for n in junctions:
+        groups.setdefault(int(label[index[n]]), []).append(n)
+    return list(groups.values())
 
 
 def merge_triple_points(graph: MedialGraph, *, stroke_width: float, may_merge=None) -> dict[int, Pairs]:
@@ -103,21 +123,14 @@ def merge_triple_points(graph: MedialGraph, *, stroke_width: float, may_merge=No
     may_merge(branch) -> False keeps a cluster apart (a user's split edit).
     """
     junctions = [n for n in graph.incident if graph.degree(n) == 3]
-    index = {n: i for i, n in enumerate(junctions)}
+    known = set(junctions)
     short = [bid for bid, b in graph.branches.items()
-             if b.a != b.b and b.a in index and b.b in index
+             if b.a != b.b and b.a in known and b.b in known
              and b.length < max(CLUSTER_REACH * stroke_width, graph.radii[b.a] + graph.radii[b.b])]
     if not short:
         return {}
-    rows = [index[graph.branches[b].a] for b in short]
-    cols = [index[graph.branches[b].b] for b in short]
-    links = coo_matrix((np.ones(len(short)), (rows, cols)), shape=(len(junctions), len(junctions)))
-    _, label = connected_components(links, directed=False)
-    groups: dict[int, list[int]] = {}
-    for n in junctions:
-        groups.setdefault(int(label[index[n]]), []).append(n)
     result = {}
-    for members in groups.values():
+    for members in linked_groups(graph, junctions, short):
         if len(members) != 4:
             continue
         inside = set(members)
@@ -127,11 +140,11 @@ def merge_triple_points(graph: MedialGraph, *, stroke_width: float, may_merge=No
         if len(inner) != 3 or (may_merge is not None and not all(may_merge(graph.branches[b]) for b in inner)):
             continue
         trial = graph.copy()
-        node = _merge_cluster(trial, sorted(members), inner)
+        node = merge_cluster(trial, sorted(members), inner)
         pairs, bend = straightest_pairs(directions(trial, node, 2.5 * stroke_width))
         if bend > MAX_BEND:
             continue
-        node = _merge_cluster(graph, sorted(members), inner)
+        node = merge_cluster(graph, sorted(members), inner)
         result[node] = straightest_pairs(directions(graph, node, 2.5 * stroke_width))[0]
     return result
 

@@ -73,14 +73,23 @@ def crossing_point(graph: MedialGraph, node: int, dirs: np.ndarray, stroke_width
     Falls back to the node's position where a branch is too short to fit (another node
     within the window) or the fit is degenerate.
     """
+    if len(dirs) != 4:
+        return np.asarray(graph.positions[node], dtype=float)
+    return passes_crossing(graph, node, crossing_pairing(dirs), stroke_width)
+
+
+def passes_crossing(graph: MedialGraph, node: int, passes, stroke_width: float) -> np.ndarray:
+    """Estimated point (2,) px where two passes through `node` cross (passes: two slot
+    pairs, indices into `slots`), fitted as in `crossing_point`; the node's position where
+    a branch is too short to fit or the fit is degenerate."""
     centre = np.asarray(graph.positions[node], dtype=float)
     span = graph.spans.get(node, 0.0)
     node_slots = slots(graph, node)
     lo, hi = span + WINDOW[0] * stroke_width, span + WINDOW[1] * stroke_width
-    windows = [_window(graph, s, lo, hi, FIT_STEP * stroke_width) for s in node_slots]
-    if len(windows) != 4 or min(len(p) for p in windows) < 3:
+    windows = {i: _window(graph, node_slots[i], lo, hi, FIT_STEP * stroke_width) for pair in passes for i in pair}
+    if min(len(p) for p in windows.values()) < 3:
         return centre
-    fits = [_pass_fit(centre, windows[a], windows[b]) for a, b in crossing_pairing(dirs)]
+    fits = [_pass_fit(centre, windows[a], windows[b]) for a, b in passes]
     if fits[0] is None or fits[1] is None:
         return centre
     # The second pass sampled, then measured across the first pass's parabola (in its frame):

@@ -1,0 +1,190 @@
+"""A stem drawn down and back up through a crossing: a cluster of junctions read as one.
+
+At the base of a cursive h (or k, or any ascender loop whose stem is drawn down and back
+up) three passes go through one small stretch of ink: the way in, which goes on up one side
+of the loop; the loop's way down, which crosses the way in at a shallow angle and goes on
+down the stem; and the stem drawn back up, which turns off into the way on. Their inks
+overlap unevenly, so the medial axis there is three to five junctions round a small hole,
+joined by short branches, with five feet leaving: the way in, the loop's two sides, the
+stem (to its free end) and the way on. No pairing at any one of those junctions describes
+the three passes (an inner branch carries one or two of them), and the route then draws
+the loop backwards, or crosses beside the true crossing, or retraces an inner branch.
+
+Read as one: the junctions and the branches round the hole become one crossing node where
+the way in and the way down cross (a degree-4 node whose pairs are known: the loop is drawn
+round from the way in, so its way down crosses it), and the stem drawn back up becomes a
+branch of its own from the stem's tip along the hole's far side into the way on, beside the
+crossing rather than through it. The stem is then a spike drawn down and back up, with a
+cusp at its tip.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from scipy.sparse.csgraph import dijkstra
+
+from vectorize.axis.clusters import MAX_BEND, Pairs, linked_groups, merge_cluster, pass_bends
+from vectorize.axis.graph import Branch, MedialGraph
+from vectorize.axis.simplify import slot_points, slots
+
+# Stroke widths. The branches round the hole at an h's base measured 0.7-4.4 widths
+# (the_acid_ate_the_metal-0-38, 3.5 px lines) and 2.1-6.7 widths
+# (the_planet_men_tend_the_yacht-1-37, 2.25 px lines, measured 1.5 px wide): the hole is as
+# long as the way in and the way down share ink, up to BAND_MAX_WIDTHS (6) at 19 degrees,
+# and on thin lines the measured width is smaller than the drawn one.
+HOLE_BRANCH_WIDTHS = 7.0
+
+
+def merge_stem_clusters(graph: MedialGraph, *, stroke_width: float, ends: int, through: dict | None = None,
+                        may_merge=None, place=None) -> dict[int, int]:
+    """Find the clusters of junctions where a stem drawn down and back up meets a crossing
+    (module doc) and read each as one crossing and one branch beside it, in place.
+
+    ends: free ends the single line is taken to have; a stem's tip is read as a cusp only
+    while the drawing has more free ends than that. through: nodes already merged where
+    three passes cross (left alone). may_merge(branch) -> False keeps a cluster apart (a
+    user's split edit). place(graph, node, passes) -> (2,) px: an estimate of where the way
+    in and the loop's way down (`passes`, two slot pairs at `node` merged in `graph`) cross
+    (default: the junctions' centre); it picks the band they share. Returns crossing node ->
+    its stem's tip, where the fit splits; the tip's other branch is the stem drawn back up
+    into the way on. Pair each node's slots with `stem_passes` once simplification is done.
+    """
+    through = through or {}
+    if len(graph.nodes_of_degree(1)) <= ends:
+        return {}
+    junctions = [n for n in graph.incident if graph.degree(n) >= 3 and n not in through]
+    known = set(junctions)
+    short = [bid for bid, b in graph.branches.items()
+             if b.a != b.b and b.a in known and b.b in known and b.length <= HOLE_BRANCH_WIDTHS * stroke_width]
+    if not short:
+        return {}
+    tips = {}
+    for members in linked_groups(graph, junctions, short):
+        inside = set(members)
+        inner = sorted(b for b in short if b in graph.branches and graph.branches[b].a in inside)
+        # One hole: as many short branches as junctions (a tree has one fewer).
+        if len(members) < 3 or len(inner) != len(members):
+            continue
+        if may_merge is not None and not all(may_merge(graph.branches[b]) for b in inner):
+            continue
+        feet = [(n, bid) for n in members for bid, _ in slots(graph, n) if bid not in inner]
+        stems = [(n, bid) for n, bid in feet if graph.degree(graph.branches[bid].other(n)) == 1]
+        loops = [bid for _, bid in feet if graph.branches[bid].a in inside and graph.branches[bid].b in inside]
+        # Five feet: the way in and the way on, the loop's two sides (one branch) and the stem.
+        if len(feet) != 5 or len(stems) != 1 or len(loops) != 2:
+            continue
+        trial, renamed = graph.copy(), {}
+        node = merge_cluster(trial, sorted(members), inner, renamed=renamed)
+        passes, bend = stem_passes(trial, node, stroke_width)
+        if bend > MAX_BEND:
+            continue
+        on_here = slots(trial, node)[passes[2][1]][0]
+        on = next(old for old, new in renamed.items() if new == on_here)
+        # The way in and the way down cross at a shallow angle: their inks merge into one band,
+        # the inner branch nearest the crossing, and they cross at its middle (as
+        # `simplify` merges a crossing's two halves at the middle of the branch between them).
+        estimate = place(trial, node, passes[:2]) if place is not None else trial.positions[node]
+        band = min(inner, key=lambda b: float(np.min(np.hypot(*(graph.branches[b].points - estimate).T))))
+        arc = graph.branches[band].arc
+        centre = graph.branches[band].points[int(np.searchsorted(arc, arc[-1] / 2.0))]
+        up = _stem_back_up(graph, stems[0], on, inside, [b for b in inner if b != band], inner)
+        graph.remove_branch(on)
+        node = merge_cluster(graph, sorted(members), inner, centre)
+        graph.add_branch(up)
+        tips[node] = up.a
+    return tips
+
+
+def stem_passes(graph: MedialGraph, node: int, stroke_width: float) -> tuple[Pairs, float]:
+    """The passes through a merged stem cluster (slot pairs) and the largest bend (degrees) of
+    the two that cross: the way in up one side of the loop, the loop's other side down the
+    stem and, while the way on still ends at the node, the stem back up into it.
+
+    The loop is drawn round from the way in, so its way down crosses the way in: of its two
+    sides, the way in goes up the one that makes the two passes cross (their feet alternate
+    round the node). Which free foot is the way in: the one that runs on straightest into
+    its side. The turn from the stem into the way on is a cusp's, and is not measured.
+    Directions are taken where each branch leaves the cluster's ink (a width beyond its
+    span), not along the branches: a loop's two sides run side by side, and further out
+    they meet again at its top.
+    """
+    node_slots = slots(graph, node)
+    dirs = _leaving(graph, node, graph.spans.get(node, 0.0) + stroke_width)
+    angle = np.arctan2(dirs[:, 1], dirs[:, 0])
+    ends = [graph.branches[bid].other(node) for bid, _ in node_slots]
+    stem = [i for i, far in enumerate(ends) if graph.degree(far) <= 2 and far != node]
+    loop = [i for i, far in enumerate(ends) if far == node]
+    free = [i for i in range(len(node_slots)) if i not in stem and i not in loop]
+
+    def between(x: int, a: int, b: int) -> bool:
+        return (angle[x] - angle[a]) % (2 * np.pi) < (angle[b] - angle[a]) % (2 * np.pi)
+
+    best, best_cost = (), np.inf
+    for into in free:
+        side, other = loop if between(loop[1], into, loop[0]) != between(stem[0], into, loop[0]) else loop[::-1]
+        on = [i for i in free if i != into]
+        pairs = ((into, side), (other, stem[0])) + (((stem[-1], on[0]),) if on else ())
+        cost = 1.0 + float(np.dot(dirs[into], dirs[side]))
+        if cost < best_cost:
+            best, best_cost = pairs, cost
+    return best, max(pass_bends(dirs, best[:2]))
+
+
+def _leaving(graph: MedialGraph, node: int, radius: float) -> np.ndarray:
+    """(D, 2) unit vectors from `node` to where each of its branches (in `slots` order)
+    first reaches `radius` px from it (its far end if it never does)."""
+    centre = graph.positions[node]
+    result = []
+    for slot in slots(graph, node):
+        points = slot_points(graph, slot)
+        out = np.flatnonzero(np.hypot(*(points - centre).T) >= radius)
+        chord = points[out[0] if len(out) else -1] - centre
+        result.append(chord / max(float(np.hypot(*chord)), 1e-9))
+    return np.array(result)
+
+
+def _stem_back_up(graph: MedialGraph, stem: tuple[int, int], on: int, inside: set[int], beside: list[int],
+                  inner: list[int]) -> Branch:
+    """The stem drawn back up into the way on, as one branch from the stem's tip to the way
+    on's far end: up the stem, along the hole's other side (the shortest way between the two
+    feet over `beside`, the inner branches but the band where the other two passes cross;
+    over all `inner` ones if that is no way) and on. stem: (junction, branch id); on: the
+    way on's branch id."""
+    at, bid = stem
+    end = next(n for n in (graph.branches[on].a, graph.branches[on].b) if n in inside)
+    path = _shortest(graph, beside, at, end)
+    if path is None:
+        path = _shortest(graph, inner, at, end) or []
+    parts, node = [graph.branches[bid].oriented_from(graph.branches[bid].other(at))], at
+    for b in path:
+        parts.append(graph.branches[b].oriented_from(node))
+        node = graph.branches[b].other(node)
+    parts.append(graph.branches[on].oriented_from(end))
+    points = np.vstack([parts[0].points] + [p.points[1:] for p in parts[1:]])
+    radii = np.concatenate([parts[0].radii] + [p.radii[1:] for p in parts[1:]])
+    sins = np.concatenate([p.sins for p in parts])
+    return Branch(parts[0].a, parts[-1].b, points, radii, sins)
+
+
+def _shortest(graph: MedialGraph, branches: list[int], start: int, end: int) -> list[int] | None:
+    """Branch ids of the shortest way from `start` to `end` over `branches`, or None."""
+    if start == end:
+        return []
+    nodes = sorted({n for b in branches for n in (graph.branches[b].a, graph.branches[b].b)} | {start, end})
+    at = {n: i for i, n in enumerate(nodes)}
+    weights = np.full((len(nodes), len(nodes)), np.inf)
+    which = {}
+    for b in branches:
+        i, j = at[graph.branches[b].a], at[graph.branches[b].b]
+        if graph.branches[b].length < weights[i, j]:
+            weights[i, j] = weights[j, i] = graph.branches[b].length
+            which[i, j] = which[j, i] = b
+    dist, pred = dijkstra(np.where(np.isfinite(weights), weights, 0.0), directed=False,
+                          indices=at[start], return_predecessors=True)
+    if not np.isfinite(dist[at[end]]):
+        return None
+    path, k = [], at[end]
+    while k != at[start]:
+        path.append(which[pred[k], k])
+        k = pred[k]
+    return path[::-1]
