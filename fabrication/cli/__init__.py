@@ -185,8 +185,11 @@ class LazyGroup(OnestrokeGroup):
         if name in COMMANDS and name not in self.commands:
             import importlib
 
+            from fabrication.cli.heap import loading_for_good
+
             module, attribute = COMMANDS[name].split(":")
-            self.add_command(getattr(importlib.import_module(module), attribute), name)
+            with loading_for_good():  # numpy and the rest it brings (fabrication/cli/heap.py)
+                self.add_command(getattr(importlib.import_module(module), attribute), name)
         return super().get_command(ctx, name)
 
 

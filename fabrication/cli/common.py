@@ -175,9 +175,14 @@ def read_drawing(path: str, *, multi: bool = False, threshold: float | None = No
     edits: path of an edits file (the studio's corrections) to replay; progress: a step's
     progress callback (`step`).
     """
-    from vectorize import VectorizeOptions, vectorize_file
-    from vectorize.refine.edits import read_edits
+    from fabrication.cli.heap import loading_for_good
 
+    with loading_for_good():  # as `onestroke vectorize` does (fabrication/cli/heap.py)
+        from vectorize import VectorizeOptions, vectorize_file
+        from vectorize.pipeline import import_stages_for
+        from vectorize.refine.edits import read_edits
+
+        import_stages_for(path)
     replay = read_edits(edits) if edits is not None else None
     result = vectorize_file(path, VectorizeOptions(multi=multi, threshold=threshold, blur=blur,
                                                    classifier=classifier), edits=replay,

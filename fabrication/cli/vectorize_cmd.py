@@ -57,12 +57,10 @@ def vectorize(source: str, output: str, multi: bool, threshold: float | None, bl
     # (fabrication/cli/heap.py); a raster drawing's stages load now for that.
     with loading_for_good():
         from vectorize import VectorizeOptions, vectorize_file
+        from vectorize.pipeline import import_stages_for
         from vectorize.svg_write import write_drawing
 
-        if os.path.splitext(source)[1].lower() not in (".svg", ".svgz"):
-            from vectorize.pipeline import import_raster_stages
-
-            import_raster_stages()
+        import_stages_for(source)
     keep_freed_memory()  # the image's arrays reuse freed heap memory
 
     placement = None  # the page at the design's size; None: the input's own page (in mm with --inkstitch)

@@ -30,10 +30,11 @@ def test_an_h_base_crosses_where_the_way_in_and_the_way_down_do(seed, index, cen
     assert len(found) and np.min(np.linalg.norm(found - crossing, axis=1)) <= MATCH_DISTANCE
 
 
-@pytest.mark.parametrize("index", [2, 7])
+@pytest.mark.parametrize("index", [2, 7, 8])
 def test_every_h_of_a_new_line_keeps_its_crossing(index):
     """A line of h's the benchmark does not draw ("the hen hath a hat", seed 7): before, 2 of
-    9 and 2 of 10 of its crossings were lost, each at an h's base."""
+    9, 2 of 10 and 1 of 10 of its crossings were lost, each at an h's base (line 8's hole has
+    a side 7.45 widths long, more than the 7 first allowed)."""
     from benchmarks.common.render import render
     from benchmarks.metrics.table1 import evaluate
     from benchmarks.sets.cursive import cursive_drawing

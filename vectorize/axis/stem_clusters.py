@@ -27,12 +27,13 @@ from vectorize.axis.clusters import MAX_BEND, Pairs, linked_groups, merge_cluste
 from vectorize.axis.graph import Branch, MedialGraph
 from vectorize.axis.simplify import slot_points, slots
 
-# Stroke widths. The branches round the hole at an h's base measured 0.7-4.4 widths
-# (the_acid_ate_the_metal-0-38, 3.5 px lines) and 2.1-6.7 widths
-# (the_planet_men_tend_the_yacht-1-37, 2.25 px lines, measured 1.5 px wide): the hole is as
-# long as the way in and the way down share ink, up to BAND_MAX_WIDTHS (6) at 19 degrees,
-# and on thin lines the measured width is smaller than the drawn one.
-HOLE_BRANCH_WIDTHS = 7.0
+# Stroke widths. The branches round the hole at the cursive h bases measured 0.7-4.4 widths
+# (the_acid_ate_the_metal-0-38, 3.5 px lines), 2.1-6.7 (the_planet_men_tend_the_yacht-1-37,
+# 2.25 px lines measured 1.5 px wide), up to 7.13 (ethnically-1-26, the hole's far side) and 7.45
+# (a line of h's drawn at seed 7): the hole runs as far as the way in and the way down share
+# ink, w / sin(a / 2) for passes crossing at a. The bound is that at a = 15 degrees, 7.7 widths
+# (`route_inspection.BAND_MAX_WIDTHS`, 6, is 19 degrees).
+HOLE_BRANCH_WIDTHS = 1.0 / np.sin(np.radians(15.0 / 2.0))
 
 
 def merge_stem_clusters(graph: MedialGraph, *, stroke_width: float, ends: int, through: dict | None = None,
