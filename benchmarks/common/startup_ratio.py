@@ -7,6 +7,12 @@ after the other (the order alternating) so that both see the same machine. The m
 is taken per drawing from an unmeasured run of the command inside a process that lists
 `sys.modules` when it ends (a drawing without odd nodes, say, never imports networkx).
 Used by `startup_cost.py --pairs N`.
+
+The command imports its libraries with the garbage collector paused and then frozen
+(`fabrication.cli.heap.loading_for_good`), which a plain import does not do: part of its
+lead over the bare floor is loading the same libraries more cheaply, not vectorizing
+faster. So each pair also runs a second floor that imports them the same way ("bare,
+collector paused"), and its ratio says what the work itself adds.
 """
 
 from __future__ import annotations
@@ -51,6 +57,15 @@ for name in json.load(open(sys.argv[1])):
         pass
 """
 
+# The same, loading the modules as the command does: collector paused, then frozen.
+BARE_PAUSED_CHILD = """
+import gc
+gc.disable()
+""" + BARE_CHILD + """
+gc.freeze()
+gc.enable()
+"""
+
 
 def third_party_roots() -> list[str]:
     """Folders third-party packages are installed in (site-packages of this interpreter; a
@@ -89,20 +104,25 @@ def ratio_pairs(picks: list, command: list[str], python: str, env: dict, timeout
             subprocess.run([python, "-c", child, str(listing), "vectorize", str(src), "-o", str(out)],
                            capture_output=True, text=True, env=env, timeout=timeout, check=True, cwd=tmp)
             runs = {"command": command + ["vectorize", str(src), "-o", str(out)],
-                    "bare": [python, "-c", BARE_CHILD, str(listing)]}
-            order = ("command", "bare") if k % 2 == 0 else ("bare", "command")
+                    "bare": [python, "-c", BARE_CHILD, str(listing)],
+                    "paused": [python, "-c", BARE_PAUSED_CHILD, str(listing)]}
+            order = ("command", "bare", "paused") if k % 2 == 0 else ("paused", "bare", "command")
             times = {kind: _run(runs[kind], env, timeout, cwd=tmp) for kind in order}
             modules = json.loads(listing.read_text())
             rows.append((gt.name, len(modules), any(m.split(".")[0] == "networkx" for m in modules), times))
-            (cw, cc), (bw, bc) = times["command"], times["bare"]
+            (cw, cc), (bw, bc), (pw, _) = times["command"], times["bare"], times["paused"]
             print(f"  {gt.name:34s} command {cw:6.3f} s (CPU {cc:6.3f})  bare {bw:6.3f} s (CPU {bc:6.3f})  "
-                  f"ratio {cw / bw:5.3f} (CPU {cc / bc:5.3f})  {len(modules)} modules"
+                  f"ratio {cw / bw:5.3f} (CPU {cc / bc:5.3f})  to the paused floor {cw / pw:5.3f}  {len(modules)} modules"
                   f"{' with networkx' if rows[-1][2] else ''}", flush=True)
     wall = [t["command"][0] / t["bare"][0] for *_, t in rows]
     cpu = [t["command"][1] / t["bare"][1] for *_, t in rows]
+    paused = [t["command"][0] / t["paused"][0] for *_, t in rows]
     load = " ".join(f"{x:.1f}" for x in os.getloadavg())
     print(f"{len(rows)} pairs, {os.cpu_count()} CPUs, load average now {load}")
     print(f"command / bare import floor: median {statistics.median(wall):.3f} (wall), {statistics.median(cpu):.3f} "
           f"(CPU); command median {statistics.median(t['command'][0] for *_, t in rows):.3f} s, bare median "
           f"{statistics.median(t['bare'][0] for *_, t in rows):.3f} s")
+    print(f"command / floor importing as the command does (collector paused, then frozen): median "
+          f"{statistics.median(paused):.3f} (wall); that floor's median "
+          f"{statistics.median(t['paused'][0] for *_, t in rows):.3f} s")
     return 0
