@@ -1,6 +1,6 @@
 """A narrow cusp keeps its tip: where both sides of a handwritten i or n merge into one blob
 of ink before the tip, the medial axis turns back short of it; the fitted corner goes where
-the ink shows the pen turned (`fitting._tip_in_ink`), not where the axis turned."""
+the ink shows the pen turned (`fit.tips.tip_in_ink`), not where the axis turned."""
 
 from __future__ import annotations
 

@@ -9,7 +9,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.interpolate import splev, splprep
 
-from vectorize.fit.ink_guard import MARGIN, STEP, InkGuard, curve_excess, keep_in_ink
+from vectorize.fit.ink_guard import MARGIN, InkGuard, curve_excess, keep_in_ink
 from vectorize.fit.retraces import (
     Twin,
     mirror_flags,
@@ -19,6 +19,7 @@ from vectorize.fit.retraces import (
     twin_piece,
     valid_twins,
 )
+from vectorize.fit.tips import tip_in_ink, with_fork_tips
 from vectorize.stroke import Stroke, arc_lengths, edge_lengths
 
 
@@ -254,49 +255,6 @@ def _corner_point(before: np.ndarray, after: np.ndarray, fallback: np.ndarray, l
     return apex
 
 
-def _tip_in_ink(xy: np.ndarray, arc: np.ndarray, at: int, guard: InkGuard, stroke_width: float,
-                closed: bool) -> np.ndarray | None:
-    """Where the pen turned at the corner `xy[at]` of the traced centre line ((N, 2) px;
-    `arc` (N,) px: arc length at each point), read from the ink: along the corner's outward
-    bisector (away from both sides, as seen 1.5 widths along the line), half a width short of
-    where the ink ends (the pen's round tip). None when the ink does not end within 3 widths.
-
-    At a narrow cusp (the top of a handwritten i, n or u) both sides merge into one blob of
-    ink before the tip: the medial axis turns back a width or more short of it, and the two
-    sides' tangents, bent by that turn, meet short of the tip too; the ink still shows how
-    far the pen went. At an ordinary sharp corner the ink's round outer edge lies half a
-    width beyond the corner, so this finds the corner itself.
-    """
-    reach = 1.5 * stroke_width
-    sides = []
-    for target in (arc[at] - reach, arc[at] + reach):
-        if closed:
-            target = np.mod(target, arc[-1])
-        elif not 0.0 <= target <= arc[-1]:
-            return None
-        # np.interp on the few points around the target: the same value as over the whole
-        # line, without copying the line at every corner (TSP art has thousands)
-        j = int(np.searchsorted(arc, target, side="right"))
-        near = slice(max(j - 2, 0), min(j + 2, len(arc)))
-        point = np.array([np.interp(target, arc[near], xy[near, 0]), np.interp(target, arc[near], xy[near, 1])])
-        chord = point - xy[at]
-        if np.linalg.norm(chord) < 1e-9:
-            return None
-        sides.append(chord / np.linalg.norm(chord))
-    inward = sides[0] + sides[1]
-    if np.linalg.norm(inward) < 1e-6:
-        return None  # the line runs straight through: no corner to extend
-    direction = -inward / np.linalg.norm(inward)
-    count = int(np.ceil(3.0 * stroke_width / (STEP / 2)))
-    steps = np.arange(1, count + 1) * (3.0 * stroke_width / count)
-    outside = guard.excess(xy[at] + steps[:, None] * direction) > 0.0
-    if not outside.any():
-        return None
-    # The first step found outside lies up to the guard's margin beyond the ink's edge.
-    edge = float(steps[int(np.argmax(outside))]) - guard.margin
-    return xy[at] + max(edge - 0.5 * stroke_width, 0.0) * direction
-
-
 def _open_fit(points: np.ndarray, sigma: float) -> np.ndarray:
     return fit_piece(points, closed=False, sigma=sigma, anchor=True)
 
@@ -364,6 +322,10 @@ def fit_stroke(traced: TracedPoints, *, closed: bool, sigma: float, stroke_width
         keep, split, corner = np.append(keep, keep[0]), np.append(split, split[0]), np.append(corner, corner[0])
         junction = np.append(junction, junction[0])
         closed = False
+        twins = valid_twins(xy, twins)
+    if guard is not None:
+        xy, keep, split, corner, junction, twins = with_fork_tips(xy, keep, split, corner, junction, twins,
+                                                                    guard, stroke_width, closed)
         twins = valid_twins(xy, twins)
     # Around a corner the axis is off the centre line for about a stroke width: leave it out.
     # (The corner joints below read the tip along this arc too.)
@@ -434,7 +396,7 @@ def fit_stroke(traced: TracedPoints, *, closed: bool, sigma: float, stroke_width
             # Where the ink shows the pen went further than the tangents say (a narrow cusp
             # whose axis stops short), the tip goes there; the sides' handles follow it.
             # Not at a junction: beyond it lies the ink of the other branches, not a tip.
-            tip = (_tip_in_ink(xy, arc, at, guard, stroke_width, closed)
+            tip = (tip_in_ink(xy, arc, at, guard, stroke_width, closed)
                    if guard is not None and not junction[at] else None)
             # Only a tip beyond the corner point by more than the invariant's slack moves it: a
             # sharp corner whose sides' tangents meet in the ink is already where the pen turned.

@@ -100,6 +100,15 @@ class InkGuard:
             excess[out[(values < self.level).any(axis=1)]] = 0.0
         return excess
 
+    def beyond_balls(self, xy: np.ndarray) -> np.ndarray:
+        """(N, 2) points -> (N,) px beyond the nearest medial ball, ungrown (<= 0: some ball
+        holds the point). Ink beyond every ball is ink the centre line does not hold: the
+        tip of a sharp corner whose spur was pruned."""
+        xy = np.asarray(xy, dtype=float).reshape(-1, 2)
+        k = min(NEIGHBOURS, len(self.points))
+        dist, index = self.tree.query(xy, k=k)
+        return (dist.reshape(len(xy), k) - self.radii[index.reshape(len(xy), k)]).min(axis=1)
+
     def strays(self, xy: np.ndarray) -> np.ndarray:
         """(N, 2) points -> (N,): `excess` where a point lies outside the grown ink (> 0, the
         same number); where it lies inside, some number <= 0 (not its excess).
