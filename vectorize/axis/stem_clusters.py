@@ -36,8 +36,8 @@ from vectorize.axis.simplify import slot_points, slots
 HOLE_BRANCH_WIDTHS = 1.0 / np.sin(np.radians(15.0 / 2.0))
 
 
-def merge_stem_clusters(graph: MedialGraph, *, stroke_width: float, ends: int, through: dict | None = None,
-                        may_merge=None, place=None) -> dict[int, int]:
+def merge_stem_clusters(graph: MedialGraph, *, stroke_width: float, ends: int, place, through: dict | None = None,
+                        may_merge=None) -> dict[int, int]:
     """Find the clusters of junctions where a stem drawn down and back up meets a crossing
     (module doc) and read each as one crossing and one branch beside it, in place.
 
@@ -46,7 +46,8 @@ def merge_stem_clusters(graph: MedialGraph, *, stroke_width: float, ends: int, t
     three passes cross (left alone). may_merge(branch) -> False keeps a cluster apart (a
     user's split edit). place(graph, node, passes) -> (2,) px: an estimate of where the way
     in and the loop's way down (`passes`, two slot pairs at `node` merged in `graph`) cross
-    (default: the junctions' centre); it picks the band they share. Returns crossing node ->
+    (`vectorize.junctions.crossing_point.passes_crossing`, passed in: the junctions' stage
+    comes after this one); it picks the band they share. Returns crossing node ->
     its stem's tip, where the fit splits; the tip's other branch is the stem drawn back up
     into the way on. Pair each node's slots with `stem_passes` once simplification is done.
     """
@@ -89,7 +90,7 @@ def merge_stem_clusters(graph: MedialGraph, *, stroke_width: float, ends: int, t
         # The way in and the way down cross at a shallow angle: their inks merge into one band,
         # the inner branch nearest the crossing, and they cross at its middle (as
         # `simplify` merges a crossing's two halves at the middle of the branch between them).
-        estimate = place(trial, node, passes[:2]) if place is not None else trial.positions[node]
+        estimate = place(trial, node, passes[:2])
         band = min(inner, key=lambda b: float(np.min(np.hypot(*(graph.branches[b].points - estimate).T))))
         arc = graph.branches[band].arc
         centre = graph.branches[band].points[int(np.searchsorted(arc, arc[-1] / 2.0))]
