@@ -33,7 +33,7 @@ from vectorize.raster.binarize import downscaled_gray, ink_image, ink_threshold,
 from vectorize.raster.outline import outline_rings
 from vectorize.route.retrace_paths import turn_prices, turns_at
 from vectorize.route.route_ends import end_costs
-from vectorize.route.route_inspection import connect_pairings, plan_routes, shared_bands
+from vectorize.route.route_inspection import connect_pairings, cuts_off, plan_routes, shared_bands
 from vectorize.route.traversal import Ordering, half_turns, order_strokes, turn_backs
 from vectorize.stroke import Stroke, lengths
 
@@ -128,6 +128,7 @@ def _pair_through(graph: MedialGraph, nodes, gray: np.ndarray, w: float,
                   options: VectorizeOptions) -> tuple[dict, dict]:
     """Pair the feet of each triple point: by continuation and the image (the pass scorer,
     with the CNN classifier, when its model is installed), by continuation alone otherwise.
+    A single line leaves a node undecided where that pairing would cut it in pieces.
     Returns (node -> slot pairs, six-foot node -> the scorer's posterior over its pairings)."""
     if not nodes:
         return {}, {}
@@ -142,6 +143,14 @@ def _pair_through(graph: MedialGraph, nodes, gray: np.ndarray, w: float,
         centers = np.array([graph.positions[n] for n in six])
         for node, (pick, odds) in zip(six, scored_pairings(gray, centers, [feet[n] for n in six], w, scorer)):
             result[node], posterior[node] = pick, odds
+    if not options.multi:
+        # Passes that cut a piece off the line (`route_inspection.cuts_off`: from one free end
+        # to another, as an entry tick and a stem drawn down from one point make when they are
+        # collinear) are not how the line went through: the node is not three passes (spikes
+        # drawn out and back leave it), and route inspection walks it as an undecided
+        # junction, which keeps the line in one piece.
+        result = {n: pairs for n, pairs in result.items() if not cuts_off(graph, n, pairs)}
+        posterior = {n: odds for n, odds in posterior.items() if n in result}
     return result, posterior
 
 

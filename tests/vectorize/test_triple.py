@@ -16,6 +16,8 @@ from vectorize.axis.clusters import merge_triple_points, straightest_pairs
 from vectorize.axis.simplify import directions
 from vectorize.junctions.pass_scorer import DEFAULT_MODEL, PAIRS, PassScorer, pair_feet
 from vectorize.options import VectorizeOptions
+from vectorize.pipeline import vectorize_image
+from vectorize.stroke import Stroke
 from vectorize.training.pass_eval import node_truth, same_pairing
 from vectorize.training.triple_synth import render_scene
 from vectorize.vectorizer import _Clock, _front
@@ -70,6 +72,42 @@ def test_the_shipped_pass_scorer_ships_and_pairs_real_triple_points():
     # The three true passes are the image's likeliest three of fifteen, and the combined
     # pairing is the drawn one, on (nearly) every node found.
     assert total >= 5 and top3 >= total - 1 and combined >= total - 1
+
+
+def _ray(center: np.ndarray, degrees: float, length: float) -> np.ndarray:
+    """The point `length` px from `center` at `degrees` (counter-clockwise on the page, y down)."""
+    a = np.radians(degrees)
+    return center + length * np.array([np.cos(a), -np.sin(a)])
+
+
+def test_a_point_where_two_spikes_leave_a_crossing_line_is_one_stroke():
+    """A line comes in from the left end A through P, runs round a wide loop and back through
+    P at 60 degrees, drawing two spikes out and back from P on the way (at 115 and 295
+    degrees: collinear) before it leaves for its end E. Six feet leave P's cluster, read as
+    three passes crossing; the straightest pairing joins the two spikes, a pass from free end
+    to free end, and four free feet round one loop leave no pairing that does not cut the
+    line. Before, that pass was a stroke of its own: 2 strokes. Now P is left to route
+    inspection: one stroke from A to E, each spike drawn twice."""
+    from scipy.spatial import cKDTree
+
+    from tests.drawings import render_polylines
+
+    p = np.array([200.0, 200.0])
+    a, r, f, e = _ray(p, 180, 150), _ray(p, 0, 120), _ray(p, 240, 120), _ray(p, 60, 150)
+    t = np.linspace(0.0, 1.0, 60)[1:, None]
+    c1, c2 = r + np.array([60.0, 150.0]), f + np.array([-40.0, 120.0])
+    loop = (1 - t) ** 3 * r + 3 * (1 - t) ** 2 * t * c1 + 3 * (1 - t) * t ** 2 * c2 + t ** 3 * f
+    line = np.vstack([a, p, r, loop, p, _ray(p, 115, 45), p, _ray(p, 295, 45), p, e])
+    width = 6.0
+    result = vectorize_image(render_polylines([line], width=width), VectorizeOptions(classifier="cnn"))
+    assert result.report.strokes == 1, result.report.warnings
+    stroke = result.drawing.strokes[0]
+    assert {tuple(np.round(stroke.start / 10)), tuple(np.round(stroke.end / 10))} == \
+        {tuple(np.round(a / 10)), tuple(np.round(e / 10))}
+    drawn = float(np.linalg.norm(np.diff(line, axis=0), axis=1).sum())
+    assert abs(stroke.length - drawn) < 0.02 * drawn  # each spike twice, nothing more
+    gap, _ = cKDTree(stroke.sample_evenly(0.5)).query(Stroke.from_polyline(line).sample_evenly(1.0))
+    assert gap.max() < width
 
 
 @pytest.mark.slow

@@ -123,6 +123,15 @@ def pieces(graph: MedialGraph, pairings: dict) -> int:
     return PieceCount(graph, pairings)({})
 
 
+def cuts_off(graph: MedialGraph, node: int, pairs) -> bool:
+    """Whether the passes `pairs` (slot pairs) through `node`, with every other junction left
+    free to turn, cut a piece off the line: a pass from a free end to a free end (that pass
+    would be a whole line), or one that closes a loop meeting nothing else. A single line
+    has no such pass unless it is all of the ink."""
+    count = PieceCount(graph, {}, (node,))
+    return count({node: pairs}) > count({})
+
+
 class PieceCount:
     """`pieces` for one graph whose `variable` nodes take many pairings in turn (the search in
     `connect_pairings` asks hundreds of times): the graph's pieces with those nodes' branch
