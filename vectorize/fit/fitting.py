@@ -19,7 +19,7 @@ from vectorize.fit.retraces import (
     twin_piece,
     valid_twins,
 )
-from vectorize.fit.tips import tip_in_ink, with_fork_tips
+from vectorize.fit.tips import corner_tip, pruned_cusps, with_fork_tips
 from vectorize.stroke import Stroke, arc_lengths, edge_lengths
 
 
@@ -299,6 +299,11 @@ def fit_stroke(traced: TracedPoints, *, closed: bool, sigma: float, stroke_width
     junction = np.zeros(len(xy), dtype=bool) if traced.junction is None else np.array(traced.junction, dtype=bool)
     found = sharp_corners(xy, stroke_width, closed=closed)
     corner[found[keep[found] & ~split[found]]] = True
+    if guard is not None and len(xy) >= 5:
+        # A cusp whose pruned spur left the axis's turn too round for a corner (`tips.pruned_cusps`).
+        arc = arc_lengths(xy)
+        free = keep & ~split & ~junction & (along_distance(arc, corner) > 2.0 * stroke_width)
+        corner[pruned_cusps(xy, _turn(xy, arc, 1.5 * stroke_width, closed), free, guard, stroke_width, closed)] = True
     if traced.corner is not None:
         corner |= np.asarray(traced.corner, dtype=bool)
     split |= corner
@@ -396,7 +401,7 @@ def fit_stroke(traced: TracedPoints, *, closed: bool, sigma: float, stroke_width
             # Where the ink shows the pen went further than the tangents say (a narrow cusp
             # whose axis stops short), the tip goes there; the sides' handles follow it.
             # Not at a junction: beyond it lies the ink of the other branches, not a tip.
-            tip = (tip_in_ink(xy, arc, at, guard, stroke_width, closed)
+            tip = (corner_tip(xy, arc, at, guard, stroke_width, closed)
                    if guard is not None and not junction[at] else None)
             # Only a tip beyond the corner point by more than the invariant's slack moves it: a
             # sharp corner whose sides' tangents meet in the ink is already where the pen turned.

@@ -1,5 +1,6 @@
 """Where the pen turned, read from the ink: a narrow cusp's tip beyond its corner, and a cusp's
-tip beyond a fork whose spur pruning took (`fitting.fit_stroke` asks at its corners and splits)."""
+tip beyond a fork or a turn of the traced line whose spur pruning took (`fitting.fit_stroke`
+asks at its corners, turns and splits)."""
 
 from __future__ import annotations
 
@@ -96,6 +97,69 @@ def _fork_tip(xy: np.ndarray, arc: np.ndarray, at: int, guard: InkGuard, stroke_
     return max(tips, key=lambda tip: float(np.linalg.norm(tip - xy[at])), default=None)
 
 
+def _reverses(xy: np.ndarray, arc: np.ndarray, i: int, stroke_width: float, closed: bool) -> bool:
+    """Whether the pen reverses its heading at `xy[i]` (a V): the two sides, `FORK_V_SIDES`
+    widths along the line, open at most `FORK_V_MAX` degrees and end more than a width apart
+    (not a turn back over one branch, both sides the same points, nor a bend into another stroke)."""
+    reach = FORK_V_SIDES * stroke_width
+    if closed or arc[i] < reach or arc[i] + reach > arc[-1]:
+        return False
+    ends = np.array([[np.interp(arc[i] + d, arc, xy[:, k]) for k in (0, 1)] for d in (-reach, reach)])
+    sides = ends - xy[i]
+    norms = float(np.linalg.norm(sides[0]) * np.linalg.norm(sides[1]))
+    cos = float(np.dot(sides[0], sides[1])) / max(norms, 1e-9)
+    return cos > np.cos(np.radians(FORK_V_MAX)) and float(np.linalg.norm(ends[1] - ends[0])) > stroke_width
+
+
+def corner_tip(xy: np.ndarray, arc: np.ndarray, at: int, guard: InkGuard, stroke_width: float,
+               closed: bool) -> np.ndarray | None:
+    """Where the pen turned at the corner `xy[at]` (not a fork): the ink's tip along the
+    bisector (`tip_in_ink`) or, where the pen reverses its heading, the tip of ink no medial
+    ball holds (`_fork_tip`), whichever lies farther; None when neither is found.
+
+    A cusp whose sides merge for a long way (a u's entry cusp 14 degrees wide with a hook at
+    its tip: the_little_duck_had_tea-4-9) loses its spur to pruning 2-3 widths below its tip;
+    the ink runs on beyond `tip_in_ink`'s 3 widths (7.5 px at a 2.3 px line), or the tip lies
+    off the bisector where the pen hooked into the turn. Ink beyond every ball is the pruned
+    spur's own, so it is looked for out to `FORK_REACH` widths and `FORK_FAN` degrees either side.
+    """
+    tip = tip_in_ink(xy, arc, at, guard, stroke_width, closed)
+    if not _reverses(xy, arc, at, stroke_width, closed):
+        return tip
+    spur = _fork_tip(xy, arc, at, guard, stroke_width, closed)
+    if spur is None or (tip is not None and np.linalg.norm(tip - xy[at]) >= np.linalg.norm(spur - xy[at])):
+        return tip
+    return spur
+
+
+# A turn of the traced line that `fitting.sharp_corners` does not call a corner, because the axis
+# rounds it off where a cusp's spur was pruned (i_like_mint_tea_at_midday-4-14's m entry: 111
+# degrees over 1.5 widths, 65 of them within half a width, 0.6 needed), is a corner when the pen
+# reverses there and the ink shows a tip no medial ball holds: it turns more than TURN_MIN
+# degrees over 1.5 widths either side, the least any corner turns.
+TURN_MIN = 40.0
+
+
+def pruned_cusps(xy: np.ndarray, wide: np.ndarray, free: np.ndarray, guard: InkGuard, stroke_width: float,
+                 closed: bool) -> np.ndarray:
+    """Indices of the turns of the traced line ((N, 2) px) where a cusp's spur was pruned: the
+    sharpest point of each run of turns over `TURN_MIN` degrees (`wide`: (N,) rad over 1.5
+    widths either side), where `free` ((N,) bool) allows a corner, the pen reverses its heading
+    (`_reverses`) and `_fork_tip` finds ink beyond every ball (the spur's)."""
+    arc = arc_lengths(xy)
+    found = []
+    turning = wide > np.radians(TURN_MIN)
+    # runs of turning points: one candidate each, its sharpest
+    edges = np.flatnonzero(np.diff(np.r_[0, turning.astype(np.int8), 0]))
+    for lo, hi in zip(edges[::2], edges[1::2]):
+        i = lo + int(np.argmax(wide[lo:hi]))
+        if not free[lo:hi].all() or not _reverses(xy, arc, i, stroke_width, closed):
+            continue
+        if _fork_tip(xy, arc, i, guard, stroke_width, closed) is not None:
+            found.append(i)
+    return np.array(found, dtype=int)
+
+
 def with_fork_tips(xy, keep, split, corner, junction, twins, guard: InkGuard, stroke_width: float,
                    closed: bool):
     """The traced arrays with a spike out to each fork's tip (`_fork_tip`) and back: the
@@ -105,19 +169,8 @@ def with_fork_tips(xy, keep, split, corner, junction, twins, guard: InkGuard, st
     arrays as `fitting.fit_stroke` holds them."""
     arc = arc_lengths(xy)
 
-    def a_v(i: int) -> bool:
-        # The pen reverses its heading (a V), not a turn back over one branch (both sides the
-        # same points) nor a bend into another stroke.
-        reach = FORK_V_SIDES * stroke_width
-        if closed or arc[i] < reach or arc[i] + reach > arc[-1]:
-            return False
-        ends = np.array([[np.interp(arc[i] + d, arc, xy[:, k]) for k in (0, 1)] for d in (-reach, reach)])
-        sides = ends - xy[i]
-        norms = float(np.linalg.norm(sides[0]) * np.linalg.norm(sides[1]))
-        cos = float(np.dot(sides[0], sides[1])) / max(norms, 1e-9)
-        return cos > np.cos(np.radians(FORK_V_MAX)) and float(np.linalg.norm(ends[1] - ends[0])) > stroke_width
-
-    turns = [int(i) for i in np.flatnonzero(split & junction) if 0 < i < len(xy) - 1 and a_v(int(i))]
+    turns = [int(i) for i in np.flatnonzero(split & junction)
+             if 0 < i < len(xy) - 1 and _reverses(xy, arc, int(i), stroke_width, closed)]
     tips = {i: tip for i in turns if (tip := _fork_tip(xy, arc, i, guard, stroke_width, closed)) is not None}
     if tips:
         corner = corner.copy()
