@@ -102,3 +102,17 @@ def test_a_cursive_entry_cusp_is_covered(index, tip):
     scores = ink_scores(gt, drawing, order_tolerance(gt.width))
     assert scores.uncovered <= order_tolerance(gt.width)
     assert scores.excursion <= excursion_bound(gt.width)
+
+
+def test_a_corner_beside_a_fork_stays_on_the_line():
+    """handy_lady_tidy_attic-3-18, 3 px: the route turns at a fork into an a's stem, and the
+    fit found a corner 0.46 px past that split. Its joint went where the tangents of the piece
+    between them (four axis points) and the stem meet: 3.2 px off the line, and the stem's two
+    passes, fitted from there, left the bowl's closing stroke beside them 3.9 px uncovered.
+    A corner within a width of a split is the split's own turn."""
+    gt = cursive_drawing(3, 18)
+    result = vectorize_image(render_truth(gt), VectorizeOptions(multi=False, classifier="cnn", seed=0))
+    assert len(result.drawing.strokes) == 1
+    scores = ink_scores(gt, result.drawing, order_tolerance(gt.width))
+    assert scores.uncovered <= order_tolerance(gt.width)
+    assert scores.excursion <= excursion_bound(gt.width)

@@ -298,10 +298,14 @@ def fit_stroke(traced: TracedPoints, *, closed: bool, sigma: float, stroke_width
     corner = np.zeros(len(xy), dtype=bool)
     junction = np.zeros(len(xy), dtype=bool) if traced.junction is None else np.array(traced.junction, dtype=bool)
     found = sharp_corners(xy, stroke_width, closed=closed)
-    corner[found[keep[found] & ~split[found]]] = True
+    arc = arc_lengths(xy)
+    # A corner within a width of a split is the split's own turn (the route turning at a fork
+    # is split there): the piece between them is a few tenths of a pixel long, and the
+    # corner's joint, placed where its tangents meet, went 3 px off the line.
+    found = found[keep[found] & (along_distance(arc, split)[found] > stroke_width)]
+    corner[found] = True
     if guard is not None and len(xy) >= 5:
         # A cusp whose pruned spur left the axis's turn too round for a corner (`tips.pruned_cusps`).
-        arc = arc_lengths(xy)
         free = keep & ~split & ~junction & (along_distance(arc, corner) > 2.0 * stroke_width)
         corner[pruned_cusps(xy, _turn(xy, arc, 1.5 * stroke_width, closed), free, guard, stroke_width, closed)] = True
     if traced.corner is not None:
