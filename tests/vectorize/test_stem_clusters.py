@@ -14,9 +14,13 @@ from vectorize import VectorizeOptions, vectorize_image
 @pytest.mark.parametrize("seed, index, center, half", [
     (0, 38, (117.0, 517.0), 60.0),  # "the" of the_acid_ate_the_metal, 3.5 px: crossed 45.6 px off before
     (1, 37, (897.0, 507.0), 40.0),  # "ht" of the_planet_men_tend_the_yacht, 2.25 px: 6.5 px off before
+    # "ch" of the_chemical_plant_in_the_dell, drawn 2.25 px wide and measured 1.5: the hole's far
+    # side is 9.0 measured widths long, more than a short branch; 6.1 px off before
+    (2, 38, (212.0, 495.0), 60.0),
 ])
 def test_an_h_base_crosses_where_the_way_in_and_the_way_down_do(seed, index, center, half):
-    """The medial axis there is four or five junctions round a hole; read one at a time,
+    """The medial axis there is four or five junctions round a hole (one of its sides may be
+    longer than the branches that found the cluster); read one at a time,
     the way down ran along the band's far side and crossed the way in away from the true
     crossing (or not at all). Read as one, the two cross in the band they share."""
     from benchmarks.common.render import render
