@@ -25,7 +25,7 @@ from vectorize.fit.ink_width import edge_offset, ink_widths
 from vectorize.fit.retraces import Twin, foot_is_retraced, trimmed_twins, twin_spans
 from vectorize.junctions.classifiers import make_classifier, shipped_pass_scorer
 from vectorize.junctions.crossing_point import crossing_point, passes_crossing
-from vectorize.junctions.intersections import (Junction, JunctionVerdict, lone_junctions, ranked_pairings,
+from vectorize.junctions.intersections import (Junction, JunctionVerdict, along_line, lone_junctions, ranked_pairings,
                                               sharp_touch)
 from vectorize.junctions.junction_ink import own_ink, own_ink_reach
 from vectorize.options import InputFrame, VectorizeOptions, VectorizeReport, VectorizeResult
@@ -347,8 +347,9 @@ def _order(graph: MedialGraph, ink, options: VectorizeOptions, ends: int, clock:
             if junction_list else []
         if options.classifier == "cnn" and junction_list:
             geometry = make_classifier("geometric").classify(ink.gray, junction_list, w)
-            lone = lone_junctions(np.array([j.center for j in junction_list]),
-                                  np.array([graph.spans.get(n, 0.0) for n in simple.crossings]), 2.5 * w)
+            spans = np.array([graph.spans.get(n, 0.0) for n in simple.crossings])
+            lone = lone_junctions(np.array([j.center for j in junction_list]), spans, 2.5 * w,
+                                  along_line(graph, simple.crossings, 2.5 * w + 2.0 * float(spans.max())))
             verdict_list = [_with_geometry(v, g, sharp_touch(j.directions) and alone)
                             for v, g, j, alone in zip(verdict_list, geometry, junction_list, lone)]
         verdicts = dict(zip(simple.crossings, verdict_list))

@@ -12,11 +12,14 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Protocol
+from typing import TYPE_CHECKING, Protocol
 
 import numpy as np
 
 from vectorize.axis.clusters import pass_bends
+
+if TYPE_CHECKING:
+    from vectorize.axis.graph import MedialGraph
 
 
 # A configuration pairs the four branch slots 0..3 into two passes through the node.
@@ -122,16 +125,36 @@ def sharp_touch(directions: np.ndarray) -> bool:
     return touch > TOUCH_MAX_BEND and straight < STRAIGHT_MAX_BEND
 
 
-def lone_junctions(centers: np.ndarray, spans: np.ndarray, reach: float) -> np.ndarray:
+def lone_junctions(centers: np.ndarray, spans: np.ndarray, reach: float, apart: np.ndarray | None = None) -> np.ndarray:
     """(N,) bool: no other junction within `reach` px plus both junctions' spans (px of
     shared ink, (N,)) of each centre ((N, 2) px). Branch directions measured `reach` beyond
     a junction's span run through a nearer one's ink (two crossings in one band of three
-    passes): there they do not show how the strokes bend."""
+    passes): there they do not show how the strokes bend. apart: (N, N) px between the
+    junctions along the line (`along_line`), where the directions are measured; default:
+    straight between the centres (never more than along the line)."""
     c = np.asarray(centers, dtype=float).reshape(-1, 2)
     s = np.asarray(spans, dtype=float).reshape(-1)
-    gap = np.hypot(*(c[:, None, :] - c[None, :, :]).transpose(2, 0, 1)) - s[:, None] - s[None, :]
+    if apart is None:
+        apart = np.hypot(*(c[:, None, :] - c[None, :, :]).transpose(2, 0, 1))
+    gap = np.array(apart, dtype=float) - s[:, None] - s[None, :]
     np.fill_diagonal(gap, np.inf)
     return gap.min(axis=1, initial=np.inf) >= reach
+
+
+def along_line(graph: MedialGraph, nodes: Sequence[int], limit: float) -> np.ndarray:
+    """(N, N) px between `nodes` of `graph` along its branches (inf beyond `limit` px): a
+    junction two letters away round a loop may lie near in the image, but the branch
+    directions read from the other reach it only after the loop's length."""
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import dijkstra
+
+    index = {n: i for i, n in enumerate(graph.incident)}
+    branches = list(graph.branches.values())
+    matrix = coo_matrix(([max(b.length, 1e-6) for b in branches],
+                         ([index[b.a] for b in branches], [index[b.b] for b in branches])),
+                        shape=(len(index), len(index))).tocsr()
+    at = [index[n] for n in nodes]
+    return dijkstra(matrix, directed=False, indices=at, limit=limit)[:, at]
 
 
 # Degrees. Touches: the touching pairing bends <= 28; cursive e entries bend 21-30 going
