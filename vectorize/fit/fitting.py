@@ -260,7 +260,7 @@ def _open_fit(points: np.ndarray, sigma: float) -> np.ndarray:
 
 
 def _settle(pieces: list[np.ndarray], cuts: list[int], xy: np.ndarray, twins: list[Twin],
-            guard: InkGuard, sigma: float) -> None:
+            guard: InkGuard, sigma: float, inside: list[np.ndarray | None]) -> None:
     """In place, last: every piece of the curve as written lies in the ink.
 
     The joints move piece ends (to where two sides meet at a corner, to the middle of two
@@ -269,7 +269,9 @@ def _settle(pieces: list[np.ndarray], cuts: list[int], xy: np.ndarray, twins: li
     corner cut across the paper, a loop's end pulled onto a spike's other joint). Each piece
     that strays now is refitted on all of its traced points between its final ends, so no
     joint moves again; a later pass takes its earlier twin's settled curve (settled first:
-    it comes earlier) when their ends still agree.
+    it comes earlier) when their ends still agree. inside: per piece, the curve found in the
+    ink when it was fitted (None: not checked there); a piece still equal to it is not
+    measured again (the joints leave most pieces as they were).
     """
     index = {(lo, hi): k for k, (lo, hi) in enumerate(zip(cuts[:-1], cuts[1:]))}
     for k, (lo, hi) in enumerate(zip(cuts[:-1], cuts[1:])):
@@ -279,6 +281,8 @@ def _settle(pieces: list[np.ndarray], cuts: list[int], xy: np.ndarray, twins: li
             copy = pieces[j][::-1, ::-1] if source[2] else pieces[j]
             if np.array_equal(copy[0, 0], pieces[k][0, 0]) and np.array_equal(copy[-1, 3], pieces[k][-1, 3]):
                 pieces[k] = np.array(copy)
+        if inside[k] is not None and np.array_equal(inside[k], pieces[k]):
+            continue
         if curve_excess(guard, pieces[k])[0] <= 0.0:
             continue
         whole = xy[lo:hi + 1].copy()
@@ -346,6 +350,7 @@ def fit_stroke(traced: TracedPoints, *, closed: bool, sigma: float, stroke_width
     dense = along_distance(arc, ~keep) <= DENSE * stroke_width
     cuts = [0] + [int(i) for i in np.flatnonzero(split) if 0 < i < len(xy) - 1] + [len(xy) - 1]
     pieces = []
+    inside: list[np.ndarray | None] = []  # per piece: its curve when found in the ink (`_settle`)
     previous = None
     fitted: dict[tuple[int, int], int] = {}
     for lo, hi in zip(cuts[:-1], cuts[1:]):
@@ -354,6 +359,7 @@ def fit_stroke(traced: TracedPoints, *, closed: bool, sigma: float, stroke_width
             # The later pass over a retraced stretch: the earlier pass's curve.
             control = pieces[fitted[source[:2]]]
             pieces.append(np.array(control[::-1, ::-1] if source[2] else control))
+            inside.append(None)
             previous = None
             continue
         mask = keep[lo:hi + 1].copy()
@@ -368,6 +374,7 @@ def fit_stroke(traced: TracedPoints, *, closed: bool, sigma: float, stroke_width
             # The way back from a retraced spike: exactly the way out, reversed, so the
             # two passes lie on each other instead of crossing back and forth.
             control = pieces[-1][::-1, ::-1]
+            checked = None
         else:
             settings = dict(closed=closed and len(cuts) == 2, sigma=sigma, anchor=not (corner[lo] or corner[hi]))
             # A long piece is first fitted on about one point per THIN widths away from its
@@ -376,7 +383,9 @@ def fit_stroke(traced: TracedPoints, *, closed: bool, sigma: float, stroke_width
             # before the guard's ladder: thinned knots can swing across a long uncertain stretch.
             spacing = min(THIN * stroke_width, THIN_MAX) if len(piece) > THIN_FROM else 0.0
             control = fit_piece(piece, **settings, spacing=spacing, dense=near)
-            if guard is not None and curve_excess(guard, control)[0] > 0.0:
+            worst = curve_excess(guard, control)[0] if guard is not None else 0.0
+            checked = np.array(control) if guard is not None and worst <= 0.0 else None
+            if worst > 0.0:
                 if spacing:
                     control = fit_piece(piece, **settings)
                 # Measured against every traced point of the piece, the uncertain ones too.
@@ -387,6 +396,7 @@ def fit_stroke(traced: TracedPoints, *, closed: bool, sigma: float, stroke_width
         previous = piece
         fitted[(lo, hi)] = len(pieces)
         pieces.append(np.array(control))  # writable: the joints move its ends
+        inside.append(checked)
     # Join the pieces: at corners where their sides meet, elsewhere where they end.
     joints = list(zip(range(len(pieces) - 1), range(1, len(pieces)), cuts[1:-1]))
     if corner[0] and corner[-1] and len(pieces) > 1:
@@ -422,6 +432,6 @@ def fit_stroke(traced: TracedPoints, *, closed: bool, sigma: float, stroke_width
         after[0, 0] = point
     share_pieces(twins, cuts, pieces)
     if guard is not None and not (closed and len(pieces) == 1):  # a closed piece was checked when fitted
-        _settle(pieces, cuts, xy, twins, guard, sigma)
+        _settle(pieces, cuts, xy, twins, guard, sigma, inside)
     control = np.concatenate(pieces, axis=0)
     return Stroke(control)
