@@ -169,11 +169,18 @@ def test_edge_offset_read_in_chunks_is_the_whole_profiles(name, monkeypatch):
 
 
 def test_paper_median_without_sorting_is_numpys():
-    from vectorize.fit.ink_width import _median
+    from vectorize.fit.ink_width import _median_where
 
     rng = np.random.default_rng(3)
     for n in (1, 2, 3, 4, 5, 10, 11, 1000, 1001):
         for top_share in (0.0, 0.4, 0.5, 0.6, 0.9, 1.0):
-            values = rng.random(n).astype(np.float32)
-            values[rng.random(n) < top_share] = 1.0
-            assert _median(values) == float(np.median(values)), (n, top_share)
+            for kept in (0.0, 0.5, 0.9, 1.0):  # the share of values asked for (the paper's)
+                values = rng.random(n).astype(np.float32)
+                values[rng.random(n) < top_share] = 1.0
+                where = rng.random(n) < kept
+                expected = float(np.median(values[where])) if where.any() else 1.0
+                assert _median_where(values, where) == expected, (n, top_share, kept)
+                grid = values[: n - n % 2].reshape(2, -1)[:, ::2]  # a strided 2-D view, as edge_offset reads
+                mask = where[: n - n % 2].reshape(2, -1)[:, ::2]
+                expected = float(np.median(grid[mask])) if mask.any() else 1.0
+                assert _median_where(grid, mask) == expected, (n, top_share, kept)

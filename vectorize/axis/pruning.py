@@ -31,9 +31,11 @@ def prune(graph: MedialGraph, *, threshold: float, stroke_width: float) -> int:
     removed = 0
     incident, radii = graph.incident, graph.radii
     while True:
-        measure_short(list(graph.branches.values()))
+        # Only a branch at a free end can be a spur: the others are not looked at.
+        leaves = {bid: graph.branches[bid] for bid in sorted({inc[0] for inc in incident.values() if len(inc) == 1})}
+        measure_short(list(leaves.values()))
         doomed = []
-        for bid, branch in graph.branches.items():
+        for bid, branch in leaves.items():
             a, b = branch.a, branch.b
             leaf_a, leaf_b = len(incident[a]) == 1, len(incident[b]) == 1
             if a == b or leaf_a == leaf_b:

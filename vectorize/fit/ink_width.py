@@ -74,7 +74,7 @@ def edge_offset(gray: np.ndarray, ink: np.ndarray, rings: list[np.ndarray], thre
     stride = max(1, int(np.sqrt(ink.size / 250_000)))  # levels from a quarter-million pixels at most
     dark = float(np.percentile(gray[ink], 5))
     sparse, sparse_ink = gray[::stride, ::stride], ink[::stride, ::stride]
-    paper = _median(sparse[~sparse_ink]) if (~sparse_ink).any() else 1.0
+    paper = _median_where(sparse, ~sparse_ink)
     middle = 0.5 * (dark + paper)
     if not paper > dark:
         return 0.0
@@ -111,14 +111,18 @@ def edge_offset(gray: np.ndarray, ink: np.ndarray, rings: list[np.ndarray], thre
     return float(direction * np.median(steps[first]))
 
 
-def _median(values: np.ndarray) -> float:
-    """`np.median` of `values` (N,), without sorting when more than half of them are the
-    largest value (the paper of a clean drawing, all at one level): then both middle values
-    are that value."""
+def _median_where(values: np.ndarray, where: np.ndarray) -> float:
+    """`np.median(values[where])` (1.0 when `where` is all False), without gathering or
+    sorting the values when more than half of them are the largest of all `values` (the
+    paper of a clean drawing, all at one level, is brighter than the ink): then both middle
+    values are that value. values, where: arrays of one shape, `where` bool."""
+    count = np.count_nonzero(where)
+    if not count:
+        return 1.0
     top = values.max()
-    if 2 * np.count_nonzero(values == top) > len(values) + 2:
+    if 2 * np.count_nonzero((values == top) & where) > count + 2:
         return float(top)
-    return float(np.median(values))
+    return float(np.median(values[where]))
 
 
 def _corners(stroke: Stroke) -> tuple[np.ndarray, np.ndarray]:
