@@ -40,7 +40,7 @@ with open(listing, "w") as fh:
 NOT_IMPORTED = ("rich", "vectorize.debug_overlay", "vectorize.refine.refine", "vectorize.refine.pass_choices", "skimage.transform._warps", "skimage.filters._gaussian",
                 "fabrication.embroidery", "fabrication.laser", "fabrication.studio", "machines",
                 "pyembroidery", "svgelements", "torch", "xml.sax", "urllib.request", "http.client", "ssl",
-                "vectorize.refine.edits")
+                "vectorize.refine.edits", "vectorize.raster.scan_bands", "mmap")  # bands: images over 2x max_size
 
 
 def _run(tmp_path: Path, *args: str) -> tuple[dict, subprocess.CompletedProcess]:

@@ -11,7 +11,6 @@ from PIL import Image, UnidentifiedImageError
 from onestroke.errors import InputError
 from onestroke.paths import check_input_file
 from vectorize.options import InputFrame
-from vectorize.raster import scan_bands
 
 # Largest image read (decoded pixels): a 1200 dpi A4 scan is 139 Mpx; beyond this a file is
 # refused right after its header is read, before any decoding. This check replaces Pillow's
@@ -81,6 +80,10 @@ def load_image(path: str | os.PathLike, *, max_size: int | None = None):
 def _read_reduced(image: Image.Image, factor: int) -> np.ndarray:
     """The working image box-averaged by `factor`, read a band at a time (vectorize.raster.scan_bands):
     a PNG streamed, anything else decoded in its native mode only."""
+    # Imported here: only an image larger than twice the working size is read in bands, and a
+    # command pays for every module it imports (this one brings `mmap`).
+    from vectorize.raster import scan_bands
+
     if scan_bands.can_stream(image):  # its only deep mode is I;16, whose top needs no maximum
         return scan_bands.reduce_png_stream(image, factor, lambda band: _working(band, _gray_top(band, 0.0)))
     image.load()
