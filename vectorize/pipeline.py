@@ -20,17 +20,21 @@ __all__ = ["InputFrame", "VectorizeOptions", "VectorizeReport", "VectorizeResult
            "vectorize_image"]
 
 
-def import_stages_for(path: str | os.PathLike) -> None:
+def import_stages_for(path: str | os.PathLike, *, li_threshold: bool = False) -> None:
     """Import the modules that vectorizing the file `path` uses, which `vectorize_file`
     otherwise imports as it reaches them: a raster drawing's stages (reading an SVG of
-    strokes needs none of scipy, so for an SVG nothing). For a caller that wants them loaded
-    before the work starts, such as a command that then leaves the loaded objects out of the
-    garbage collector's passes (`fabrication.cli.heap`)."""
+    strokes needs none of scipy, so for an SVG nothing), and with `li_threshold` (a run that
+    leaves the threshold to Li's method) scikit-image's filters. For a caller that wants them
+    loaded before the work starts, such as a command that then leaves the loaded objects out
+    of the garbage collector's passes (`fabrication.cli.heap`)."""
     if os.path.splitext(str(path))[1].lower() in (".svg", ".svgz"):
         return
     from vectorize.fit import fitting  # noqa: F401 - imported for its side effect
     from vectorize import vectorizer  # noqa: F401
     from vectorize.raster import image_io  # noqa: F401
+
+    if li_threshold:
+        from skimage.filters import threshold_li  # noqa: F401 - what `binarize.ink_threshold` imports
 
 
 def vectorize_file(path: str | os.PathLike, options: VectorizeOptions = VectorizeOptions(), *,

@@ -182,7 +182,7 @@ def read_drawing(path: str, *, multi: bool = False, threshold: float | None = No
         from vectorize.pipeline import import_stages_for
         from vectorize.refine.edits import read_edits
 
-        import_stages_for(path)
+        import_stages_for(path, li_threshold=threshold is None and edits is None)
     replay = read_edits(edits) if edits is not None else None
     result = vectorize_file(path, VectorizeOptions(multi=multi, threshold=threshold, blur=blur,
                                                    classifier=classifier), edits=replay,

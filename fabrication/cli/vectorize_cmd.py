@@ -60,7 +60,7 @@ def vectorize(source: str, output: str, multi: bool, threshold: float | None, bl
         from vectorize.pipeline import import_stages_for
         from vectorize.svg_write import write_drawing
 
-        import_stages_for(source)
+        import_stages_for(source, li_threshold=threshold is None and edits is None)
     keep_freed_memory()  # the image's arrays reuse freed heap memory
 
     placement = None  # the page at the design's size; None: the input's own page (in mm with --inkstitch)

@@ -29,10 +29,12 @@ except SystemExit as done:
     code = done.code
 import gc
 fitting = sys.modules.get("vectorize.fit.fitting")
+li = sys.modules.get("skimage.filters.thresholding")
 collected = {id(o) for o in gc.get_objects()}  # what the collector still goes through
 with open(listing, "w") as fh:
     json.dump({"exit": code, "modules": sorted(sys.modules), "frozen": gc.get_freeze_count(),
-               "fitting collected": fitting is not None and id(fitting.fit_stroke) in collected}, fh)
+               "fitting collected": fitting is not None and id(fitting.fit_stroke) in collected,
+               "li collected": li is not None and id(li.threshold_li) in collected}, fh)
 """
 
 # Not on the path of a plain `onestroke vectorize IN.png -o OUT.svg` with stderr in a pipe.
@@ -67,6 +69,8 @@ def test_vectorize_imports_only_what_the_run_uses(tmp_path):
     # The libraries and the stages were loaded before the work and then left out of the
     # garbage collector's passes (`fabrication.cli.heap.freeze_loaded_objects`).
     assert result["frozen"] > 10_000 and not result["fitting collected"]
+    # Li's threshold (scikit-image's filters) too, which the run's threshold stage uses.
+    assert "skimage.filters.thresholding" in modules and not result["li collected"]
 
     # --debug asks for the overlay: then it is imported and its images written.
     debug = tmp_path / "debug"
