@@ -22,6 +22,7 @@ docs/benchmark.md says exactly how each is measured.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -142,7 +143,10 @@ def _pairing_cost(dist: np.ndarray) -> float:
                                   if np.isfinite(dist[i, j]))
     graph.add_weighted_edges_from((i, free, 0) for i in range(k) for free in ("free a", "free b"))
     graph.add_edge("free a", "free b", weight=0)
-    return sum(float(dist[u, v]) for u, v in nx.min_weight_matching(graph) if isinstance(u, int) and isinstance(v, int))
+    # fsum: the matching's pairs come in an order that follows the hash seed, and a plain sum
+    # of floats in another order differs in its last bit (the minimum then wobbled by 1 ULP).
+    return math.fsum(float(dist[u, v]) for u, v in nx.min_weight_matching(graph)
+                     if isinstance(u, int) and isinstance(v, int))
 
 
 def min_traversal_length(graph: InkGraph) -> float:

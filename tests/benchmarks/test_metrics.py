@@ -349,6 +349,20 @@ def test_minimum_traversal_is_route_inspection():
     assert min_traversal_length(ink_graph(square)) == pytest.approx(40.0)
 
 
+
+def test_minimum_pairing_is_one_rounding_of_the_matched_distances():
+    """The matching returns its pairs in an order that follows the hash seed; the minimum must
+    not depend on it: it is the matched distances' exact sum, rounded once."""
+    from benchmarks.metrics.ink import _pairing_cost
+
+    # eight odd nodes in four far-apart pairs 0.1, 0.2, 0.3 and 0.7 px apart: the pen's two ends
+    # take the 0.7 pair, and 0.1 + 0.2 + 0.3 summed left to right is 0.6000000000000001
+    pos = np.array([[0, 0], [0, 0.1], [1000, 0], [1000, 0.2], [0, 1000], [0, 1000.3], [500, 500], [500, 500.7]])
+    dist = np.hypot(*(pos[:, None] - pos[None]).transpose(2, 0, 1))
+    for a, gap in ((0, 0.1), (2, 0.2), (4, 0.3), (6, 0.7)):
+        dist[a, a + 1] = dist[a + 1, a] = gap
+    assert _pairing_cost(dist) == 0.6
+
 def _fork():
     """A Y whose two arms are equal free stubs: either could be the retraced one."""
     from benchmarks.sets.hershey import Glyph, glyph_ground_truth
