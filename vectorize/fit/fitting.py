@@ -212,7 +212,13 @@ def sharp_corners(xy: np.ndarray, stroke_width: float, *, closed: bool) -> np.nd
     if len(xy) < 5:
         return np.zeros(0, dtype=int)
     arc = arc_lengths(xy)
-    wide = _turn(xy, arc, 1.5 * stroke_width, closed)
+    return _sharp_corners(xy, arc, _turn(xy, arc, 1.5 * stroke_width, closed), stroke_width, closed)
+
+
+def _sharp_corners(xy: np.ndarray, arc: np.ndarray, wide: np.ndarray, stroke_width: float,
+                   closed: bool) -> np.ndarray:
+    """`sharp_corners` of a line of 5 points or more, given its arc lengths and its turn over
+    1.5 widths (`_turn`), which `fit_stroke` reads again for `tips.pruned_cusps`."""
     narrow = _turn(xy, arc, 0.5 * stroke_width, closed)
     candidate = (wide > np.radians(40.0)) & (narrow > 0.6 * wide)
     corners: list[int] = []
@@ -301,17 +307,18 @@ def fit_stroke(traced: TracedPoints, *, closed: bool, sigma: float, stroke_width
     split = np.array(traced.split, dtype=bool)
     corner = np.zeros(len(xy), dtype=bool)
     junction = np.zeros(len(xy), dtype=bool) if traced.junction is None else np.array(traced.junction, dtype=bool)
-    found = sharp_corners(xy, stroke_width, closed=closed)
     arc = arc_lengths(xy)
+    wide = _turn(xy, arc, 1.5 * stroke_width, closed) if len(xy) >= 5 else None
+    found = _sharp_corners(xy, arc, wide, stroke_width, closed) if wide is not None else np.zeros(0, dtype=int)
     # A corner within a width of a split is the split's own turn (the route turning at a fork
     # is split there): the piece between them is a few tenths of a pixel long, and the
     # corner's joint, placed where its tangents meet, went 3 px off the line.
     found = found[keep[found] & (along_distance(arc, split)[found] > stroke_width)]
     corner[found] = True
-    if guard is not None and len(xy) >= 5:
+    if guard is not None and wide is not None:
         # A cusp whose pruned spur left the axis's turn too round for a corner (`tips.pruned_cusps`).
         free = keep & ~split & ~junction & (along_distance(arc, corner) > 2.0 * stroke_width)
-        corner[pruned_cusps(xy, _turn(xy, arc, 1.5 * stroke_width, closed), free, guard, stroke_width, closed)] = True
+        corner[pruned_cusps(xy, arc, wide, free, guard, stroke_width, closed)] = True
     if traced.corner is not None:
         corner |= np.asarray(traced.corner, dtype=bool)
     split |= corner

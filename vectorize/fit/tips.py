@@ -140,13 +140,13 @@ def corner_tip(xy: np.ndarray, arc: np.ndarray, at: int, guard: InkGuard, stroke
 TURN_MIN = 40.0
 
 
-def pruned_cusps(xy: np.ndarray, wide: np.ndarray, free: np.ndarray, guard: InkGuard, stroke_width: float,
-                 closed: bool) -> np.ndarray:
-    """Indices of the turns of the traced line ((N, 2) px) where a cusp's spur was pruned: the
-    sharpest point of each run of turns over `TURN_MIN` degrees (`wide`: (N,) rad over 1.5
-    widths either side), where `free` ((N,) bool) allows a corner, the pen reverses its heading
-    (`_reverses`) and `_fork_tip` finds ink beyond every ball (the spur's)."""
-    arc = arc_lengths(xy)
+def pruned_cusps(xy: np.ndarray, arc: np.ndarray, wide: np.ndarray, free: np.ndarray, guard: InkGuard,
+                 stroke_width: float, closed: bool) -> np.ndarray:
+    """Indices of the turns of the traced line ((N, 2) px; `arc` (N,) px: arc length at each
+    point) where a cusp's spur was pruned: the sharpest point of each run of turns over
+    `TURN_MIN` degrees (`wide`: (N,) rad over 1.5 widths either side), where `free` ((N,) bool)
+    allows a corner, the pen reverses its heading (`_reverses`) and `_fork_tip` finds ink
+    beyond every ball (the spur's)."""
     found = []
     turning = wide > np.radians(TURN_MIN)
     # runs of turning points: one candidate each, its sharpest
