@@ -37,14 +37,66 @@ def import_stages_for(path: str | os.PathLike, *, li_threshold: bool = False) ->
         from skimage.filters import threshold_li  # noqa: F401 - what `binarize.ink_threshold` imports
 
 
+class Binarizing:
+    """A raster file read, and its binarize stage (`binarize.paper_gray` and `ink_image` at
+    some options) running in a second thread: `image`, `frame` as `load_image` gives them,
+    `result()` the `InkImage` (waits for it; raises what the stage raised)."""
+
+    def __init__(self, image: np.ndarray, frame: InputFrame, options: VectorizeOptions) -> None:
+        from concurrent.futures import ThreadPoolExecutor
+
+        from vectorize.raster.binarize import ink_image, paper_gray
+
+        def binarized():
+            gray, scale = paper_gray(image, max_size=options.max_size, blur=options.blur, threads=1)
+            return ink_image(gray, scale, threshold=options.threshold, threads=1)
+
+        self.image, self.frame, self.options = image, frame, options
+        self._pool = ThreadPoolExecutor(max_workers=1, thread_name_prefix="binarize")
+        self._future = self._pool.submit(binarized)
+        self._pool.shutdown(wait=False)  # the thread ends with its one task
+
+    def result(self):
+        return self._future.result()
+
+
+def binarize_beside(path: str | os.PathLike, options: VectorizeOptions) -> Binarizing | None:
+    """Read the raster file `path` here and start its binarize stage in a second thread, for
+    a caller with other work to do meanwhile (`onestroke vectorize` imports the later
+    stages' libraries, which holds the GIL; the binarizing is mostly numpy and scipy.ndimage
+    loops that let go of it), to pass to `vectorize_file(..., binarizing=...)`. The thread
+    imports nothing (what the stage imports where used is imported here first), so it never
+    waits on the caller's imports. None where it would gain nothing: an SVG, or a machine
+    without a core to spare (`onestroke.cores.idle_cores`)."""
+    from onestroke.cores import idle_cores
+    from onestroke.paths import check_input_file
+
+    path = check_input_file(path, expect="an image or an SVG")
+    if os.path.splitext(path)[1].lower() in (".svg", ".svgz") or idle_cores() < 2:
+        return None
+    from vectorize.raster.binarize import import_used_for
+
+    image, frame = _raster(path, options)
+    import_used_for(np.asarray(image).shape, max_size=options.max_size, blur=options.blur,
+                    li_threshold=options.threshold is None)
+    return Binarizing(image, frame, options)
+
+
 def vectorize_file(path: str | os.PathLike, options: VectorizeOptions = VectorizeOptions(), *,
-                   edits=None, cache=None, progress=None) -> VectorizeResult:
+                   edits=None, cache=None, progress=None, binarizing: Binarizing | None = None) -> VectorizeResult:
     """Vectorize a raster image or read an SVG (strokes as they are; outlines to centre lines).
 
     edits: a `vectorize.refine.edits.Edits` to apply; cache: a `vectorize.refine.refine.StageCache`
     reused between calls on the same file (each edit then re-runs only later stages).
-    progress: an `onestroke.progress.ProgressCallback` for reading a large SVG.
+    progress: an `onestroke.progress.ProgressCallback` for reading a large SVG. binarizing:
+    `binarize_beside(path, options)`, the file read and being binarized (not with edits or a
+    cache).
     """
+    if binarizing is not None:
+        if binarizing.options != options:
+            raise ValueError("the file was binarized at other options")
+        return vectorize_image(binarizing.image, options, frame=binarizing.frame, edits=edits, cache=cache,
+                               binarized=binarizing.result)
     from onestroke.paths import check_input_file
 
     path = check_input_file(path, expect="an image or an SVG")
@@ -102,13 +154,14 @@ def _vectorize_svg(path: str, options: VectorizeOptions, edits=None, cache=None,
 
 
 def vectorize_image(image: np.ndarray, options: VectorizeOptions = VectorizeOptions(), *,
-                    frame: InputFrame | None = None, edits=None, cache=None) -> VectorizeResult:
+                    frame: InputFrame | None = None, edits=None, cache=None, binarized=None) -> VectorizeResult:
     """Vectorize a raster image: (H, W) gray or (H, W, 3|4) colour, uint8, uint16 or float in
     [0, 1] (1 = paper), or an (H, W) bool ink mask (True = ink; note that a PIL mode "1"
     image as an array is the opposite, True = white: convert it to "L" first).
 
     The drawing comes out in the image's pixels (pixel i covers [i, i + 1)), or in `frame`.
+    binarized: as `vectorizer.run_pipeline`'s.
     """
     from vectorize.vectorizer import run_pipeline
 
-    return run_pipeline(image, options, frame=frame, edits=edits, cache=cache)
+    return run_pipeline(image, options, frame=frame, edits=edits, cache=cache, binarized=binarized)

@@ -29,7 +29,7 @@ from vectorize.junctions.intersections import (Junction, JunctionVerdict, along_
                                               sharp_touch)
 from vectorize.junctions.junction_ink import own_ink, own_ink_reach
 from vectorize.options import InputFrame, VectorizeOptions, VectorizeReport, VectorizeResult
-from vectorize.raster.binarize import downscaled_gray, ink_image, ink_threshold, paper_gray
+from vectorize.raster.binarize import InkImage, downscaled_gray, ink_image, ink_threshold, paper_gray
 from vectorize.raster.outline import outline_rings
 from vectorize.route.retrace_paths import turn_prices, turns_at
 from vectorize.route.route_ends import end_costs
@@ -38,6 +38,8 @@ from vectorize.route.traversal import Ordering, half_turns, order_strokes, turn_
 from vectorize.stroke import Stroke, lengths
 
 if TYPE_CHECKING:  # the studio's refinement is imported where edits or a session ask for it
+    from collections.abc import Callable
+
     from vectorize.fit.fitting import TracedPoints
     from vectorize.refine.edits import Edits
     from vectorize.refine.refine import Refinement, StageCache
@@ -436,13 +438,18 @@ def threshold_mask(image: np.ndarray, options: VectorizeOptions, cache: StageCac
     return gray < level, level
 
 
-def _axis(image: np.ndarray, options: VectorizeOptions, clock: _Clock, cache: StageCache | None = None):
+def _axis(image: np.ndarray, options: VectorizeOptions, clock: _Clock, cache: StageCache | None = None,
+          binarized: Callable[[], InkImage] | None = None):
     """Binarize, outline and medial axis: the stages that threshold and blur change, and the
-    mode does not. Returns (ink, rings, graph before pruning)."""
+    mode does not. Returns (ink, rings, graph before pruning). binarized: gives the binarize
+    stage's result for this image and options, computed elsewhere (`pipeline.binarize_beside`)."""
     # Every piece of ink is kept here; in single-line mode the pieces of a line broken by
     # pen gaps are bridged later, and only then is the largest kept.
-    gray, scale = working_paper(image, options, cache)
-    ink = ink_image(gray, scale, threshold=options.threshold)
+    if binarized is not None:
+        ink = binarized()
+    else:
+        gray, scale = working_paper(image, options, cache)
+        ink = ink_image(gray, scale, threshold=options.threshold)
     clock.lap("binarize")
     w = ink.stroke_width
     spacing = float(np.clip(w / 8.0, 0.3, 1.0))
@@ -473,7 +480,8 @@ def output_matrix(ink_scale: float, frame: InputFrame) -> np.ndarray:
 
 
 def _front(image: np.ndarray, options: VectorizeOptions, clock: _Clock, cache: StageCache | None = None,
-           frame: InputFrame | None = None, edits: Edits | None = None):
+           frame: InputFrame | None = None, edits: Edits | None = None,
+           binarized: Callable[[], InkImage] | None = None):
     """Binarize, outline, medial axis, pruning and (single-line) gap bridging: the stages
     that only threshold, blur and mode change (and the edits' "unbridge" positions, in
     `frame`). Returns (ink, rings, graph, bridges, dropped, unbridged), bridges: the pen
@@ -483,7 +491,7 @@ def _front(image: np.ndarray, options: VectorizeOptions, clock: _Clock, cache: S
     With `cache`, the stages before pruning are shared between the modes (a copy of the
     cached graph is pruned) and the paper-flattened gray between thresholds."""
     if cache is None:
-        ink, rings, graph = _axis(image, options, clock)
+        ink, rings, graph = _axis(image, options, clock, binarized=binarized)
     else:
         key = (options.threshold, options.blur, options.max_size)
         ink, rings, graph = cache.stage("axis", key, lambda: _axis(image, options, clock, cache))
@@ -521,17 +529,21 @@ def _pixel_frame(image: np.ndarray) -> InputFrame:
 
 def run_pipeline(image: np.ndarray, options: VectorizeOptions, *,
                  frame: InputFrame | None = None, edits: Edits | None = None,
-                 cache: StageCache | None = None) -> VectorizeResult:
+                 cache: StageCache | None = None, binarized: Callable[[], InkImage] | None = None) -> VectorizeResult:
     """Vectorize `image`; the drawing comes out in `frame` (default: the image's pixels).
 
     edits: the user's corrections (`vectorize.refine.edits`); cache: a `StageCache` kept between
-    calls on the same image, so that an edit re-runs only the stages after it.
+    calls on the same image, so that an edit re-runs only the stages after it. binarized:
+    gives the binarize stage's `InkImage` of this image at these options, computed elsewhere
+    (`pipeline.binarize_beside`); not with edits or a cache.
     """
     clock = _Clock(cache.checkpoint if cache is not None else None)
     shape = np.asarray(image).shape
     if frame is None:
         frame = _pixel_frame(image)
     refining = edits is not None or cache is not None
+    if refining and binarized is not None:
+        raise ValueError("a binarize stage computed elsewhere cannot be refined (edits or a cache)")
     if refining:
         # Only the studio and --edits refine: a plain run never imports (or compiles) it.
         from vectorize.refine.edits import Edits
@@ -543,7 +555,7 @@ def run_pipeline(image: np.ndarray, options: VectorizeOptions, *,
         front = cache.front_for(image, options, lambda stages: _front(image, options, clock, stages, frame, edits),
                                 edits)
     else:
-        front = _front(image, options, clock)
+        front = _front(image, options, clock, binarized=binarized)
     ink, rings, graph, bridges, dropped, unbridged = front
     w = ink.stroke_width
     scale = ink.scale * frame.scale  # working px per output unit

@@ -57,7 +57,14 @@ def vectorize(source: str, output: str, multi: bool, threshold: float | None, bl
     # (fabrication/cli/heap.py); a raster drawing's stages load now for that.
     with loading_for_good():
         from vectorize import VectorizeOptions, vectorize_file
-        from vectorize.pipeline import import_stages_for
+        from vectorize.pipeline import binarize_beside, import_stages_for
+
+        options = VectorizeOptions(multi=multi, threshold=threshold, blur=blur, classifier=classifier,
+                                   keep_stages=debug_dir is not None, whole_image_confidence=debug_dir is not None)
+        # Without edits (which may change the threshold and blur), the drawing is read now and
+        # binarized on a spare core while the later stages' libraries load (the binarizing
+        # mostly runs outside the GIL, the imports hold it): the same ink, sooner.
+        binarizing = binarize_beside(source, options) if edits is None else None
         from vectorize.svg_write import write_drawing
 
         import_stages_for(source, li_threshold=threshold is None and edits is None)
@@ -74,10 +81,8 @@ def vectorize(source: str, output: str, multi: bool, threshold: float | None, bl
 
         replay = read_edits(edits)
     started = time.perf_counter()
-    options = VectorizeOptions(multi=multi, threshold=threshold, blur=blur, classifier=classifier,
-                               keep_stages=debug_dir is not None, whole_image_confidence=debug_dir is not None)
     with step(f"vectorizing {os.path.basename(source)}") as progress:
-        result = vectorize_file(source, options, edits=replay, progress=progress)
+        result = vectorize_file(source, options, edits=replay, progress=progress, binarizing=binarizing)
     for message in result.report.warnings:
         warn(message)
     drawing = result.drawing

@@ -458,13 +458,27 @@ def _kept_ink(ink: np.ndarray, longest: int, *, threads: int = 1) -> tuple[np.nd
 
 
 def paper_gray(image: np.ndarray, *, max_size: int, blur: float,
-               downscaled: tuple[np.ndarray, float] | None = None) -> tuple[np.ndarray, float]:
+               downscaled: tuple[np.ndarray, float] | None = None,
+               threads: int | None = None) -> tuple[np.ndarray, float]:
     """The working gray image with the paper's shading divided out (H, W) float32, and the
     scale: what the threshold does not change (`binarize` without the ink). downscaled:
     `downscaled_gray` of this image and max_size, when the caller has it (a blur does not
-    change it)."""
+    change it); threads: as `blurred`'s."""
     gray, scale = downscaled if downscaled is not None else downscaled_gray(image, max_size=max_size)
-    return flatten_paper(blurred(gray, blur)), scale
+    return flatten_paper(blurred(gray, blur, threads=threads)), scale
+
+
+def import_used_for(shape: tuple[int, ...], *, max_size: int, blur: float, li_threshold: bool) -> None:
+    """Import what `paper_gray` and `ink_image` import where used (scikit-image's rescale,
+    gaussian and Li's threshold, each only where needed: a command pays for every import)
+    for an image of this shape at these settings, so that a thread running them afterwards
+    imports nothing."""
+    if max(shape[:2]) > max_size:
+        from skimage.transform import rescale  # noqa: F401
+    if blur > 0:
+        from skimage.filters import gaussian  # noqa: F401
+    if li_threshold:
+        from skimage.filters import threshold_li  # noqa: F401
 
 
 def ink_image(gray: np.ndarray, scale: float, *, threshold: float | None, threads: int | None = None) -> InkImage:
