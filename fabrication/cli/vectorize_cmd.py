@@ -51,6 +51,11 @@ def vectorize(source: str, output: str, multi: bool, threshold: float | None, bl
 
         stage_images = [("--debug image", os.path.join(debug_dir, name)) for name in STAGE_IMAGES]
     check_distinct(inputs=[("input", source), ("--edits file", edits)], outputs=[("output", output), *stage_images])
+    placement = None  # the page at the design's size; None: the input's own page (in mm with --inkstitch)
+    if any(v is not None for v in (size, width, height)) or rotate:
+        from fabrication.placement import PlacementOptions
+
+        placement = PlacementOptions(size=size, width=width, height=height, rotate=rotate)
     from fabrication.cli.heap import keep_freed_memory, loading_for_good
 
     # The libraries load with the garbage collector paused and then stay out of its passes
@@ -70,11 +75,6 @@ def vectorize(source: str, output: str, multi: bool, threshold: float | None, bl
         import_stages_for(source, li_threshold=threshold is None and edits is None)
     keep_freed_memory()  # the image's arrays reuse freed heap memory
 
-    placement = None  # the page at the design's size; None: the input's own page (in mm with --inkstitch)
-    if any(v is not None for v in (size, width, height)) or rotate:
-        from fabrication.placement import PlacementOptions
-
-        placement = PlacementOptions(size=size, width=width, height=height, rotate=rotate)
     replay = None
     if edits is not None:  # the edits module only when there are edits to replay
         from vectorize.refine.edits import read_edits

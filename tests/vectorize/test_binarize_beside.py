@@ -134,3 +134,38 @@ def test_the_thread_imports_nothing(tmp_path, threshold, blur):
         assert result["made in"] and result["made in"][0].startswith("binarize")
         assert result["strokes"] == 1
         assert result["imports"] == []
+
+
+# The command line in a fresh process with `cores` idle cores; prints the threads the ink was made in.
+COMMAND = """
+import sys, threading
+import onestroke.cores
+cores, argv = int(sys.argv[1]), sys.argv[2:]
+onestroke.cores.idle_cores = lambda: cores
+import vectorize.raster.binarize as binarize
+ink_image, made_in = binarize.ink_image, []
+def recorded(*args, **kwargs):
+    made_in.append(threading.current_thread().name)
+    return ink_image(*args, **kwargs)
+binarize.ink_image = recorded
+sys.argv = ["onestroke", *argv]
+from fabrication.cli import main
+try:
+    main()
+except SystemExit as done:
+    print("made in", made_in, "exit", done.code)
+"""
+
+
+def test_the_command_binarizes_on_a_spare_core(tmp_path):
+    outputs = {}
+    for cores in (2, 1):
+        out = tmp_path / f"{cores}.svg"
+        done = subprocess.run([sys.executable, "-c", COMMAND, str(cores), "vectorize", str(EXAMPLES / "loops.png"),
+                               "-o", str(out)], capture_output=True, text=True, env=child_env(), timeout=300,
+                              cwd=tmp_path)
+        assert done.returncode == 0, done.stderr
+        made_in = done.stdout.strip().splitlines()[-1]
+        assert ("'binarize" in made_in) == (cores == 2) and made_in.endswith("exit 0"), made_in
+        outputs[cores] = out.read_bytes()
+    assert outputs[2] == outputs[1]
