@@ -157,11 +157,13 @@ except SystemExit as done:
 """
 
 
-def test_the_command_binarizes_on_a_spare_core(tmp_path):
+@pytest.mark.parametrize("command, suffix", [("vectorize", ".svg"), ("embroider", ".pes")])
+def test_the_command_binarizes_on_a_spare_core(tmp_path, command, suffix):
+    """`onestroke vectorize`, and the commands that read a drawing (`common.read_drawing`)."""
     outputs = {}
     for cores in (2, 1):
-        out = tmp_path / f"{cores}.svg"
-        done = subprocess.run([sys.executable, "-c", COMMAND, str(cores), "vectorize", str(EXAMPLES / "loops.png"),
+        out = tmp_path / f"{cores}{suffix}"
+        done = subprocess.run([sys.executable, "-c", COMMAND, str(cores), command, str(EXAMPLES / "loops.png"),
                                "-o", str(out)], capture_output=True, text=True, env=child_env(), timeout=300,
                               cwd=tmp_path)
         assert done.returncode == 0, done.stderr
