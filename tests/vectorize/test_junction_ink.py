@@ -105,17 +105,18 @@ def _junctions_at_crossings(seed: int, index: int):
 
 
 def test_the_cnn_reads_a_cursive_lines_crossings_from_their_own_ink():
-    """'the little duck had tea' (seed 0): with the whole word in its far crop, the shipped
-    model calls 5 of the line's 10 crossings crossings; shown each junction's own ink, 9
-    (measured)."""
+    """'the little duck had tea' (seed 0): of the line's 10 crossings, the base of the first
+    h ("the") is read from its medial tree (`stem_clusters`) and never shown to the model; of
+    the other 9, with the whole word in its far crop, the shipped model calls 5 crossings,
+    shown each junction's own ink, 8 (measured; the one missed is the second h's base)."""
     from vectorize.junctions.classifiers import make_classifier
 
     _, gray, width, near = _junctions_at_crossings(0, 13)
-    assert len(near) == 10 and all(j.ink is not None for j in near)
+    assert len(near) == 9 and all(j.ink is not None for j in near)
     cnn = make_classifier("cnn")
     own = [v.is_crossing for v in cnn.classify(gray, near, width)]
     whole = [v.is_crossing for v in cnn.classify(gray, [dataclasses.replace(j, ink=None) for j in near], width)]
-    assert sum(own) >= 9 and sum(whole) <= 5
+    assert sum(own) >= 8 and sum(whole) <= 5
 
 
 def test_a_cursive_line_crosses_where_its_h_loops_cross():

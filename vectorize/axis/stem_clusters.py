@@ -5,17 +5,19 @@ up) three passes go through one small stretch of ink: the way in, which goes on 
 of the loop; the loop's way down, which crosses the way in at a shallow angle and goes on
 down the stem; and the stem drawn back up, which turns off into the way on. Their inks
 overlap unevenly, so the medial axis there is three to five junctions round a small hole,
-joined by short branches, with five feet leaving: the way in, the loop's two sides, the
-stem (to its free end) and the way on. No pairing at any one of those junctions describes
-the three passes (an inner branch carries one or two of them), and the route then draws
-the loop backwards, or crosses beside the true crossing, or retraces an inner branch.
+or, where the stem drawn back up merges with the others' ink, two or three junctions with
+no hole (a tree), joined by short branches, with five feet leaving: the way in, the loop's
+two sides, the stem (to its free end) and the way on. No pairing at any one of those
+junctions describes the three passes (an inner branch carries one to three of them), and
+the route then draws the loop backwards, or crosses beside the true crossing, or retraces
+an inner branch; at a tree the crossing classifier, shown one junction, calls it a touch.
 
-Read as one: the junctions and the branches round the hole become one crossing node where
+Read as one: the junctions and the branches between them become one crossing node where
 the way in and the way down cross (a degree-4 node whose pairs are known: the loop is drawn
 round from the way in, so its way down crosses it), and the stem drawn back up becomes a
-branch of its own from the stem's tip along the hole's far side into the way on, beside the
-crossing rather than through it. The stem is then a spike drawn down and back up, with a
-cusp at its tip.
+branch of its own from the stem's tip along the hole's far side (at a tree, up the stem)
+into the way on, beside the crossing rather than through it. The stem is then a spike
+drawn down and back up, with a cusp at its tip.
 """
 
 from __future__ import annotations
@@ -47,7 +49,8 @@ def merge_stem_clusters(graph: MedialGraph, *, stroke_width: float, ends: int, p
     user's split edit). place(graph, node, passes) -> (2,) px: an estimate of where the way
     in and the loop's way down (`passes`, two slot pairs at `node` merged in `graph`) cross
     (`vectorize.junctions.crossing_point.passes_crossing`, passed in: the junctions' stage
-    comes after this one); it picks the band they share. Returns crossing node ->
+    comes after this one); the node's place where three passes share the band, and which
+    band where a hole's way in does not border its loop's junction. Returns crossing node ->
     its stem's tip, where the fit splits; the tip's other branch is the stem drawn back up
     into the way on. Pair each node's slots with `stem_passes` once simplification is done.
     """
@@ -63,14 +66,16 @@ def merge_stem_clusters(graph: MedialGraph, *, stroke_width: float, ends: int, p
     tips = {}
     for members in linked_groups(graph, junctions, short):
         inside = set(members)
-        # One hole: as many branches between the junctions as junctions, besides the loop (the
-        # longest, an ascender far longer than the hole's sides). A side may be longer than
-        # the short branches that found the cluster: where the line is thin the measured
-        # width falls short of the drawn one (1.5 px measured for lines drawn 2-2.25 px wide).
+        # Besides the loop (the longest, an ascender far longer than the hole's sides), one
+        # branch between the junctions for each junction (one hole) or one fewer (a tree: the
+        # passes' inks merge with no hole between them). A side may be longer than the short
+        # branches that found the cluster: where the line is thin the measured width falls
+        # short of the drawn one (1.5 px measured for lines drawn 2-2.25 px wide).
         joining = sorted({bid for n in members for bid in graph.incident[n]
                           if graph.branches[bid].a in inside and graph.branches[bid].b in inside},
                          key=lambda bid: (graph.branches[bid].length, bid))
-        if len(members) < 3 or len(joining) != len(members) + 1:
+        tree = len(joining) == len(members)
+        if len(members) < 2 or len(joining) not in (len(members), len(members) + 1):
             continue
         inner = sorted(joining[:-1])
         # The loop leaves the ink the passes share and comes back: longer than a short
@@ -98,16 +103,48 @@ def merge_stem_clusters(graph: MedialGraph, *, stroke_width: float, ends: int, p
             continue
         on_here = slots(trial, node)[passes[2][1]][0]
         on = next(old for old, new in renamed.items() if new == on_here)
-        # The way in and the way down cross at a shallow angle: their inks merge into one band,
-        # the inner branch nearest the crossing, and they cross at its middle (as
-        # `simplify` merges a crossing's two halves at the middle of the branch between them).
-        estimate = place(trial, node, passes[:2])
-        band = min(inner, key=lambda b: float(np.min(np.hypot(*(graph.branches[b].points - estimate).T))))
-        arc = graph.branches[band].arc
-        centre = graph.branches[band].points[int(np.searchsorted(arc, arc[-1] / 2.0))]
+        # The way in and the way down cross at a shallow angle and share one band of ink. The
+        # way in goes from its junction up to the loop's, the way down from the loop's through
+        # the way in's to the stem: a branch joining those two junctions carries both. If the
+        # stem drawn back up reaches the way on without it, it carries no third pass, and two
+        # passes' ink is narrowest where they cross (one width there, wider either way as they
+        # part): the node goes to its least medial radius. If the stem drawn back up runs along
+        # it too (a tree whose way on leaves at the loop's junction), the band's width tells
+        # nothing of where two of the three cross: the node goes to their estimated crossing
+        # (from each pass's course on either side). A tree whose way in's junction does not
+        # border the loop's (the way on leaves between them) is left as it is. A hole without
+        # such a branch: the band is the inner branch nearest the estimate and they cross at
+        # its middle (as `simplify` merges a crossing's two halves at the middle of the
+        # branch between them).
+        into = _junction(graph, next(old for old, new in renamed.items()
+                                     if new == slots(trial, node)[passes[0][0]][0]), inside)
+        loop_at = {graph.branches[joining[-1]].a, graph.branches[joining[-1]].b}
+        joins = [b for b in inner if into not in loop_at
+                 and {graph.branches[b].a, graph.branches[b].b} in ({into, end} for end in loop_at)]
+        if tree and len(joins) != 1:
+            continue
+        band = joins[0] if len(joins) == 1 else None
+        if band is not None and _shortest(graph, [b for b in inner if b != band], stems[0][0],
+                                          _junction(graph, on, inside)) is not None:
+            radii = graph.branches[band].radii
+            centre = graph.branches[band].points[1 + int(np.argmin(radii[1:-1])) if len(radii) > 2 else 0]
+        elif tree:
+            band, centre = None, np.asarray(place(trial, node, passes[:2]), dtype=float)
+        else:
+            estimate = place(trial, node, passes[:2])
+            band = min(inner, key=lambda b: float(np.min(np.hypot(*(graph.branches[b].points - estimate).T))))
+            arc = graph.branches[band].arc
+            centre = graph.branches[band].points[int(np.searchsorted(arc, arc[-1] / 2.0))]
         up = _stem_back_up(graph, stems[0], on, inside, [b for b in inner if b != band], inner)
         graph.remove_branch(on)
+        band_ends = [graph.positions[n] for n in
+                     (members if band is None else (graph.branches[band].a, graph.branches[band].b))]
         node = merge_cluster(graph, sorted(members), inner, centre)
+        if tree:
+            # The ink the crossing passes share is the band; the tree's other junction is
+            # where the stem and the way on part from it, outside the crossing (the uncertain
+            # zone round the node, which the fit bridges, reaches as far as the span).
+            graph.spans[node] = float(max(np.hypot(*(end - centre)) for end in band_ends))
         graph.add_branch(up)
         tips[node] = up.a
     return tips
@@ -147,6 +184,12 @@ def stem_passes(graph: MedialGraph, node: int, stroke_width: float, tip: int) ->
         if cost < best_cost:
             best, best_cost = pairs, cost
     return best, max(pass_bends(dirs, best[:2]))
+
+
+def _junction(graph: MedialGraph, bid: int, inside: set[int]) -> int:
+    """The end of branch `bid` that is one of the cluster's junctions (`inside`)."""
+    branch = graph.branches[bid]
+    return branch.a if branch.a in inside else branch.b
 
 
 def _leaving(graph: MedialGraph, node: int, radius: float) -> np.ndarray:
