@@ -11,6 +11,21 @@ from tests.drawings import cursive_stretch
 from vectorize import VectorizeOptions, vectorize_image
 
 
+def _assert_one_stroke_crossing_where_drawn(seed, index, center, half):
+    """The stretch of cursive line `index` at `seed` within `half` px of `center`
+    (`tests.drawings.cursive_stretch`) comes out in one stroke, crossing within the benchmark's
+    match distance of where the drawn passes cross."""
+    from benchmarks.common.render import render
+    from benchmarks.metrics.table1 import MATCH_DISTANCE, drawing_polylines, polyline_intersections
+
+    drawing, crossing = cursive_stretch(seed, index, center, half)
+    result = vectorize_image(render(drawing), VectorizeOptions(classifier="cnn"))
+    assert result.report.strokes == 1
+    polys, closed = drawing_polylines(result.drawing)
+    found = polyline_intersections(polys, closed).crossings
+    assert len(found) and np.min(np.linalg.norm(found - crossing, axis=1)) <= MATCH_DISTANCE
+
+
 @pytest.mark.parametrize("seed, index, center, half", [
     (0, 38, (117.0, 517.0), 60.0),  # "the" of the_acid_ate_the_metal, 3.5 px: crossed 45.6 px off before
     (1, 37, (897.0, 507.0), 40.0),  # "ht" of the_planet_men_tend_the_yacht, 2.25 px: 6.5 px off before
@@ -23,15 +38,7 @@ def test_an_h_base_crosses_where_the_way_in_and_the_way_down_do(seed, index, cen
     longer than the branches that found the cluster); read one at a time,
     the way down ran along the band's far side and crossed the way in away from the true
     crossing (or not at all). Read as one, the two cross in the band they share."""
-    from benchmarks.common.render import render
-    from benchmarks.metrics.table1 import MATCH_DISTANCE, drawing_polylines, polyline_intersections
-
-    drawing, crossing = cursive_stretch(seed, index, center, half)
-    result = vectorize_image(render(drawing), VectorizeOptions(classifier="cnn"))
-    assert result.report.strokes == 1
-    polys, closed = drawing_polylines(result.drawing)
-    found = polyline_intersections(polys, closed).crossings
-    assert len(found) and np.min(np.linalg.norm(found - crossing, axis=1)) <= MATCH_DISTANCE
+    _assert_one_stroke_crossing_where_drawn(seed, index, center, half)
 
 
 @pytest.mark.parametrize("seed, index, center, half", [
@@ -46,15 +53,7 @@ def test_an_h_base_with_no_hole_crosses_in_the_band_three_passes_share(seed, ind
     back up runs the band with the two crossing passes. Read one junction at a time, the
     output crossed nowhere near (31.3 and 65.4 px off); read as one, with the node at the
     passes' estimated crossing, within 1.5 px (measured)."""
-    from benchmarks.common.render import render
-    from benchmarks.metrics.table1 import MATCH_DISTANCE, drawing_polylines, polyline_intersections
-
-    drawing, crossing = cursive_stretch(seed, index, center, half)
-    result = vectorize_image(render(drawing), VectorizeOptions(classifier="cnn"))
-    assert result.report.strokes == 1
-    polys, closed = drawing_polylines(result.drawing)
-    found = polyline_intersections(polys, closed).crossings
-    assert len(found) and np.min(np.linalg.norm(found - crossing, axis=1)) <= MATCH_DISTANCE
+    _assert_one_stroke_crossing_where_drawn(seed, index, center, half)
 
 
 @pytest.mark.parametrize("index", [0, 2, 4, 5, 7, 8, 9])
