@@ -82,6 +82,17 @@ def binarize_beside(path: str | os.PathLike, options: VectorizeOptions) -> Binar
     return Binarizing(image, frame, options)
 
 
+def start_vectorizing(path: str | os.PathLike, options: VectorizeOptions, *, edits: bool) -> Binarizing | None:
+    """What a command does before `vectorize_file(path, options, binarizing=...)`: start the
+    binarize stage on a spare core (`binarize_beside`; not with edits, which may change the
+    threshold and blur), then import the later stages (`import_stages_for`; scikit-image's
+    Li threshold where the run leaves the threshold to it) while it runs. Returns the
+    `binarizing` to pass on, or None."""
+    binarizing = None if edits else binarize_beside(path, options)
+    import_stages_for(path, li_threshold=options.threshold is None and not edits)
+    return binarizing
+
+
 def vectorize_file(path: str | os.PathLike, options: VectorizeOptions = VectorizeOptions(), *,
                    edits=None, cache=None, progress=None, binarizing: Binarizing | None = None) -> VectorizeResult:
     """Vectorize a raster image or read an SVG (strokes as they are; outlines to centre lines).

@@ -179,14 +179,12 @@ def read_drawing(path: str, *, multi: bool = False, threshold: float | None = No
 
     with loading_for_good():  # as `onestroke vectorize` does (fabrication/cli/heap.py)
         from vectorize import VectorizeOptions, vectorize_file
-        from vectorize.pipeline import binarize_beside, import_stages_for
+        from vectorize.pipeline import start_vectorizing
 
         options = VectorizeOptions(multi=multi, threshold=threshold, blur=blur, classifier=classifier)
         # Binarized on a spare core while the later stages load, as `onestroke vectorize` does.
-        binarizing = binarize_beside(path, options) if edits is None else None
+        binarizing = start_vectorizing(path, options, edits=edits is not None)
         from vectorize.refine.edits import read_edits
-
-        import_stages_for(path, li_threshold=threshold is None and edits is None)
     replay = read_edits(edits) if edits is not None else None
     result = vectorize_file(path, options, edits=replay, progress=progress, binarizing=binarizing)
     for message in result.report.warnings:

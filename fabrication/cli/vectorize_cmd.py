@@ -62,17 +62,15 @@ def vectorize(source: str, output: str, multi: bool, threshold: float | None, bl
     # (fabrication/cli/heap.py); a raster drawing's stages load now for that.
     with loading_for_good():
         from vectorize import VectorizeOptions, vectorize_file
-        from vectorize.pipeline import binarize_beside, import_stages_for
+        from vectorize.pipeline import start_vectorizing
 
         options = VectorizeOptions(multi=multi, threshold=threshold, blur=blur, classifier=classifier,
                                    keep_stages=debug_dir is not None, whole_image_confidence=debug_dir is not None)
         # Without edits (which may change the threshold and blur), the drawing is read now and
         # binarized on a spare core while the later stages' libraries load (the binarizing
         # mostly runs outside the GIL, the imports hold it): the same ink, sooner.
-        binarizing = binarize_beside(source, options) if edits is None else None
+        binarizing = start_vectorizing(source, options, edits=edits is not None)
         from vectorize.svg_write import write_drawing
-
-        import_stages_for(source, li_threshold=threshold is None and edits is None)
     keep_freed_memory()  # the image's arrays reuse freed heap memory
 
     replay = None
