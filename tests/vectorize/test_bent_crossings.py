@@ -13,7 +13,8 @@ from benchmarks.metrics.table1 import drawing_polylines, polyline_intersections
 from benchmarks.sets.cursive import cursive_drawing
 from vectorize import VectorizeOptions, vectorize_image
 from vectorize.drawing import Drawing
-from vectorize.junctions.intersections import lone_junctions, sharp_touch
+from vectorize.axis.graph import Branch, MedialGraph
+from vectorize.junctions.intersections import along_line, lone_junctions, sharp_touch
 from vectorize.stroke import Stroke
 
 
@@ -45,6 +46,18 @@ def test_lone_junctions_counts_the_spans():
     # their branch directions, read along the line, do not reach each other's ink.
     apart = np.array([[0.0, 40.0, 100.0], [40.0, 0.0, 90.0], [100.0, 90.0, 0.0]])
     assert lone_junctions(centers, np.array([2.0, 2.0, 0.0]), 8.0, apart).tolist() == [True, True, True]
+
+
+def test_along_line_takes_the_shorter_side_of_a_hole():
+    """Two junctions joined by both sides of a small hole (3 and 10 px) and a third 20 px on:
+    along the line they are 3 px apart, not the two sides' lengths added up."""
+    graph = MedialGraph()
+    a, b, c = (graph.add_node(np.array(p), 1.0) for p in ([0.0, 0.0], [3.0, 0.0], [23.0, 0.0]))
+    for ends, via in (((a, b), []), ((a, b), [[1.5, 3.5]]), ((b, c), []), ((c, c), [[30.0, 5.0], [30.0, -5.0]])):
+        points = np.array([graph.positions[ends[0]], *via, graph.positions[ends[1]]], dtype=float)
+        graph.add_branch(Branch(*ends, points, np.ones(len(points)), np.ones(len(points) - 1)))
+    apart = along_line(graph, [a, b, c], 100.0)
+    assert np.allclose(apart, [[0.0, 3.0, 23.0], [3.0, 0.0, 20.0], [23.0, 20.0, 0.0]]), apart
 
 
 def _stretch(seed: int, index: int, center: tuple[float, float], half: float) -> tuple[Drawing, np.ndarray]:

@@ -149,9 +149,14 @@ def along_line(graph: MedialGraph, nodes: Sequence[int], limit: float) -> np.nda
     from scipy.sparse.csgraph import dijkstra
 
     index = {n: i for i, n in enumerate(graph.incident)}
-    branches = list(graph.branches.values())
-    matrix = coo_matrix(([max(b.length, 1e-6) for b in branches],
-                         ([index[b.a] for b in branches], [index[b.b] for b in branches])),
+    # The shortest of parallel branches (two sides of a hole): a sparse matrix would add
+    # their lengths up. A loop from a node back to itself shortens no way.
+    shortest: dict[tuple[int, int], float] = {}
+    for b in graph.branches.values():
+        if b.a != b.b:
+            key = tuple(sorted((index[b.a], index[b.b])))
+            shortest[key] = min(shortest.get(key, np.inf), max(b.length, 1e-6))
+    matrix = coo_matrix((list(shortest.values()), ([i for i, _ in shortest], [j for _, j in shortest])),
                         shape=(len(index), len(index))).tocsr()
     at = [index[n] for n in nodes]
     return dijkstra(matrix, directed=False, indices=at, limit=limit)[:, at]
