@@ -56,6 +56,42 @@ def test_an_h_base_with_no_hole_crosses_in_the_band_three_passes_share(seed, ind
     _assert_one_stroke_crossing_where_drawn(seed, index, center, half)
 
 
+@pytest.mark.parametrize("seed, index, center, half", [
+    (5, 36, (84.0, 493.0), 60.0),  # "h" of handy_lady_tidy_attic, 3 px: crossed 9.7 px off before
+    (5, 21, (82.3, 532.7), 60.0),  # "h" of he_hummed_the_name, 3.25 px: 7.2 px off before
+    (11, 10, (81.0, 506.0), 60.0),  # "h" of handy_lady_tidy_attic, 3 px, round a hole: 46.1 px off before
+])
+def test_an_h_that_starts_the_line_crosses_where_drawn(seed, index, center, half):
+    """The line starts at the h's way in, so two of the cluster's feet end free: the way in and
+    the stem. Both readings pair the same feet in the two crossing passes; only the stem
+    drawn back up into the way on tells them apart, as it crosses neither pass. Before, such
+    a cluster was left as it was and the route turned from the way in down the stem."""
+    _assert_one_stroke_crossing_where_drawn(seed, index, center, half)
+
+
+@pytest.mark.parametrize("seed, index, center, half", [
+    (3, 3, (198.0, 520.0), 100.0),  # second "h" of he_hummed_the_name, 3.25 px: 62.0 px off before
+    (9, 7, (96.0, 529.0), 60.0),  # "th" of the_mad_hatted_duke_met_a_lady, 2 px: 32.1 px off before
+])
+def test_an_h_base_whose_way_on_leaves_a_pixel_from_the_way_ins_junction(seed, index, center, half):
+    """A tree whose way on leaves at a junction 1.3-1.7 px from the way in's, their maximal
+    discs overlapping: one junction in one blob of ink, so the branch from it to the loop's
+    junction is the band the two crossing passes share. Before, the way on was taken to leave
+    inside the band and the tree was left as it was."""
+    _assert_one_stroke_crossing_where_drawn(seed, index, center, half)
+
+
+@pytest.mark.parametrize("seed, index, center, half", [
+    (7, 29, (96.8, 528.2), 60.0),  # "th" of the_mad_hatted_duke_met_a_lady, 2 px: 31.5 px off before
+    (12, 22, (197.8, 515.3), 60.0),  # "th" of the_hunted_elk_came_at_ten, 2 px: 52.8 px off before
+])
+def test_a_thin_h_base_round_two_holes_crosses_where_drawn(seed, index, center, half):
+    """On 2 px lines the three passes' inks touch and part again along the band: 7 junctions
+    round 2 small holes besides the loop. Before, only a cluster round one hole or none was
+    read."""
+    _assert_one_stroke_crossing_where_drawn(seed, index, center, half)
+
+
 @pytest.mark.parametrize("index", [0, 2, 4, 5, 7, 8, 9])
 def test_every_h_of_a_new_line_keeps_its_crossing(index):
     """A line of h's the benchmark does not draw ("the hen hath a hat", seed 7): before, 2 of

@@ -6,8 +6,11 @@ of the loop; the loop's way down, which crosses the way in at a shallow angle an
 down the stem; and the stem drawn back up, which turns off into the way on. Their inks
 overlap unevenly, so the medial axis there is three to five junctions round a small hole,
 or, where the stem drawn back up merges with the others' ink, two or three junctions with
-no hole (a tree), joined by short branches, with five feet leaving: the way in, the loop's
-two sides, the stem (to its free end) and the way on. No pairing at any one of those
+no hole (a tree), or, on thin lines, more junctions round two or more small holes, joined by
+short branches, with five feet leaving: the way in, the loop's two sides, the stem (to its
+free end) and the way on. Where the line starts at the h, the way in ends free too, and the
+stem is the free foot whose pass back up into the way on crosses neither of the two
+crossing passes. No pairing at any one of those
 junctions describes the three passes (an inner branch carries one to three of them), and
 the route then draws the loop backwards, or crosses beside the true crossing, or retraces
 an inner branch; at a tree the crossing classifier, shown one junction, calls it a touch.
@@ -67,15 +70,17 @@ def merge_stem_clusters(graph: MedialGraph, *, stroke_width: float, ends: int, p
     for members in linked_groups(graph, junctions, short):
         inside = set(members)
         # Besides the loop (the longest, an ascender far longer than the hole's sides), one
-        # branch between the junctions for each junction (one hole) or one fewer (a tree: the
-        # passes' inks merge with no hole between them). A side may be longer than the short
-        # branches that found the cluster: where the line is thin the measured width falls
-        # short of the drawn one (1.5 px measured for lines drawn 2-2.25 px wide).
+        # branch between the junctions for each junction (one hole), one fewer (a tree: the
+        # passes' inks merge with no hole between them) or more (holes: on thin lines the
+        # three passes' inks touch and part again along the band, 7 junctions round 2 holes
+        # at 2-2.5 px). A side may be longer than the short branches that found the cluster:
+        # where the line is thin the measured width falls short of the drawn one (1.5 px
+        # measured for lines drawn 2-2.25 px wide).
         joining = sorted({bid for n in members for bid in graph.incident[n]
                           if graph.branches[bid].a in inside and graph.branches[bid].b in inside},
                          key=lambda bid: (graph.branches[bid].length, bid))
         tree = len(joining) == len(members)
-        if len(members) < 2 or len(joining) not in (len(members), len(members) + 1):
+        if len(members) < 2 or len(joining) < len(members):
             continue
         inner = sorted(joining[:-1])
         # The loop leaves the ink the passes share and comes back: longer than a short
@@ -88,16 +93,27 @@ def merge_stem_clusters(graph: MedialGraph, *, stroke_width: float, ends: int, p
         feet = [(n, bid) for n in members for bid, _ in slots(graph, n) if bid not in inner]
         stems = [(n, bid) for n, bid in feet if graph.degree(graph.branches[bid].other(n)) == 1]
         loops = [bid for _, bid in feet if graph.branches[bid].a in inside and graph.branches[bid].b in inside]
-        # Five feet: the way in and the way on, the loop's two sides (one branch) and the stem.
-        if len(feet) != 5 or len(stems) != 1 or len(loops) != 2:
+        # Five feet: the way in and the way on, the loop's two sides (one branch) and the stem;
+        # the way in ends free too where the line starts at the h.
+        if len(feet) != 5 or len(stems) not in (1, 2) or len(loops) != 2:
             continue
-        tip = graph.branches[stems[0][1]].other(stems[0][0])
         # A foot to a degree-2 node is another cluster's stem drawn back up (its tip): this
         # cluster then has no way in or no way on of its own, and is left as it is.
         if any(graph.degree(graph.branches[bid].other(n)) == 2 for n, bid in feet):
             continue
         trial, renamed = graph.copy(), {}
         node = merge_cluster(trial, sorted(members), inner, renamed=renamed)
+        if len(stems) == 2:
+            # Two free feet: the way in and the stem. Both readings pair the same feet in the
+            # two crossing passes; they differ in the third, the stem drawn back up into the
+            # way on, which runs beside the crossing and crosses neither (the stem's foot and
+            # the way on's are neighbours round the node). Neither or both: left as it is.
+            beside = [stem for stem in stems
+                      if _beside(trial, node, stroke_width, graph.branches[stem[1]].other(stem[0]))]
+            if len(beside) != 1:
+                continue
+            stems = beside
+        tip = graph.branches[stems[0][1]].other(stems[0][0])
         passes, bend = stem_passes(trial, node, stroke_width, tip)
         if bend > MAX_BEND:
             continue
@@ -119,8 +135,14 @@ def merge_stem_clusters(graph: MedialGraph, *, stroke_width: float, ends: int, p
         into = _junction(graph, next(old for old, new in renamed.items()
                                      if new == slots(trial, node)[passes[0][0]][0]), inside)
         loop_at = {graph.branches[joining[-1]].a, graph.branches[joining[-1]].b}
-        joins = [b for b in inner if into not in loop_at
-                 and {graph.branches[b].a, graph.branches[b].b} in ({into, end} for end in loop_at)]
+        # A junction inside another's maximal disc is the same junction at the ink's
+        # resolution (a way on leaving a pixel or two from the way in's junction does not
+        # leave inside the band).
+        near_in = _blob(graph, {into}, inner)
+        near_loop = _blob(graph, loop_at, inner)
+        joins = [b for b in inner if not near_in & near_loop
+                 and {graph.branches[b].a in near_in, graph.branches[b].b in near_in} == {True, False}
+                 and {graph.branches[b].a in near_loop, graph.branches[b].b in near_loop} == {True, False}]
         if tree and len(joins) != 1:
             continue
         band = joins[0] if len(joins) == 1 else None
@@ -184,6 +206,32 @@ def stem_passes(graph: MedialGraph, node: int, stroke_width: float, tip: int) ->
         if cost < best_cost:
             best, best_cost = pairs, cost
     return best, max(pass_bends(dirs, best[:2]))
+
+
+def _beside(graph: MedialGraph, node: int, stroke_width: float, tip: int) -> bool:
+    """Whether, read with its stem to `tip`, the merged cluster's third pass (the stem drawn
+    back up into the way on) crosses neither of the two that cross each other: no foot of
+    theirs lies between the stem's foot and the way on's on one side round the node only."""
+    passes, _ = stem_passes(graph, node, stroke_width, tip)
+    if len(passes) < 3:
+        return False
+    dirs = _leaving(graph, node, graph.spans.get(node, 0.0) + stroke_width)
+    angle = np.arctan2(dirs[:, 1], dirs[:, 0])
+    stem, on = passes[2]
+    turn = (angle[on] - angle[stem]) % (2 * np.pi)
+    inside = [(angle[i] - angle[stem]) % (2 * np.pi) < turn for pair in passes[:2] for i in pair if i != stem]
+    return all(inside) or not any(inside)
+
+
+def _blob(graph: MedialGraph, nodes: set[int], inner: list[int]) -> set[int]:
+    """`nodes` and the junctions an `inner` branch joins to one of them inside one of the two's
+    maximal disc (the branch shorter than the larger medial radius)."""
+    result = set(nodes)
+    for bid in inner:
+        branch = graph.branches[bid]
+        if branch.length < max(graph.radii[branch.a], graph.radii[branch.b]) and (branch.a in nodes or branch.b in nodes):
+            result |= {branch.a, branch.b}
+    return result
 
 
 def _junction(graph: MedialGraph, bid: int, inside: set[int]) -> int:
