@@ -185,6 +185,9 @@ def read_drawing(path: str, *, multi: bool = False, threshold: float | None = No
         # Binarized on a spare core while the later stages load, as `onestroke vectorize` does.
         binarizing = start_vectorizing(path, options, edits=edits is not None)
         from vectorize.refine.edits import read_edits
+    from onestroke.lasting import load_later_imports_for_good
+
+    load_later_imports_for_good()  # onnxruntime and networkx where the drawing needs them
     replay = read_edits(edits) if edits is not None else None
     result = vectorize_file(path, options, edits=replay, progress=progress, binarizing=binarizing)
     for message in result.report.warnings:

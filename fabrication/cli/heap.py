@@ -19,6 +19,8 @@ import gc
 from collections.abc import Iterator
 from contextlib import contextmanager
 
+from onestroke.lasting import paused_then_frozen
+
 # mallopt's parameter numbers (glibc's malloc.h)
 M_TRIM_THRESHOLD = -1
 M_MMAP_THRESHOLD = -3
@@ -60,11 +62,5 @@ def loading_for_good() -> Iterator[None]:
     --pairs` imports them with it running) took the garbage collection in a command from
     75-120 to 10-30 ms (3 drawings, gc callbacks) and the command / floor ratio from 1.181
     to 1.105 wall, 1.167 to 1.128 CPU (median of 45 pairs, load 7, 2026-12-05)."""
-    was_on = gc.isenabled()
-    gc.disable()
-    try:
+    with paused_then_frozen():
         yield
-    finally:
-        freeze_loaded_objects()
-        if was_on:
-            gc.enable()

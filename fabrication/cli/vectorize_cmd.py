@@ -57,6 +57,7 @@ def vectorize(source: str, output: str, multi: bool, threshold: float | None, bl
 
         placement = PlacementOptions(size=size, width=width, height=height, rotate=rotate)
     from fabrication.cli.heap import keep_freed_memory, loading_for_good
+    from onestroke.lasting import load_later_imports_for_good
 
     # The libraries load with the garbage collector paused and then stay out of its passes
     # (fabrication/cli/heap.py); a raster drawing's stages load now for that.
@@ -72,6 +73,7 @@ def vectorize(source: str, output: str, multi: bool, threshold: float | None, bl
         binarizing = start_vectorizing(source, options, edits=edits is not None)
         from vectorize.svg_write import write_drawing
     keep_freed_memory()  # the image's arrays reuse freed heap memory
+    load_later_imports_for_good()  # onnxruntime and networkx where the drawing needs them
 
     replay = None
     if edits is not None:  # the edits module only when there are edits to replay

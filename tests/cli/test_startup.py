@@ -31,11 +31,29 @@ import gc
 fitting = sys.modules.get("vectorize.fit.fitting")
 li = sys.modules.get("skimage.filters.thresholding")
 collected = {id(o) for o in gc.get_objects()}  # what the collector still goes through
+nx, ort = sys.modules.get("networkx"), sys.modules.get("onnxruntime")
 with open(listing, "w") as fh:
     json.dump({"exit": code, "modules": sorted(sys.modules), "frozen": gc.get_freeze_count(),
                "fitting collected": fitting is not None and id(fitting.fit_stroke) in collected,
-               "li collected": li is not None and id(li.threshold_li) in collected}, fh)
+               "li collected": li is not None and id(li.threshold_li) in collected,
+               "networkx collected": nx is not None and id(nx.min_weight_matching) in collected,
+               "onnxruntime collected": ort is not None and id(ort.InferenceSession) in collected,
+               "gc enabled": gc.isenabled()}, fh)
 """
+
+# The same drawing through the library alone, as a long-running process (the studio) runs it.
+LIBRARY_CHILD = """
+import gc, json, sys
+from vectorize import vectorize_file
+vectorize_file(sys.argv[2])
+collected = {id(o) for o in gc.get_objects()}
+nx, ort = sys.modules["networkx"], sys.modules["onnxruntime"]
+with open(sys.argv[1], "w") as fh:
+    json.dump({"networkx collected": id(nx.min_weight_matching) in collected,
+               "onnxruntime collected": id(ort.InferenceSession) in collected, "gc enabled": gc.isenabled()}, fh)
+"""
+# Free ends beside the spike: more than two odd nodes, so the route's matching imports networkx.
+MANY_ENDS = ROOT / "examples" / "spike-drawing.png"
 
 # Not on the path of a plain `onestroke vectorize IN.png -o OUT.svg` with stderr in a pipe.
 # (xml.sax's saxutils would bring urllib.request, http.client and ssl; edits only with --edits.)
@@ -45,10 +63,10 @@ NOT_IMPORTED = ("rich", "vectorize.debug_overlay", "vectorize.refine.refine", "v
                 "vectorize.refine.edits", "vectorize.raster.scan_bands", "mmap")  # bands: images over 2x max_size
 
 
-def _run(tmp_path: Path, *args: str) -> tuple[dict, subprocess.CompletedProcess]:
+def _run(tmp_path: Path, *args: str, drawing: Path = DRAWING) -> tuple[dict, subprocess.CompletedProcess]:
     listing = tmp_path / "modules.json"
     env = {k: v for k, v in child_env().items() if k not in ("FORCE_COLOR", "TTY_COMPATIBLE")}
-    done = subprocess.run([sys.executable, "-c", CHILD, str(listing), "vectorize", str(DRAWING), *args],
+    done = subprocess.run([sys.executable, "-c", CHILD, str(listing), "vectorize", str(drawing), *args],
                           capture_output=True, text=True, env=env, timeout=300)
     return json.loads(listing.read_text()), done
 
@@ -79,6 +97,24 @@ def test_vectorize_imports_only_what_the_run_uses(tmp_path):
     assert _loaded(result["modules"], "vectorize.debug_overlay") and len(list(debug.glob("*.png"))) == 5
     assert not _loaded(result["modules"], "rich")
     assert done.stderr.strip() == f"debug: 5 stage images in {debug}"
+
+
+def test_libraries_imported_in_the_work_are_loaded_for_good_by_the_command_only(tmp_path):
+    """onnxruntime (crossings) and networkx (a route with more than two odd nodes) are
+    imported in the middle of the work: a command leaves them out of the collector's passes,
+    as it does the libraries it loads before (onestroke/lasting.py); the library alone, as
+    the studio runs it, leaves the collector as it is."""
+    result, done = _run(tmp_path, "-o", str(tmp_path / "out.svg"), drawing=MANY_ENDS)
+    assert result["exit"] == 0, done.stderr
+    assert _loaded(result["modules"], "networkx") and _loaded(result["modules"], "onnxruntime")
+    assert not result["networkx collected"] and not result["onnxruntime collected"] and result["gc enabled"]
+
+    listing = tmp_path / "library.json"
+    done = subprocess.run([sys.executable, "-c", LIBRARY_CHILD, str(listing), str(MANY_ENDS)],
+                          capture_output=True, text=True, env=child_env(), timeout=300)
+    assert done.returncode == 0, done.stderr
+    alone = json.loads(listing.read_text())
+    assert alone == {"networkx collected": True, "onnxruntime collected": True, "gc enabled": True}
 
 
 def test_plain_status_lines_read_as_rich_would_write_them(monkeypatch):
