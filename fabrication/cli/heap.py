@@ -24,13 +24,22 @@ from onestroke.lasting import paused_then_frozen
 # mallopt's parameter numbers (glibc's malloc.h)
 M_TRIM_THRESHOLD = -1
 M_MMAP_THRESHOLD = -3
+M_ARENA_MAX = -8
 MMAP_THRESHOLD = 32 << 20  # glibc's largest accepted value on 64-bit systems
 TRIM_THRESHOLD = 1 << 30
 
 
 def keep_freed_memory() -> bool:
-    """Raise glibc's mmap and trim thresholds for this process (module doc). Returns whether
-    both were set: False where the C library has no `mallopt` (macOS, musl, Windows)."""
+    """Raise glibc's mmap and trim thresholds for this process (module doc), and keep every
+    thread's allocations in the one heap (one arena). Call it before the process starts a
+    thread: a second thread otherwise gets an arena of its own, and what it frees (the
+    binarize stage's arrays, made on a spare core while the libraries load,
+    `vectorize.pipeline.binarize_beside`) stays there, out of reach of the stages after it.
+    Set before the image is read instead of after the imports, with one arena: a command's
+    minor page faults ~28,000 -> ~21,500 (the 15 drawings of `startup_cost.py --pairs`, 4
+    rounds, 2026-12-06; the work's own ~4,400-4,800 -> ~2,000-2,600 on four of them).
+    Returns whether all were set: False where the C library has no `mallopt` (macOS, musl,
+    Windows)."""
     try:
         import ctypes  # already loaded by numpy
 
@@ -38,7 +47,8 @@ def keep_freed_memory() -> bool:
     except (OSError, AttributeError, TypeError):
         return False
     mallopt.argtypes = (ctypes.c_int, ctypes.c_int)
-    return bool(mallopt(M_MMAP_THRESHOLD, MMAP_THRESHOLD)) and bool(mallopt(M_TRIM_THRESHOLD, TRIM_THRESHOLD))
+    return all([bool(mallopt(M_MMAP_THRESHOLD, MMAP_THRESHOLD)), bool(mallopt(M_TRIM_THRESHOLD, TRIM_THRESHOLD)),
+                bool(mallopt(M_ARENA_MAX, 1))])
 
 
 def freeze_loaded_objects() -> None:

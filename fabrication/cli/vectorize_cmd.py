@@ -59,6 +59,7 @@ def vectorize(source: str, output: str, multi: bool, threshold: float | None, bl
     from fabrication.cli.heap import keep_freed_memory, loading_for_good
     from onestroke.lasting import load_later_imports_for_good
 
+    keep_freed_memory()  # before the binarize thread starts: its freed arrays serve the later stages
     # The libraries load with the garbage collector paused and then stay out of its passes
     # (fabrication/cli/heap.py); a raster drawing's stages load now for that.
     with loading_for_good():
@@ -72,7 +73,6 @@ def vectorize(source: str, output: str, multi: bool, threshold: float | None, bl
         # mostly runs outside the GIL, the imports hold it): the same ink, sooner.
         binarizing = start_vectorizing(source, options, edits=edits is not None)
         from vectorize.svg_write import write_drawing
-    keep_freed_memory()  # the image's arrays reuse freed heap memory
     load_later_imports_for_good()  # onnxruntime and networkx where the drawing needs them
 
     replay = None

@@ -83,3 +83,42 @@ def test_vectorize_keeps_freed_heap_memory(tmp_path):
     later_tuned, later_plain = sum(tuned["faults"][1:]), sum(plain["faults"][1:])
     assert later_plain > 4 * 900  # 4 MB a round is ~1000 pages: glibc's defaults fault them again
     assert later_tuned < later_plain / 10, (tuned["faults"], plain["faults"])
+
+
+# keep_freed_memory, then large arrays made and freed in a second thread (as the binarize
+# stage's on a spare core), then the same sizes in the main thread: their minor page faults.
+THREAD_CHILD = """
+import json, resource, sys, threading
+import numpy as np
+from fabrication.cli.heap import keep_freed_memory
+kept = keep_freed_memory() if sys.argv[2] == "1" else None
+
+def made_and_freed():
+    arrays = [np.ones(500_000) for _ in range(4)]  # 4 MB each
+    del arrays
+
+thread = threading.Thread(target=made_and_freed)
+thread.start()
+thread.join()
+before = resource.getrusage(resource.RUSAGE_SELF).ru_minflt
+arrays = [np.ones(500_000) for _ in range(4)]
+with open(sys.argv[1], "w") as fh:
+    json.dump({"kept": kept, "faults": resource.getrusage(resource.RUSAGE_SELF).ru_minflt - before}, fh)
+"""
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="glibc's mallopt")
+def test_memory_a_thread_freed_serves_the_main_thread(tmp_path):
+    """With the heap kept (`keep_freed_memory`, which a command sets before its binarize
+    thread starts), what a second thread frees is in the one heap the main thread's later
+    arrays come from; by default that thread has an arena of its own."""
+    report = tmp_path / "thread.json"
+    results = {}
+    for tuned in ("1", "0"):
+        done = subprocess.run([sys.executable, "-c", THREAD_CHILD, str(report), tuned], capture_output=True,
+                              text=True, env=child_env(), timeout=120)
+        assert done.returncode == 0, done.stderr
+        results[tuned] = json.loads(report.read_text())
+    assert results["1"]["kept"] is True
+    assert results["0"]["faults"] > 4 * 900  # 16 MB: ~4,000 pages touched afresh
+    assert results["1"]["faults"] < results["0"]["faults"] / 10, results
