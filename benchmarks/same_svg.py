@@ -17,6 +17,11 @@ several threshold and blur values through one `StageCache` (as the studio does, 
 cached path is checked too), and the same values fresh. The curves (the SVG without its
 `data-widths`) and the ink widths are hashed apart, as "KEY" and "KEY widths": versions
 before widths existed compare equal on their curves. `compare` lists what differs.
+
+`run --svgs` also keeps every SVG's text (in OUT with `.svgs.json` for `.json`); where both
+runs kept them, `compare` says by how much each differing output's numbers differ (the
+largest absolute difference of its numbers, in the SVG's units, where both have as many):
+for a change whose outputs may differ in rounding only.
 """
 
 from __future__ import annotations
@@ -62,8 +67,12 @@ def make(folder: Path, sets: list[str], seeds: list[int], count: int | None) -> 
     return 0
 
 
-def _one(task: tuple) -> tuple[str, str]:
-    """(key, SHA-256 of the SVG or the error) of one vectorization."""
+NUMBER = re.compile(r"-?\d+(?:\.\d+)?(?:[eE][-+]?\d+)?")
+
+
+def _one(task: tuple) -> list[tuple[str, str, str]]:
+    """(key, SHA-256 of the SVG or the error, the SVG's text or the error) of each output of
+    one drawing."""
     import numpy as np
 
     from vectorize import VectorizeOptions, vectorize_file, vectorize_image
@@ -94,20 +103,25 @@ def _one(task: tuple) -> tuple[str, str]:
                                                  cache=shared).drawing
                         results.append((f"{key} t={threshold} b={blur} multi={multi} {how}", drawing_to_svg(drawing)))
     except Exception as exc:  # noqa: BLE001 - a failure is an output to compare too
-        return [(key, f"{type(exc).__name__}: {exc}")]
+        return [(key, f"{type(exc).__name__}: {exc}", "")]
     out = []
     for k, svg in results:
         # The curves and the ink widths apart: a change of one shows as that one.
         widths = " ".join(WIDTHS.findall(svg))
-        out.append((k, hashlib.sha256(WIDTHS.sub("", svg).encode()).hexdigest()))
+        out.append((k, hashlib.sha256(WIDTHS.sub("", svg).encode()).hexdigest(), WIDTHS.sub("", svg)))
         if widths:
-            out.append((f"{k} widths", hashlib.sha256(widths.encode()).hexdigest()))
+            out.append((f"{k} widths", hashlib.sha256(widths.encode()).hexdigest(), widths))
     return out
 
 
-def run(folder: Path, tree: Path, out: Path, jobs: int) -> int:
+def _texts_path(out: Path) -> Path:
+    return out.with_suffix(".svgs.json")
+
+
+def run(folder: Path, tree: Path, out: Path, jobs: int, keep_svgs: bool = False) -> int:
     if needs_rerun(tree):  # `vectorize` from that tree, in a child interpreter
-        return rerun_on(tree, __file__, ["run", str(folder), str(tree), str(out), "--jobs", str(jobs)])
+        return rerun_on(tree, __file__, ["run", str(folder), str(tree), str(out), "--jobs", str(jobs),
+                                         *(["--svgs"] if keep_svgs else [])])
     import vectorize
 
     source = Path(vectorize.__file__).resolve().parents[1]
@@ -117,11 +131,14 @@ def run(folder: Path, tree: Path, out: Path, jobs: int) -> int:
     for path in sorted((HERE / "examples").glob("*.png")):
         tasks.append((path.name, "file", str(path), None))
     start = time.perf_counter()
-    hashes = {}
+    hashes, texts = {}, {}
     with mp.get_context("fork").Pool(jobs) as pool:
-        for pairs in pool.imap_unordered(_one, tasks):
-            hashes.update(pairs)
+        for outputs in pool.imap_unordered(_one, tasks):
+            hashes.update((key, digest) for key, digest, _ in outputs)
+            texts.update((key, text) for key, _, text in outputs)
     out.write_text(json.dumps(dict(sorted(hashes.items())), indent=0))
+    if keep_svgs:
+        _texts_path(out).write_text(json.dumps(dict(sorted(texts.items()))))
     print(f"vectorize from {source}: {len(hashes)} outputs of {len(tasks)} drawings in "
           f"{time.perf_counter() - start:.0f} s -> {out}")
     return 0
@@ -131,13 +148,30 @@ def compare(a: Path, b: Path) -> int:
     first, second = json.loads(a.read_text()), json.loads(b.read_text())
     differ = sorted(k for k in first.keys() | second.keys() if first.get(k) != second.get(k))
     errors = sum(1 for k, v in first.items() if len(v) != 64 and not k.endswith(" widths"))
+    texts = [json.loads(_texts_path(p).read_text()) if _texts_path(p).exists() else {} for p in (a, b)]
+    largest = 0.0
     for key in differ:
-        print(f"DIFFERS {key}: {first.get(key)} != {second.get(key)}")
+        gap = _numbers_apart(texts[0].get(key), texts[1].get(key))
+        if gap is not None:
+            largest = max(largest, gap)
+        print(f"DIFFERS {key}: {first.get(key)} != {second.get(key)}"
+              f"{'' if gap is None else f'; numbers apart by up to {gap:.3g}'}")
     curves = [k for k in differ if not k.endswith(" widths")]
     print(f"{len(first)} and {len(second)} hashes; {len(curves)} outputs differ (curves, SVG without "
           f"data-widths), {len(differ) - len(curves)} ink-width profiles differ or are only on one side; "
           f"{errors} are errors in both")
+    if differ and all(texts):
+        print(f"largest difference of a number between outputs that differ only in their numbers: {largest:.3g}")
     return 1 if differ else 0
+
+
+def _numbers_apart(first: str | None, second: str | None) -> float | None:
+    """The largest absolute difference between the numbers of two texts that differ only in
+    their numbers; None otherwise (or where a text was not kept)."""
+    if not first or not second or NUMBER.sub("#", first) != NUMBER.sub("#", second):
+        return None
+    pairs = zip(NUMBER.findall(first), NUMBER.findall(second))
+    return max((abs(float(x) - float(y)) for x, y in pairs), default=0.0)
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -153,6 +187,7 @@ def main(argv: list[str] | None = None) -> int:
     r.add_argument("tree", type=Path, help="the source tree whose vectorize to run")
     r.add_argument("out", type=Path)
     r.add_argument("--jobs", type=int, default=2)
+    r.add_argument("--svgs", action="store_true", help="also keep the SVG texts, for compare to measure differences")
     c = sub.add_parser("compare")
     c.add_argument("a", type=Path)
     c.add_argument("b", type=Path)
@@ -164,7 +199,7 @@ def main(argv: list[str] | None = None) -> int:
             args.sets = [*SETS, "kinds"]
         return make(args.folder, args.sets, args.seeds, args.count)
     if args.command == "run":
-        return run(args.folder, args.tree, args.out, args.jobs)
+        return run(args.folder, args.tree, args.out, args.jobs, args.svgs)
     return compare(args.a, args.b)
 
 
