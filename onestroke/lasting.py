@@ -7,22 +7,25 @@ far, and every later collection goes through its objects again. A short command 
 libraries of its work this way before the work (`fabrication.cli.heap.loading_for_good`).
 Some are imported only where a drawing needs them, in the middle of the work: onnxruntime
 for a drawing with crossings, networkx for a route with more than two odd nodes. Those
-imports sit in `later_import()`, which loads them the same way once the process has asked
-for it (`load_later_imports_for_good`), and does nothing otherwise: a long-running process
+are imported through `import_later`, which loads them the same way once the process has asked for
+it (`load_later_imports_for_good`), and imports them plainly otherwise: a long-running process
 (the studio) keeps the collector as it is, since a frozen garbage cycle is never freed.
 """
 
 from __future__ import annotations
 
 import gc
+import importlib
+import sys
 from collections.abc import Iterator
 from contextlib import contextmanager
+from types import ModuleType
 
 _for_good = False  # set by a short command (`load_later_imports_for_good`)
 
 
 def load_later_imports_for_good(on: bool = True) -> None:
-    """From now on in this process, `later_import()` loads what it imports for good."""
+    """From now on in this process, `import_later` loads what it imports for good."""
     global _for_good
     _for_good = on
 
@@ -40,14 +43,16 @@ def paused_then_frozen() -> Iterator[None]:
             gc.enable()
 
 
-@contextmanager
-def later_import() -> Iterator[None]:
-    """Around a library's import in the middle of the work: `paused_then_frozen` where the
-    process asked for it (`load_later_imports_for_good`), nothing otherwise. In a command
-    that vectorizes a drawing needing networkx, the collections during and after its import
-    took 8-11 ms of CPU, 1.1-1.9 ms with it (two drawings, three runs each, 2026-12-06)."""
+def import_later(name: str) -> ModuleType:
+    """`importlib.import_module(name)`, for a library imported in the middle of the work: its
+    first import is loaded for good (`paused_then_frozen`) where the process asked for it
+    (`load_later_imports_for_good`). In a command that vectorizes a drawing needing
+    networkx, the collections during and after its import took 8-11 ms of CPU, 1.1-1.9 ms
+    with it (two drawings, three runs each, 2026-12-06)."""
+    module = sys.modules.get(name)
+    if module is not None:  # loaded already: nothing to freeze again
+        return module
     if not _for_good:
-        yield
-        return
+        return importlib.import_module(name)
     with paused_then_frozen():
-        yield
+        return importlib.import_module(name)

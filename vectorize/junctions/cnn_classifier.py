@@ -49,10 +49,9 @@ def onnx_session(model_path: Path, sha256: str):
     key = (str(Path(model_path).resolve()), sha256)
     with _SESSIONS_LOCK:
         if key not in _SESSIONS:
-            from onestroke.lasting import later_import
+            from onestroke.lasting import import_later
 
-            with later_import():  # for good in a command (onestroke/lasting.py)
-                import onnxruntime
+            onnxruntime = import_later("onnxruntime")  # for good in a command (onestroke/lasting.py)
 
             options = onnxruntime.SessionOptions()
             # One thread: the same float sums in the same order on every run, and a batch

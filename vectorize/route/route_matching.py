@@ -63,10 +63,9 @@ def match_odd(cost: np.ndarray, end_cost: np.ndarray) -> tuple[list[tuple[int, i
 
 def _blossom(rows: np.ndarray, cols: np.ndarray, w: np.ndarray) -> list[tuple[int, int]]:
     """networkx's minimum-weight maximum-cardinality matching over the edges given."""
-    from onestroke.lasting import later_import
+    from onestroke.lasting import import_later
 
-    with later_import():  # for good in a command (onestroke/lasting.py)
-        import networkx as nx
+    nx = import_later("networkx")  # for good in a command (onestroke/lasting.py)
     graph = nx.Graph()
     graph.add_weighted_edges_from(zip(rows.tolist(), cols.tolist(), w.tolist()))
     return [(int(u), int(v)) for u, v in nx.min_weight_matching(graph)]
