@@ -37,7 +37,8 @@ def keep_freed_memory() -> bool:
     `vectorize.pipeline.binarize_beside`) stays there, out of reach of the stages after it.
     Set before the image is read instead of after the imports, with one arena: a command's
     minor page faults ~28,000 -> ~21,500 (the 15 drawings of `startup_cost.py --pairs`, 4
-    rounds, 2026-12-06; the work's own ~4,400-4,800 -> ~2,000-2,600 on four of them).
+    rounds, 2026-12-06; the work's own ~4,400-4,800 -> ~2,000-2,600 on three of four checked,
+    8,400 -> 6,200 on the fourth).
     Returns whether all were set: False where the C library has no `mallopt` (macOS, musl,
     Windows)."""
     try:
