@@ -92,6 +92,24 @@ def test_a_thin_h_base_round_two_holes_crosses_where_drawn(seed, index, center, 
     _assert_one_stroke_crossing_where_drawn(seed, index, center, half)
 
 
+def test_a_thin_h_base_whose_band_is_many_measured_widths_long():
+    """he_hummed_the_name-7-39, drawn 2.5 px wide and measured 1.5 px: its first h's band runs
+    12.6 px from the way in's junction to the loop's, 8.4 measured widths, beyond a short
+    branch (7.66 widths), so the loop's junction was not in the cluster and the crossing was
+    lost (8 of 9 found). With the edges the overlapping passes add to the width, as
+    `simplify` measures a crossing's shared ink, the band is short and the h is read."""
+    from benchmarks.common.render import render
+    from benchmarks.metrics.table1 import evaluate
+    from benchmarks.sets.cursive import cursive_drawing
+
+    gt = cursive_drawing(7, 39)
+    image = render(gt.drawing)
+    result = vectorize_image(image, VectorizeOptions(classifier="cnn"))
+    scores = evaluate(gt, result.drawing, image)
+    assert result.report.strokes == 1
+    assert scores.undetected == 0, f"{scores.matched} of {scores.gt_intersections} crossings found"
+
+
 @pytest.mark.parametrize("index", [0, 2, 4, 5, 7, 8, 9])
 def test_every_h_of_a_new_line_keeps_its_crossing(index):
     """A line of h's the benchmark does not draw ("the hen hath a hat", seed 7): before, 2 of

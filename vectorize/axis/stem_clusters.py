@@ -30,7 +30,7 @@ from scipy.sparse.csgraph import dijkstra
 
 from vectorize.axis.clusters import MAX_BEND, Pairs, linked_groups, merge_cluster, pass_bends
 from vectorize.axis.graph import Branch, MedialGraph
-from vectorize.axis.simplify import slot_points, slots
+from vectorize.axis.simplify import CROSSING_EDGE_BLUR, slot_points, slots
 
 # Stroke widths. The branches round the hole at the cursive h bases measured 0.7-4.4 widths
 # (the_acid_ate_the_metal-0-38, 3.5 px lines), 2.1-6.7 (the_planet_men_tend_the_yacht-1-37,
@@ -62,8 +62,12 @@ def merge_stem_clusters(graph: MedialGraph, *, stroke_width: float, ends: int, p
         return {}
     junctions = [n for n in graph.incident if graph.degree(n) >= 3 and n not in through]
     known = set(junctions)
+    # The band's width as `simplify` takes a crossing's shared ink: the measured width and
+    # the anti-aliased edges the overlapping passes add (a 2.5 px line measures 1.5 px, and
+    # an h's band 12.6 px long there is 8.4 measured widths).
+    band_width = stroke_width + CROSSING_EDGE_BLUR
     short = [bid for bid, b in graph.branches.items()
-             if b.a != b.b and b.a in known and b.b in known and b.length <= HOLE_BRANCH_WIDTHS * stroke_width]
+             if b.a != b.b and b.a in known and b.b in known and b.length <= HOLE_BRANCH_WIDTHS * band_width]
     if not short:
         return {}
     tips = {}
