@@ -95,12 +95,13 @@ def _join(graph, a: int, b: int, *via, radius: float = W / 2) -> int:
     return graph.add_branch(Branch(a, b, points, np.full(len(points), radius), np.ones(len(points) - 1)))
 
 
-def _two_forks(far_fork_opens: str):
+def _two_forks(far_fork_opens: str, gap: float = 12.0, radius: float = 0.7 * W):
     """Two forks joined by a wide branch, neither with a free branch: fork A at the foot of an
     arm drawn up and back down beside itself (two strands up to its top, then a hook), fork B
     `far_fork_opens` "up" (a next letter's stem rising from the line between them: the
     branch from A runs down and along the line, as from a u's arm to a k) or "down" (a
-    crossing's other half: the branch runs straight on down). Returns the graph and A, B."""
+    crossing's other half: the branch runs straight on down, `gap` px long, of medial
+    `radius` px; every other branch's is W / 2). Returns the graph and A, B."""
     from vectorize.axis.graph import MedialGraph
 
     graph = MedialGraph()
@@ -119,8 +120,8 @@ def _two_forks(far_fork_opens: str):
         _join(graph, fork_b, tip, (55.0, -40.0))
         _join(graph, fork_b, out, (75.0, -10.0))
     else:
-        fork_b = node(0.0, 12.0)
-        _join(graph, fork_a, fork_b, radius=0.7 * W)
+        fork_b = node(0.0, gap)
+        _join(graph, fork_a, fork_b, *((0.0, y) for y in np.arange(1.0, gap, 1.0)), radius=radius)
         tip, out = node(-25.0, 80.0), node(25.0, 80.0)
         _join(graph, fork_b, tip, (-8.0, 40.0))
         _join(graph, fork_b, out, (8.0, 40.0))
@@ -144,6 +145,45 @@ def test_two_forks_that_open_the_same_way_are_not_one_crossing():
     simple = simplify(graph, stroke_width=W, multi=False)
     assert fork_a not in graph.incident and fork_b not in graph.incident
     assert len(simple.crossings) == 1
+
+
+def test_two_forks_joined_by_one_line_are_not_one_crossing():
+    """Two forks facing each other, 20 px (5 widths) apart: the two halves of a shallow
+    crossing share ink wider than one line, laid down by two passes (here 1.4 line radii
+    deep), and are one crossing. Joined by ink one line wide all along, they are two
+    junctions of one line: a cursive u whose arms' feet the axis shows as forks (thin lines,
+    where the anti-aliased V between two strokes parting at a cusp leaves a sliver of paper),
+    merged across its 44 px bowl into a degree-4 node, drew the bowl twice
+    (uncle_hank_decided_at_lunchtime-8-37)."""
+    graph, fork_a, fork_b = _two_forks("down", gap=20.0, radius=0.7 * W)
+    simple = simplify(graph, stroke_width=W, multi=False)
+    assert fork_a not in graph.incident and fork_b not in graph.incident
+    assert len(simple.crossings) == 1
+    for depth in (0.5, 0.55):  # one line, and 10 % of grid noise on it
+        graph, fork_a, fork_b = _two_forks("down", gap=20.0, radius=depth * W)
+        simple = simplify(graph, stroke_width=W, multi=False)
+        assert fork_a in graph.incident and fork_b in graph.incident
+        assert not simple.crossings
+
+
+@pytest.mark.parametrize("seed, index", [
+    (8, 37),  # uncle_hank_decided_at_lunchtime, 2 px: the 44 px bowl of lunch's u drawn twice, 3952 px for 3934
+    (12, 33),  # uncle_hank_decided_at_lunchtime, 2.25 px: 41 px of one line drawn twice, 3876 px for 3863
+    (11, 33),  # the_hunted_elk_came_at_ten, 2 px: 30 px of one line drawn twice, 3841 px for 3827
+])
+def test_a_thin_cursive_line_is_drawn_no_longer_than_its_route(seed, index):
+    """On thin lines (2-2.25 px) the axis shows the feet of a letter's arms as forks, and two
+    forks joined by one line a few widths long were merged as a crossing's halves: the route
+    then drew that stretch twice. The line must come out no longer than the fair-retrace
+    rule allows (the shortest route over the ink, plus 1 % and two widths)."""
+    from benchmarks.common.render import render_truth, to_uint8
+    from benchmarks.metrics.ink import fair_length_limit
+    from benchmarks.sets.cursive import cursive_drawing
+
+    gt = cursive_drawing(seed, index)
+    result = vectorize_image(to_uint8(render_truth(gt)), VectorizeOptions(classifier="cnn"))
+    assert result.report.strokes == 1
+    assert result.drawing.length <= fair_length_limit(gt.meta["min_length"], gt.width)
 
 
 def test_a_cursive_line_is_not_drawn_three_times_between_two_letters():

@@ -19,6 +19,12 @@ from vectorize.axis.graph import Branch, MedialGraph
 
 Slot = tuple[int, str]  # (branch id, which end of it touches the node: "a" or "b")
 
+# Ink deeper than this many line radii is laid down by two passes (`_one_pass_wide`). Between
+# the halves of crossings of thin cursive lines (2-2.5 px), two line widths or more beyond
+# their discs, the deepest point measured 1.38-2.5 line radii; on a line running alone
+# between two forks, 0.98-1.09 (pixel grid, anti-aliasing).
+TWO_PASSES_RADIUS = 1.2
+
 
 def slots(graph: MedialGraph, node: int) -> list[Slot]:
     """The branch ends at `node`, in a fixed order (a loop contributes both of its ends)."""
@@ -102,6 +108,32 @@ class Simplified:
     through_posterior: dict = field(default_factory=dict)
 
 
+def line_radius(graph: MedialGraph) -> float:
+    """The medial radius (px) of the drawing's lines where one pass runs alone: the median
+    over every branch point (most of a line drawing's ink is one pass wide). Read from the
+    axis itself, not from the estimated stroke width, which falls short on thin lines (a
+    2 px line's is read 1.5 px: the distance transform's steps)."""
+    radii = [branch.radii for branch in graph.branches.values()]
+    return float(np.median(np.concatenate(radii))) if radii else 0.0
+
+
+def _one_pass_wide(branch: Branch, radius_a: float, radius_b: float, line: float) -> bool:
+    """Whether the ink along `branch`, beyond the discs of the junctions at its ends (radii
+    `radius_a`, `radius_b` px), is one line wide all along: its medial radius nowhere above
+    `TWO_PASSES_RADIUS` times `line` (px). Two passes that cross share ink at least 1.41 line
+    radii deep where they cross (a right-angle crossing's inner corners are sqrt 2 radii
+    from its centre; deeper at shallower angles): a branch that never gets that deep joins two
+    junctions of one line, however their arms point. Told only where the discs leave two line
+    widths between them: close to a crossing's centre the pixel grid rounds its inner
+    corners off (1.0-1.2 line radii measured between the halves of right-angle crossings of
+    2 px lines, 4 px apart)."""
+    arc = branch.arc
+    if arc[-1] - radius_a - radius_b < 4.0 * line:
+        return False
+    beyond = (arc > radius_a) & (arc < arc[-1] - radius_b)
+    return bool(beyond.any()) and float(branch.radii[beyond].max()) <= TWO_PASSES_RADIUS * line
+
+
 def _min_radius(branch: Branch) -> float:
     inner = branch.radii[1:-1]
     return float(inner.min()) if inner.size else float(branch.radii.min())
@@ -181,6 +213,7 @@ def simplify(graph: MedialGraph, *, stroke_width: float, multi: bool, ends: int 
     through = dict(through or {})
     reach = 2.5 * stroke_width
     merged = _merge_split_vertices(graph, stroke_width, through, may_merge)
+    line = line_radius(graph)
 
     def spike_slot(node: int) -> int | None:
         """Slot of the branch drawn out and back at a degree-3 node, if it has one.
@@ -242,7 +275,8 @@ def simplify(graph: MedialGraph, *, stroke_width: float, multi: bool, ends: int 
 
         options = [(bid, far) for bid, far in options if other_ok(far)
                    and graph.branches[bid].length < 40.0 * stroke_width and opens_a_v(bid)
-                   and _facing(graph, node, far, bid, reach)]
+                   and _facing(graph, node, far, bid, reach)
+                   and not _one_pass_wide(graph.branches[bid], graph.radii[node], graph.radii[far], line)]
         widest = max(options, key=lambda o: _min_radius(graph.branches[o[0]]), default=None)
         foot_bid = node_slots[foot_slot(dirs)][0]
         foot = next((o for o in options if o[0] == foot_bid), None)
