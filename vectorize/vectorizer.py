@@ -581,7 +581,7 @@ def run_pipeline(image: np.ndarray, options: VectorizeOptions, *,
     # Smoothing allowance: the medial axis wobbles by ~0.07 px per px of stroke width (pixel
     # grid, anti-aliasing); fitting tighter follows that wobble, looser cuts corners.
     sigma = float(np.clip(0.065 * w, 0.15, 0.8))
-    guard = InkGuard(graph, ink.gray, ink.threshold, margin=guard_margin(w)) if solved is None else None
+    guard = InkGuard(graph, ink.gray, ink.threshold, margin=guard_margin(w), rings=rings) if solved is None else None
     edge = edge_offset(ink.gray, ink.ink, rings, ink.threshold, w) if solved is None else 0.0
     blobs = np.array([[*graph.positions[n], graph.radii[n]] for n, incident in graph.incident.items()
                       if len(incident) >= 3]).reshape(-1, 3)

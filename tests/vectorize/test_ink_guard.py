@@ -130,3 +130,33 @@ def test_a_thin_glyph_scanned_at_half_resolution_stays_within_one_width():
                      gt.drawing.height, "px")
     assert len(output.strokes) == 1
     assert excursion(gt.drawing, output) <= gt.width
+
+
+@pytest.mark.parametrize("seed, index", [(0, 35), (11, 35)])
+def test_balls_about_merged_clusters_hold_no_paper(seed, index):
+    """The guard takes the ink for the union of its medial balls. A merged cluster's node
+    carries its junctions' largest radius wherever it sits, and the straight runs joining it
+    to the old junctions carry theirs: balls that reached over paper (the small hole between
+    an h base's passes in these two words) and let a fitted curve cut across it. Measured to
+    the outline, a ball about a cluster holds ink only."""
+    from benchmarks.common.render import render_truth
+    from benchmarks.sets.cursive import cursive_drawing
+    from scipy.ndimage import map_coordinates
+
+    image = render_truth(cursive_drawing(seed, index))
+    stages = vectorize_image(image, VectorizeOptions(classifier="cnn", keep_stages=True)).stages
+    ink, graph = stages["ink"], stages["simplified"]
+    guard = InkGuard(graph, ink.gray, ink.threshold, rings=stages["rings"])
+    about = np.zeros(len(guard.points), dtype=bool)
+    for node, span in graph.spans.items():
+        if node in graph.positions:
+            about |= np.linalg.norm(guard.points - graph.positions[node], axis=1) <= span
+    assert about.sum() >= 20  # h bases merged, with their runs to the old junctions
+    # Each ball's rim, 0.25 px in from it (the outline's own chords and the bilinear field
+    # differ by less): ink all round.
+    angles = np.linspace(0.0, 2.0 * np.pi, 16, endpoint=False)
+    ring = np.column_stack([np.cos(angles), np.sin(angles)])
+    inner = np.maximum(guard.radii[about] - 0.25, 0.0)
+    rim = (guard.points[about][:, None, :] + inner[:, None, None] * ring[None]).reshape(-1, 2)
+    gray = map_coordinates(ink.gray, [rim[:, 1], rim[:, 0]], order=1, mode="nearest")
+    assert (gray < ink.threshold).all(), f"{(gray >= ink.threshold).sum()} rim points on paper"

@@ -11,7 +11,7 @@ worst point and fit the halves; the centre line as a polyline.
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 
 import numpy as np
 import shapely
@@ -34,6 +34,8 @@ STEP = 0.4
 # Checked points must keep the sampling error in hand: the guard's margin is what is left.
 SLACK = 1.0
 MARGIN = SLACK - STEP / 2 - FLATNESS
+# Outline samples looked at per point about a merged cluster (`merged_radii`).
+NEAREST_SAMPLES = 4
 # Nor more than one width away: for lines under 2 px wide that is the nearer bound.
 MIN_MARGIN = 0.05
 
@@ -67,7 +69,8 @@ class InkGuard:
     point the balls miss is looked up in the image itself (with its `margin` around it).
     """
 
-    def __init__(self, graph: MedialGraph, gray: np.ndarray, level: float, *, margin: float = MARGIN) -> None:
+    def __init__(self, graph: MedialGraph, gray: np.ndarray, level: float, *, margin: float = MARGIN,
+                 rings: Sequence[np.ndarray] = ()) -> None:
         self.gray, self.level = gray, level
         points = [b.points for b in graph.branches.values()]
         radii = [b.radii for b in graph.branches.values()]
@@ -77,6 +80,8 @@ class InkGuard:
         self.points = np.vstack(points) if points else np.zeros((1, 2))
         self.radii = np.concatenate(radii) if radii else np.zeros(1)
         self.tree = cKDTree(self.points)
+        if len(rings):
+            self.radii = merged_radii(graph, self.tree, self.radii, rings)
         self.margin = margin
         # A point farther than this from every centre-line point is outside all the balls
         # grown by the margin: `strays` stops its search for the nearest one there.
@@ -134,6 +139,41 @@ class InkGuard:
     def stroke_excess(self, stroke: Stroke) -> float:
         """Largest excess along a stroke (px), checked every `STEP` px (`curve_points`)."""
         return float(self.excess(curve_points(stroke.control)).max())
+
+
+def merged_radii(graph: MedialGraph, tree: cKDTree, radii: np.ndarray, rings: Sequence[np.ndarray]) -> np.ndarray:
+    """`radii` (N,) of the centre-line points in `tree`, with those about merged junction
+    clusters measured to the ink's outline (`rings`: closed polylines (M, 2) of outline samples).
+
+    A merged cluster's node sits at one place of its ink (where the passes cross) and carries
+    its junctions' largest radius, and the straight runs that join it to the old junctions
+    carry theirs: balls that may reach over paper, a hole between passes for one. There the
+    radius is each point's distance to the outline.
+    """
+    merged = [(graph.positions[n], span) for n, span in graph.spans.items() if n in graph.positions]
+    near = [i for centre, span in merged for i in tree.query_ball_point(centre, span + 0.5)]
+    rings = [r for r in rings if len(r) > 1]
+    if not near or not rings:
+        return radii
+    samples = np.vstack(rings)
+    # Each sample's next along its ring: the outline's segments are (sample, next).
+    starts = np.cumsum([0] + [len(r) for r in rings[:-1]])
+    following = np.arange(len(samples)) + 1
+    following[starts + [len(r) - 1 for r in rings]] = starts
+    preceding = np.empty_like(following)
+    preceding[following] = np.arange(len(samples))
+    # The nearest segment has an end among a point's nearest samples: measure the segments
+    # on either side of its NEAREST_SAMPLES nearest. (An unbalanced tree builds in half the time.)
+    at = tree.data[near]
+    nearest = cKDTree(samples, balanced_tree=False, compact_nodes=False).query(at, k=NEAREST_SAMPLES)[1]
+    ends = np.concatenate([np.stack([nearest, following[nearest]], axis=-1),
+                           np.stack([preceding[nearest], nearest], axis=-1)], axis=1)  # (P, 2k, 2)
+    a, b = samples[ends[..., 0]], samples[ends[..., 1]]
+    ab = b - a
+    t = np.clip(((at[:, None] - a) * ab).sum(axis=2) / np.maximum((ab * ab).sum(axis=2), 1e-12), 0.0, 1.0)
+    radii = radii.copy()
+    radii[near] = np.linalg.norm(at[:, None] - (a + t[..., None] * ab), axis=2).min(axis=1)
+    return radii
 
 
 def curve_excess(guard: InkGuard, control: np.ndarray) -> tuple[float, np.ndarray]:
