@@ -66,8 +66,8 @@ def freeze_loaded_objects() -> None:
 @contextmanager
 def loading_for_good() -> Iterator[None]:
     """Imports inside run with the cyclic garbage collector paused, and everything alive at
-    the end is left out of its passes (`onestroke.lasting.paused_then_frozen`). A library's import makes
-    thousands of objects that stay and next to no garbage, yet its allocations set off
+    the end is left out of its passes (`onestroke.lasting.paused_then_frozen`). A library's
+    import makes thousands of objects that stay and next to no garbage, yet its allocations set off
     collections that go through all the objects made so far: pausing the collector while
     scipy, scikit-image and the stages load (the bare import floor of `startup_cost.py
     --pairs` imports them with it running) took the garbage collection in a command from
