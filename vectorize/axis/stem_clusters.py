@@ -144,9 +144,10 @@ def merge_stem_clusters(graph: MedialGraph, *, stroke_width: float, ends: int, p
         # leave inside the band).
         near_in = _blob(graph, {into}, inner)
         near_loop = _blob(graph, loop_at, inner)
-        joins = [b for b in inner if not near_in & near_loop
-                 and {graph.branches[b].a in near_in, graph.branches[b].b in near_in} == {True, False}
-                 and {graph.branches[b].a in near_loop, graph.branches[b].b in near_loop} == {True, False}]
+        # A branch with one end at each; none where the two blobs are one.
+        joins = [] if near_in & near_loop else [
+            b for b in inner if (graph.branches[b].a in near_in) != (graph.branches[b].b in near_in)
+            and (graph.branches[b].a in near_loop) != (graph.branches[b].b in near_loop)]
         if tree and len(joins) != 1:
             continue
         band = joins[0] if len(joins) == 1 else None
