@@ -24,10 +24,10 @@ from types import ModuleType
 _for_good = False  # set by a short command (`load_later_imports_for_good`)
 
 
-def load_later_imports_for_good(on: bool = True) -> None:
+def load_later_imports_for_good() -> None:
     """From now on in this process, `import_later` loads what it imports for good."""
     global _for_good
-    _for_good = on
+    _for_good = True
 
 
 @contextmanager
