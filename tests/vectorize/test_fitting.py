@@ -98,3 +98,26 @@ def test_a_closed_piece_fits_on_thinned_points_and_stays_closed():
     control = fit_piece(points, closed=True, sigma=0.25, spacing=1.0)
     np.testing.assert_allclose(control[-1, 3], control[0, 0])
     assert np.percentile(_distance_to(control, true), 99) < 0.6
+
+
+def test_a_point_held_alone_in_a_gap_stands_for_the_points_dropped_there():
+    # A crossing node keeps its pass's only point in the uncertain zone about it (40 px
+    # here); the node lies 1.5 px off the curve through the points either side, as the
+    # crossing of two passes in a shared band does. Weighing one point, the smoothing spends
+    # its residual on it; weighing the 160 points dropped about it, the fit goes through it.
+    x = np.arange(0.0, 600.0, 0.25)
+    true = np.column_stack([x, 40.0 * np.sin(x / 60.0)])
+    points = true + np.random.default_rng(0).normal(0.0, 0.1, true.shape)
+    gap = np.abs(x - 300.0) < 20.0
+    node = int(np.argmin(np.abs(x - 300.0)))
+    points[node] += (0.0, 1.5)
+    keep = ~gap
+    keep[node] = True
+    held = np.ones(len(points))
+    held[node] = gap.sum()
+    alone = fit_piece(points[keep], closed=False, sigma=0.3)
+    weighed = fit_piece(points[keep], closed=False, sigma=0.3, held=held[keep])
+    assert _distance_to(alone, points[node : node + 1])[0] > 0.5
+    assert _distance_to(weighed, points[node : node + 1])[0] < 0.2
+    # elsewhere the fit still follows the line within half a thin line's width
+    assert np.percentile(_distance_to(weighed, true[~gap]), 99) < 0.75

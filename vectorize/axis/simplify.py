@@ -106,6 +106,8 @@ class Simplified:
     through: dict = field(default_factory=dict)  # node where three passes cross -> slot pairs
     # such a node -> (15,) posterior of the pass scorer over `pass_scorer.PAIRINGS` (slots)
     through_posterior: dict = field(default_factory=dict)
+    # crossing nodes placed where the band their passes share is narrowest (`stem_clusters`)
+    narrowest: frozenset = frozenset()
 
 
 def line_radius(graph: MedialGraph) -> float:

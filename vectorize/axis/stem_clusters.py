@@ -42,7 +42,7 @@ HOLE_BRANCH_WIDTHS = 1.0 / np.sin(np.radians(15.0 / 2.0))
 
 
 def merge_stem_clusters(graph: MedialGraph, *, stroke_width: float, ends: int, place, through: dict | None = None,
-                        may_merge=None) -> dict[int, int]:
+                        may_merge=None, narrowest: set | None = None) -> dict[int, int]:
     """Find the clusters of junctions where a stem drawn down and back up meets a crossing
     (module doc) and read each as one crossing and one branch beside it, in place.
 
@@ -53,7 +53,9 @@ def merge_stem_clusters(graph: MedialGraph, *, stroke_width: float, ends: int, p
     in and the loop's way down (`passes`, two slot pairs at `node` merged in `graph`) cross
     (`vectorize.junctions.crossing_point.passes_crossing`, passed in: the junctions' stage
     comes after this one); the node's place where three passes share the band, and which
-    band where a hole's way in does not border its loop's junction. Returns crossing node ->
+    band where a hole's way in does not border its loop's junction. narrowest (if given)
+    gets the nodes placed where the band the two crossing passes share is narrowest: their
+    crossing read from the ink. Returns crossing node ->
     its stem's tip, where the fit splits; the tip's other branch is the stem drawn back up
     into the way on. Pair each node's slots with `stem_passes` once simplification is done.
     """
@@ -151,8 +153,9 @@ def merge_stem_clusters(graph: MedialGraph, *, stroke_width: float, ends: int, p
         if tree and len(joins) != 1:
             continue
         band = joins[0] if len(joins) == 1 else None
-        if band is not None and _shortest(graph, [b for b in inner if b != band], stems[0][0],
-                                          _junction(graph, on, inside)) is not None:
+        read = band is not None and _shortest(graph, [b for b in inner if b != band], stems[0][0],
+                                              _junction(graph, on, inside)) is not None
+        if read:
             radii = graph.branches[band].radii
             centre = graph.branches[band].points[1 + int(np.argmin(radii[1:-1])) if len(radii) > 2 else 0]
         elif tree:
@@ -174,6 +177,8 @@ def merge_stem_clusters(graph: MedialGraph, *, stroke_width: float, ends: int, p
             graph.spans[node] = float(max(np.hypot(*(end - centre)) for end in band_ends))
         graph.add_branch(up)
         tips[node] = up.a
+        if read and narrowest is not None:
+            narrowest.add(node)
     return tips
 
 

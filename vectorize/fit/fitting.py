@@ -43,7 +43,9 @@ class TracedPoints:
     fit there; corner: (N,) bool or None (none), a corner (split, and the joint goes where
     the two sides' tangents meet); radius: (N,) px, the medial axis's distance to the
     outline at each point (half the ink width), or None (unknown); junction: (N,) bool or
-    None (none), the point is a node of the axis where three or more branches meet.
+    None (none), the point is a node of the axis where three or more branches meet; held:
+    (N,) how many points each weighs in the fit (a crossing node kept alone in its uncertain
+    zone stands for the points dropped there), or None (one each).
     """
 
     xy: np.ndarray
@@ -52,6 +54,7 @@ class TracedPoints:
     corner: np.ndarray | None = None
     radius: np.ndarray | None = None
     junction: np.ndarray | None = None
+    held: np.ndarray | None = None
 
     def __len__(self) -> int:
         return len(self.xy)
@@ -144,20 +147,23 @@ def along_distance(arc: np.ndarray, marked: np.ndarray) -> np.ndarray:
 
 
 def fit_piece(points: np.ndarray, *, closed: bool, sigma: float, anchor: bool = True,
-              spacing: float = 0.0, dense: np.ndarray | None = None) -> np.ndarray:
+              spacing: float = 0.0, dense: np.ndarray | None = None, held: np.ndarray | None = None) -> np.ndarray:
     """Fit one piece: (N, 2) ordered points -> Bézier control points (K, 4, 2).
 
     sigma: expected noise of the points in px; the smoothing allows that much residual.
     anchor: make an open piece start and end exactly on its first and last points.
     spacing, dense: fit only the points `thinned` keeps (spacing 0: every point), each
     weighing as much as the points it stands for: about the same sum is minimised.
+    held: (N,) how many points each point weighs besides (`TracedPoints.held`; None: one
+    each); the smoothing's allowance stays that of the points themselves.
     """
     kept, count = thinned(points, spacing, dense)
     points = points[kept]
     distinct = _distinct(points, 1e-3)
     points, count = points[distinct], count[distinct]
+    weigh = np.ones(len(points)) if held is None else np.asarray(held, dtype=float)[kept][distinct]
     if closed and len(points) > 3 and np.linalg.norm(points[0] - points[-1]) < 1e-6:
-        points, count = points[:-1], count[:-1]
+        points, count, weigh = points[:-1], count[:-1], weigh[:-1]
     if len(points) < 4 or (closed and len(points) < 6):
         line = points if len(points) >= 2 else np.vstack([points, points + 1e-3])
         if closed:
@@ -165,12 +171,13 @@ def fit_piece(points: np.ndarray, *, closed: bool, sigma: float, anchor: bool = 
         return Stroke.from_polyline(line).control
     if closed:
         points, count = np.vstack([points, points[:1]]), np.append(count, count[0])
+        weigh = np.append(weigh, weigh[0])
     u = arc_lengths(points)
     u /= u[-1]
     # FITPACK minimises sum((w * residual)^2) within s: weights sqrt(count) and s over all the
     # points stood for ask of the thinned points what the full fit asks of every point.
     smoothing = float(count.sum()) * sigma * sigma
-    weight = np.sqrt(count) if (count != 1).any() else None
+    weight = np.sqrt(count * weigh) if (count * weigh != 1).any() else None
     try:
         tck, _ = splprep([points[:, 0], points[:, 1]], w=weight, u=u, k=3, s=smoothing, per=1 if closed else 0,
                          quiet=2)
@@ -307,6 +314,7 @@ def fit_stroke(traced: TracedPoints, *, closed: bool, sigma: float, stroke_width
     split = np.array(traced.split, dtype=bool)
     corner = np.zeros(len(xy), dtype=bool)
     junction = np.zeros(len(xy), dtype=bool) if traced.junction is None else np.array(traced.junction, dtype=bool)
+    held = np.ones(len(xy)) if traced.held is None else np.array(traced.held, dtype=float)
     arc = arc_lengths(xy)
     wide = _turn(xy, arc, 1.5 * stroke_width, closed) if len(xy) >= 5 else None
     found = _sharp_corners(xy, arc, wide, stroke_width, closed) if wide is not None else np.zeros(0, dtype=int)
@@ -330,22 +338,24 @@ def fit_stroke(traced: TracedPoints, *, closed: bool, sigma: float, stroke_width
         # sharp feature, as a pen usually does: then it is a chain of open pieces.
         if np.allclose(xy[0], xy[-1]):
             last_corner = bool(corner[-1])
-            xy, keep, split, corner, junction = xy[:-1], keep[:-1], split[:-1], corner[:-1], junction[:-1]
+            xy, keep, split, corner, junction, held = (xy[:-1], keep[:-1], split[:-1], corner[:-1], junction[:-1],
+                                                       held[:-1])
             split_at = np.flatnonzero(split)
             if not split_at.size:  # the only split was the repeated point: it is the first
                 split[0], corner[0] = True, corner[0] or last_corner
                 split_at = np.zeros(1, dtype=np.int64)
         shift = int(split_at[np.argmin(xy[split_at].sum(axis=1))])
-        xy, keep, split, corner, junction = (np.roll(a, -shift, axis=0) for a in (xy, keep, split, corner, junction))
+        xy, keep, split, corner, junction, held = (np.roll(a, -shift, axis=0)
+                                                   for a in (xy, keep, split, corner, junction, held))
         twins = rolled(twins, shift, len(xy))
         xy = np.vstack([xy, xy[:1]])
         keep, split, corner = np.append(keep, keep[0]), np.append(split, split[0]), np.append(corner, corner[0])
-        junction = np.append(junction, junction[0])
+        junction, held = np.append(junction, junction[0]), np.append(held, held[0])
         closed = False
         twins = valid_twins(xy, twins)
     if guard is not None:
-        xy, keep, split, corner, junction, twins = with_fork_tips(xy, keep, split, corner, junction, twins,
-                                                                    guard, stroke_width, closed)
+        xy, keep, split, corner, junction, held, twins = with_fork_tips(xy, keep, split, corner, junction, held,
+                                                                          twins, guard, stroke_width, closed)
         twins = valid_twins(xy, twins)
     # Around a corner the axis is off the centre line for about a stroke width: leave it out.
     # (The corner joints below read the tip along this arc too.)
@@ -374,9 +384,9 @@ def fit_stroke(traced: TracedPoints, *, closed: bool, sigma: float, stroke_width
             mask[0] = mask[-1] = True
             mask[0] &= not corner[lo]
             mask[-1] &= not corner[hi]
-        piece, near = xy[lo:hi + 1][mask], dense[lo:hi + 1][mask]
+        piece, near, hold = xy[lo:hi + 1][mask], dense[lo:hi + 1][mask], held[lo:hi + 1][mask]
         if len(piece) < 2:
-            piece, near = xy[[lo, hi]], None
+            piece, near, hold = xy[[lo, hi]], None, None
         if previous is not None and len(piece) == len(previous) and np.array_equal(piece, previous[::-1]):
             # The way back from a retraced spike: exactly the way out, reversed, so the
             # two passes lie on each other instead of crossing back and forth.
@@ -389,12 +399,12 @@ def fit_stroke(traced: TracedPoints, *, closed: bool, sigma: float, stroke_width
             # 3-5 per px. Where that fit leaves the ink, the piece is fitted on every point
             # before the guard's ladder: thinned knots can swing across a long uncertain stretch.
             spacing = min(THIN * stroke_width, THIN_MAX) if len(piece) > THIN_FROM else 0.0
-            control = fit_piece(piece, **settings, spacing=spacing, dense=near)
+            control = fit_piece(piece, **settings, spacing=spacing, dense=near, held=hold)
             worst = curve_excess(guard, control)[0] if guard is not None else 0.0
             checked = np.array(control) if guard is not None and worst <= 0.0 else None
             if worst > 0.0:
                 if spacing:
-                    control = fit_piece(piece, **settings)
+                    control = fit_piece(piece, **settings, held=hold)
                 # Measured against every traced point of the piece, the uncertain ones too.
                 whole = xy[lo:hi + 1]
                 if closed and len(cuts) == 2:

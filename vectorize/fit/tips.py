@@ -160,12 +160,12 @@ def pruned_cusps(xy: np.ndarray, arc: np.ndarray, wide: np.ndarray, free: np.nda
     return np.array(found, dtype=int)
 
 
-def with_fork_tips(xy, keep, split, corner, junction, twins, guard: InkGuard, stroke_width: float,
+def with_fork_tips(xy, keep, split, corner, junction, held, twins, guard: InkGuard, stroke_width: float,
                    closed: bool):
     """The traced arrays with a spike out to each fork's tip (`_fork_tip`) and back: the
     points [tip, fork] inserted after the fork where the pen turns (a split there, or a
     corner), split at both (the spike is fitted straight and retraced, as the route retraces
-    a spike). Returns (xy, keep, split, corner, junction, twins), the first five (N', ...)
+    a spike). Returns (xy, keep, split, corner, junction, held, twins), the first six (N', ...)
     arrays as `fitting.fit_stroke` holds them."""
     arc = arc_lengths(xy)
 
@@ -181,6 +181,7 @@ def with_fork_tips(xy, keep, split, corner, junction, twins, guard: InkGuard, st
         split = np.insert(split, i + 1, [True, True])
         corner = np.insert(corner, i + 1, [False, False])
         junction = np.insert(junction, i + 1, [False, False])
+        held = np.insert(held, i + 1, [1.0, 1.0])
         # Ranges after the fork move on by the two points (one across it no longer matches
         # its partner and is dropped by `valid_twins`).
         def moved(span: tuple[int, int], i: int = i) -> tuple[int, int]:
@@ -188,4 +189,4 @@ def with_fork_tips(xy, keep, split, corner, junction, twins, guard: InkGuard, st
             return (lo + 2 if lo >= i and hi > i else lo, hi + 2 if hi > i else hi)
 
         twins = [Twin(moved(t.first), moved(t.second), t.reverse) for t in twins]
-    return xy, keep, split, corner, junction, twins
+    return xy, keep, split, corner, junction, held, twins
