@@ -11,6 +11,7 @@ from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
 
+from onestroke.cores import idle_cores
 from onestroke.errors import InputError
 from vectorize.axis.clusters import merge_triple_points, straightest_pairs
 from vectorize.axis.gaps import bridge_gaps, keep_largest_piece
@@ -59,6 +60,10 @@ MAX_OUTLINES, MAX_BRANCH_POINTS = 5000, 4000
 MAX_OUTLINE_SAMPLES = 150_000
 LONG_LINE_OUTLINES = 500
 MAX_LONG_LINE_SAMPLES = 600_000
+# Outline samples up to which the crossing CNN is started beside qhull (`_cnn_beside`): qhull
+# takes ~2.5 us a sample, so up to ~50 ms in one thread against ~25-30 ms in two tiles, while
+# onnxruntime's import and the session take ~30 ms of this thread.
+CNN_BESIDE_SAMPLES = 20_000
 # Share of plausibility of the smoother touching pairing when the classifier says "touch".
 SMOOTHER_TOUCH = 0.85
 
@@ -484,11 +489,45 @@ def _axis(image: np.ndarray, options: VectorizeOptions, clock: _Clock, cache: St
     _refuse_noise(samples, "outline samples", MAX_OUTLINE_SAMPLES if len(rings) > LONG_LINE_OUTLINES
                   else MAX_LONG_LINE_SAMPLES, ink.threshold, options.threshold is not None)
     # A process's first call imports the fitting stage's libraries (scipy.interpolate and
-    # scipy.optimize, ~0.1 s, holding the GIL) while qhull triangulates in another thread.
-    later = None if "vectorize.fit.fitting" in sys.modules else partial(import_module, "vectorize.fit.fitting")
-    graph = medial_axis(rings, ink.gray, ink.threshold, beside=later)
+    # scipy.optimize, ~0.1 s, holding the GIL) while qhull triangulates in another thread,
+    # and starts the crossing CNN there where the line likely crosses itself.
+    later = [] if "vectorize.fit.fitting" in sys.modules else [partial(import_module, "vectorize.fit.fitting")]
+    if _cnn_beside(len(rings), samples, options.classifier, idle_cores()):
+        later.append(_start_cnn)
+    graph = medial_axis(rings, ink.gray, ink.threshold, beside=partial(_each, later) if later else None)
     clock.lap("medial axis")
     return ink, rings, graph
+
+
+def _cnn_beside(rings: int, samples: int, classifier, cores: int) -> bool:
+    """Whether to start the crossing CNN (onnxruntime's import and the model's session,
+    ~30 ms of CPU holding the GIL, otherwise paid in the classification stage) in this
+    thread while qhull triangulates in another: where a core is spare (`cores`), the
+    `classifier` is the CNN and onnxruntime is not loaded yet, and the ink's outline of
+    `samples` points has three `rings` or more. A line that closes two loops or more meets
+    itself somewhere (the two loops' centre lines form a graph with a node of degree 3 or
+    more), and those junctions are classified by the ONNX networks; one hole (an O) needs
+    none. Up to `CNN_BESIDE_SAMPLES`: beyond that, qhull in two tiles saves more than the
+    overlap (`medial_axis` makes one tile per spare core while this thread works).
+    A guess of what the classification stage will ask for: the output is the same either way."""
+    return (classifier == "cnn" and rings >= 3 and samples <= CNN_BESIDE_SAMPLES and cores > 1
+            and "onnxruntime" not in sys.modules)
+
+
+def _start_cnn() -> None:
+    """Import onnxruntime and start the crossing CNN's session (`make_classifier`'s cached
+    one). A failure (the model missing or damaged, onnxruntime not loading) is left to the
+    classification stage, which meets it again only if the drawing needs the CNN."""
+    try:
+        make_classifier("cnn").session  # noqa: B018 - started for its side effect
+    except Exception:  # noqa: BLE001 - a guess must not fail a drawing that needs no CNN
+        pass
+
+
+def _each(steps: list[Callable[[], object]]) -> None:
+    """Run `steps` in order."""
+    for step in steps:
+        step()
 
 
 def output_matrix(ink_scale: float, frame: InputFrame) -> np.ndarray:
