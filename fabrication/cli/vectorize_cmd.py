@@ -56,10 +56,14 @@ def vectorize(source: str, output: str, multi: bool, threshold: float | None, bl
         from fabrication.placement import PlacementOptions
 
         placement = PlacementOptions(size=size, width=width, height=height, rotate=rotate)
-    from fabrication.cli.heap import keep_freed_memory, loading_for_good
+    from fabrication.cli.heap import keep_freed_memory, loading_for_good, touch_heap_beside
+    from onestroke.cores import idle_cores
     from onestroke.lasting import load_later_imports_for_good
 
-    keep_freed_memory()  # before the binarize thread starts: its freed arrays serve the later stages
+    # Before the binarize thread starts: its freed arrays serve the later stages. With a core
+    # to spare, the heap's first pages are touched there while this thread imports.
+    if keep_freed_memory() and idle_cores() > 1:
+        touch_heap_beside()
     # The libraries load with the garbage collector paused and then stay out of its passes
     # (fabrication/cli/heap.py); a raster drawing's stages load now for that.
     with loading_for_good():

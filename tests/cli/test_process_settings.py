@@ -122,3 +122,36 @@ def test_memory_a_thread_freed_serves_the_main_thread(tmp_path):
     assert results["1"]["kept"] is True
     assert results["0"]["faults"] > 4 * 900  # 16 MB: ~4,000 pages touched afresh
     assert results["1"]["faults"] < results["0"]["faults"] / 10, results
+
+
+# keep_freed_memory, the heap touched ahead in a second thread or not, then arrays made in the
+# main thread (as a command's imports and stages make them): the main thread's page faults.
+AHEAD_CHILD = """
+import json, resource, sys
+import numpy as np
+from fabrication.cli.heap import keep_freed_memory, touch_heap_beside
+keep_freed_memory()
+ahead = touch_heap_beside() if sys.argv[2] == "1" else None
+if ahead is not None:
+    ahead.join()
+before = resource.getrusage(resource.RUSAGE_THREAD).ru_minflt
+arrays = [np.ones(500_000) for _ in range(4)]
+with open(sys.argv[1], "w") as fh:
+    json.dump({"ahead": ahead is not None, "faults": resource.getrusage(resource.RUSAGE_THREAD).ru_minflt - before}, fh)
+"""
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="glibc's mallopt")
+def test_the_heap_touched_ahead_in_another_thread_faults_no_page_in_this_one(tmp_path):
+    """`touch_heap_beside` (a command with a core to spare, while it imports): the heap's
+    pages are faulted in by a second thread and kept, so this thread's arrays take none."""
+    report = tmp_path / "ahead.json"
+    results = {}
+    for ahead in ("1", "0"):
+        done = subprocess.run([sys.executable, "-c", AHEAD_CHILD, str(report), ahead], capture_output=True,
+                              text=True, env=child_env(), timeout=120)
+        assert done.returncode == 0, done.stderr
+        results[ahead] = json.loads(report.read_text())
+    assert results["1"]["ahead"] is True
+    assert results["0"]["faults"] > 4 * 900  # 16 MB: ~4,000 pages touched afresh
+    assert results["1"]["faults"] < results["0"]["faults"] / 10, results
