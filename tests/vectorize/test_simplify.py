@@ -101,7 +101,8 @@ def _two_forks(far_fork_opens: str, gap: float = 12.0, radius: float = 0.7 * W):
     `far_fork_opens` "up" (a next letter's stem rising from the line between them: the
     branch from A runs down and along the line, as from a u's arm to a k) or "down" (a
     crossing's other half: the branch runs straight on down, `gap` px long, of medial
-    `radius` px; every other branch's is W / 2). Returns the graph and A, B."""
+    `radius` px (a number, or one per point: gap + 1 of them); every other branch's is W / 2).
+    Returns the graph and A, B."""
     from vectorize.axis.graph import MedialGraph
 
     graph = MedialGraph()
@@ -122,10 +123,11 @@ def _two_forks(far_fork_opens: str, gap: float = 12.0, radius: float = 0.7 * W):
     else:
         fork_b = node(0.0, gap)
         _join(graph, fork_a, fork_b, *((0.0, y) for y in np.arange(1.0, gap, 1.0)), radius=radius)
-        tip, out = node(-25.0, 80.0), node(25.0, 80.0)
-        _join(graph, fork_b, tip, (-8.0, 40.0))
-        _join(graph, fork_b, out, (8.0, 40.0))
-    _join(graph, tip, out, (90.0, -100.0) if far_fork_opens == "up" else (0.0, 120.0))
+        below = max(gap, 20.0)  # fork B's arms run on down beyond it
+        tip, out = node(-25.0, below + 60.0), node(25.0, below + 60.0)
+        _join(graph, fork_b, tip, (-8.0, below + 20.0))
+        _join(graph, fork_b, out, (8.0, below + 20.0))
+    _join(graph, tip, out, (90.0, -100.0) if far_fork_opens == "up" else (0.0, below + 100.0))
     _join(graph, out, node(200.0, 0.0))
     return graph, fork_a, fork_b
 
@@ -166,8 +168,33 @@ def test_two_forks_joined_by_one_line_are_not_one_crossing():
         assert not simple.crossings
 
 
+def test_two_forks_joined_by_one_line_with_a_touch_beside_it_are_not_one_crossing():
+    """Two forks facing each other 60 px (15 widths) apart, joined by one line that another
+    line touches on the way (the ink 1.4 line radii deep along 3 px of it): still two
+    junctions of one line. Between the halves of a crossing that shallow, the two passes part
+    steadily and the ink is that deep along most of the way. Thin cursive lines drew a u's
+    bowl twice where a touch beside it deepened it locally (an_empty_cup_and_a_dull_pen-9-3,
+    the_kitten_ate_the_mauled_candy-31-20, unintended_and_unattended-34-11)."""
+    gap = 60.0
+    along = np.arange(0.0, gap + 1.0)  # the joining branch's points, fork A to fork B
+    touched = np.where(np.abs(along - 20.0) <= 1.0, 0.7 * W, 0.5 * W)
+    graph, fork_a, fork_b = _two_forks("down", gap=gap, radius=touched)
+    simple = simplify(graph, stroke_width=W, multi=False)
+    assert fork_a in graph.incident and fork_b in graph.incident
+    assert not simple.crossings
+    # Two passes parting steadily from the middle: one line's radius there, two at the forks.
+    parting = 0.5 * W * (1.0 + np.abs(along - gap / 2) / (gap / 2))
+    graph, fork_a, fork_b = _two_forks("down", gap=gap, radius=parting)
+    simple = simplify(graph, stroke_width=W, multi=False)
+    assert fork_a not in graph.incident and fork_b not in graph.incident
+    assert len(simple.crossings) == 1
+
+
 @pytest.mark.parametrize("seed, index", [
     (8, 37),  # uncle_hank_decided_at_lunchtime, 2 px: the 44 px bowl of lunch's u drawn twice, 3952 px for 3934
+    (9, 3),  # an_empty_cup_and_a_dull_pen, 2 px: a 53 px bowl with a touch beside it drawn twice, 4045 px for 3963
+    (31, 20),  # the_kitten_ate_the_mauled_candy, 2 px: a 37 px bowl, 4088 px for 4061
+    (34, 11),  # unintended_and_unattended, 2 px: a 37 px bowl, 3932 px for 3912
     (12, 33),  # uncle_hank_decided_at_lunchtime, 2.25 px: 41 px of one line drawn twice, 3876 px for 3863
     (11, 33),  # the_hunted_elk_came_at_ten, 2 px: 30 px of one line drawn twice, 3841 px for 3827
 ])

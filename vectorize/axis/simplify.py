@@ -24,6 +24,13 @@ Slot = tuple[int, str]  # (branch id, which end of it touches the node: "a" or "
 # their discs, the deepest point measured 1.38-2.5 line radii; on a line running alone
 # between two forks, 0.98-1.09 (pixel grid, anti-aliasing).
 TWO_PASSES_RADIUS = 1.2
+# Line radii beyond the junctions' discs from which a branch is long enough for the share of
+# its length that runs that deep to tell (`_one_pass_wide`), and the least such share between
+# a crossing's halves: measured 0.24 and up between the halves of crossings 16-37 line radii
+# apart (cursive, 2-3.5 px lines); a touch beside one line deepened 0.005-0.024 of branches
+# 25-58 line radii long between two forks of that line.
+LONG_BRANCH_RADII = 16.0
+TWO_PASSES_SHARE = 0.1
 
 
 def slots(graph: MedialGraph, node: int) -> list[Slot]:
@@ -128,12 +135,25 @@ def _one_pass_wide(branch: Branch, radius_a: float, radius_b: float, line: float
     junctions of one line, however their arms point. Told only where the discs leave two line
     widths between them: close to a crossing's centre the pixel grid rounds its inner
     corners off (1.0-1.2 line radii measured between the halves of right-angle crossings of
-    2 px lines, 4 px apart)."""
+    2 px lines, 4 px apart). A branch over `LONG_BRANCH_RADII` line radii long is one line
+    wide too when it runs that deep along less than `TWO_PASSES_SHARE` of that length."""
     arc = branch.arc
-    if arc[-1] - radius_a - radius_b < 4.0 * line:
+    length = arc[-1] - radius_a - radius_b
+    if length < 4.0 * line:
         return False
     beyond = (arc > radius_a) & (arc < arc[-1] - radius_b)
-    return bool(beyond.any()) and float(branch.radii[beyond].max()) <= TWO_PASSES_RADIUS * line
+    if not beyond.any():
+        return False
+    deep = branch.radii > TWO_PASSES_RADIUS * line
+    if not deep[beyond].any():
+        return True
+    # Far apart, a crossing's halves are joined by the two passes parting steadily: their
+    # centre lines are more than a fifth of a width apart, the ink more than 1.2 line radii
+    # deep, along most of the way. A touch or a blot beside one line deepens it locally.
+    inner = np.clip(arc, radius_a, arc[-1] - radius_b)
+    steps = np.diff(inner)
+    deep_length = float(steps[(deep[:-1] & deep[1:])].sum()) + 0.5 * float(steps[deep[:-1] ^ deep[1:]].sum())
+    return length >= LONG_BRANCH_RADII * line and deep_length < TWO_PASSES_SHARE * length
 
 
 def _min_radius(branch: Branch) -> float:
