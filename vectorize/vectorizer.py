@@ -66,6 +66,9 @@ MAX_LONG_LINE_SAMPLES = 600_000
 CNN_BESIDE_SAMPLES = 20_000
 # Share of plausibility of the smoother touching pairing when the classifier says "touch".
 SMOOTHER_TOUCH = 0.85
+# How sure a verdict may be taken where pairings of equal capped cost are told apart
+# (`route_inspection.connect_pairings`): the classifiers' own bound (`_with_geometry`).
+EVIDENCE_SURE = 1.0 - 1e-6
 
 
 class _Clock:
@@ -161,9 +164,10 @@ def _pair_through(graph: MedialGraph, nodes, gray: np.ndarray, w: float,
     return result, posterior
 
 
-def _pairing_costs(verdict: JunctionVerdict) -> tuple[float, float, float]:
-    """-log plausibility of the three ranked pairings, relative to the first."""
-    p = float(np.clip(verdict.p_crossing, 0.02, 0.98))
+def _pairing_costs(verdict: JunctionVerdict, sure: float = 0.98) -> tuple[float, float, float]:
+    """-log plausibility of the three ranked pairings, relative to the first, the verdict taken
+    as no surer than `sure` either way."""
+    p = float(np.clip(verdict.p_crossing, 1.0 - sure, sure))
     straight, touch_a, touch_b = p, (1 - p) * SMOOTHER_TOUCH, (1 - p) * (1 - SMOOTHER_TOUCH)
     ranked = [straight, touch_a, touch_b] if verdict.is_crossing else [touch_a, straight, touch_b]
     return tuple(float(np.log(ranked[0]) - np.log(x)) for x in ranked)  # type: ignore[return-value]
@@ -389,12 +393,13 @@ def _order(graph: MedialGraph, ink, options: VectorizeOptions, ends: int, clock:
         simple = refine.fix_passes(graph, simple)
     ranked = {n: ranked_pairings(junctions[n], verdicts[n]) for n in simple.crossings}
     costs = {n: _pairing_costs(verdicts[n]) for n in simple.crossings}
+    evidence = {n: _pairing_costs(verdicts[n], EVIDENCE_SURE) for n in simple.crossings}
     if refine is not None:
         refine.fix_pairings(junctions, ranked, costs)
     if options.multi:
         ordering, tried = order_strokes(graph, simple, ranked, costs, stroke_width=w)
     else:
-        ordering, tried = _single_route(graph, simple, ranked, costs, w,
+        ordering, tried = _single_route(graph, simple, ranked, costs, w, evidence,
                                         refine.start_ends(graph) if refine is not None else None,
                                         refine.route_weights(graph) if refine is not None else None)
     clock.lap("traversal")
@@ -402,11 +407,11 @@ def _order(graph: MedialGraph, ink, options: VectorizeOptions, ends: int, clock:
 
 
 def _single_route(graph: MedialGraph, simple: Simplified, ranked: dict, costs: dict,
-                  w: float, start_at: dict | None = None, weight: dict | None = None) -> tuple[Ordering, int]:
+                  w: float, evidence: dict, start_at: dict | None = None, weight: dict | None = None) -> tuple[Ordering, int]:
     """Single-line mode: one stroke over the whole (connected) graph, retracing the least.
     start_at: node -> end cost (px) that overrides the rule (a user's start edit); weight:
     branch id -> factor on its retrace cost (a user's twice / once edits)."""
-    pairing, tried = connect_pairings(graph, ranked, costs, fixed=simple.through)
+    pairing, tried = connect_pairings(graph, ranked, costs, fixed=simple.through, evidence=evidence)
     dirs = {n: directions(graph, n, 2.5 * w) for n in graph.incident if graph.degree(n) >= 3}
     end_cost = {**end_costs(graph, simple, dirs, w), **(start_at or {})}
     routes = plan_routes(graph, {**simple.through, **pairing}, stroke_width=w, directions=dirs, end_cost=end_cost,

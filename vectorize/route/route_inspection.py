@@ -444,7 +444,7 @@ def shared_bands(graph: MedialGraph, passes, stroke_width: float, *,
 
 
 def connect_pairings(graph: MedialGraph, ranked: dict, costs: dict, *, fixed: dict | None = None,
-                     max_tries: int = 400) -> tuple[dict, int]:
+                     evidence: dict | None = None, max_tries: int = 400) -> tuple[dict, int]:
     """Pairings for the decided junctions under which the drawing stays one piece.
 
     ranked[node]: its pairings, preferred first; costs[node]: the cost of each. A pairing
@@ -461,16 +461,19 @@ def connect_pairings(graph: MedialGraph, ranked: dict, costs: dict, *, fixed: di
     def assign(ranks: tuple[int, ...]) -> dict:
         return {**fixed, **{n: ranked[n][r] for n, r in zip(nodes, ranks)}}
 
+    # Ties of cost (junctions read as sure as `costs` allows) go by the evidence uncapped.
+    fine = {n: (evidence or {}).get(n, costs[n]) for n in nodes}
+    fine = {n: fine[n] if len(fine[n]) == len(costs[n]) else costs[n] for n in nodes}
     start = tuple(0 for _ in nodes)
     pieces = PieceCount(graph, fixed, nodes)  # counts under the ranked nodes' pairings (fixed ones stay)
-    best_key, best_ranks = (pieces(assign(start)), 0.0), start
+    best_key, best_ranks = (pieces(assign(start)), 0.0, 0.0), start
     tried = 1
-    heap = [(0.0, start, 0)]
+    heap = [(0.0, 0.0, start, 0)]
     seen = {start}
     while best_key[0] > 1 and heap and tried < max_tries:
-        cost, ranks, last = heapq.heappop(heap)
+        cost, weight, ranks, last = heapq.heappop(heap)
         if ranks != start:
-            key = (pieces(assign(ranks)), cost)
+            key = (pieces(assign(ranks)), cost, weight)
             tried += 1
             if key < best_key:
                 best_key, best_ranks = key, ranks
@@ -484,7 +487,8 @@ def connect_pairings(graph: MedialGraph, ranked: dict, costs: dict, *, fixed: di
                 if child not in seen:
                     seen.add(child)
                     delta = costs[nodes[j]][ranks[j] + 1] - costs[nodes[j]][ranks[j]]
-                    heapq.heappush(heap, (cost + delta, child, j))
+                    fine_delta = fine[nodes[j]][ranks[j] + 1] - fine[nodes[j]][ranks[j]]
+                    heapq.heappush(heap, (cost + delta, weight + fine_delta, child, j))
     pairing = assign(best_ranks)
     count = best_key[0]
     for n in fixed:
