@@ -160,3 +160,17 @@ def test_balls_about_merged_clusters_hold_no_paper(seed, index):
     rim = (guard.points[about][:, None, :] + inner[:, None, None] * ring[None]).reshape(-1, 2)
     gray = map_coordinates(ink.gray, [rim[:, 1], rim[:, 0]], order=1, mode="nearest")
     assert (gray < ink.threshold).all(), f"{(gray >= ink.threshold).sum()} rim points on paper"
+
+
+def test_a_narrow_loops_corner_is_not_reached_across_the_paper():
+    """academically-41-18 (4.25 px): the d's narrow loop turns back 3 px of paper short of the
+    d's stem. Its sides' tangents met in the stem's ink, so the corner point passed the guard,
+    and the spike out to it and back crossed the paper (3.94 px from the drawn line; the
+    bound is 3.13). The way from the traced corner to a corner point must lie in the ink too."""
+    from benchmarks.common.render import render_truth
+    from benchmarks.sets.cursive import cursive_drawing
+
+    gt = cursive_drawing(41, 18)
+    result = vectorize_image(render_truth(gt), VectorizeOptions(multi=False, classifier="cnn", seed=0))
+    assert len(result.drawing.strokes) == 1
+    assert excursion(gt.drawing, result.drawing) <= excursion_bound(gt.width)
