@@ -107,18 +107,25 @@ with open(sys.argv[1], "w") as fh:
 """
 
 
+def _reports_with_and_without(child: str, tmp_path) -> dict:
+    """The JSON reports of the `child` script run in a fresh process with the setting on
+    ("1") and off ("0"), its second argument."""
+    report = tmp_path / "report.json"
+    results = {}
+    for setting in ("1", "0"):
+        done = subprocess.run([sys.executable, "-c", child, str(report), setting], capture_output=True,
+                              text=True, env=child_env(), timeout=120)
+        assert done.returncode == 0, done.stderr
+        results[setting] = json.loads(report.read_text())
+    return results
+
+
 @pytest.mark.skipif(not sys.platform.startswith("linux"), reason="glibc's mallopt")
 def test_memory_a_thread_freed_serves_the_main_thread(tmp_path):
     """With the heap kept (`keep_freed_memory`, which a command sets before its binarize
     thread starts), what a second thread frees is in the one heap the main thread's later
     arrays come from; by default that thread has an arena of its own."""
-    report = tmp_path / "thread.json"
-    results = {}
-    for tuned in ("1", "0"):
-        done = subprocess.run([sys.executable, "-c", THREAD_CHILD, str(report), tuned], capture_output=True,
-                              text=True, env=child_env(), timeout=120)
-        assert done.returncode == 0, done.stderr
-        results[tuned] = json.loads(report.read_text())
+    results = _reports_with_and_without(THREAD_CHILD, tmp_path)
     assert results["1"]["kept"] is True
     assert results["0"]["faults"] > 4 * 900  # 16 MB: ~4,000 pages touched afresh
     assert results["1"]["faults"] < results["0"]["faults"] / 10, results
@@ -145,13 +152,7 @@ with open(sys.argv[1], "w") as fh:
 def test_the_heap_touched_ahead_in_another_thread_faults_no_page_in_this_one(tmp_path):
     """`touch_heap_beside` (a command with a core to spare, while it imports): the heap's
     pages are faulted in by a second thread and kept, so this thread's arrays take none."""
-    report = tmp_path / "ahead.json"
-    results = {}
-    for ahead in ("1", "0"):
-        done = subprocess.run([sys.executable, "-c", AHEAD_CHILD, str(report), ahead], capture_output=True,
-                              text=True, env=child_env(), timeout=120)
-        assert done.returncode == 0, done.stderr
-        results[ahead] = json.loads(report.read_text())
+    results = _reports_with_and_without(AHEAD_CHILD, tmp_path)
     assert results["1"]["ahead"] is True
     assert results["0"]["faults"] > 4 * 900  # 16 MB: ~4,000 pages touched afresh
     assert results["1"]["faults"] < results["0"]["faults"] / 10, results
