@@ -453,7 +453,9 @@ def connect_pairings(graph: MedialGraph, ranked: dict, costs: dict, *, fixed: di
     within `max_tries` is, junctions are left undecided, least sure first, until it is:
     there the walk may turn any way. Returns node -> pairing (undecided nodes left out) and
     the number of assignments tried. fixed: node -> slot pairs decided elsewhere (three
-    passes through a point), part of every assignment and never changed.
+    passes through a point), part of every assignment and never changed. evidence[node]:
+    the costs of its pairings with the verdict uncapped; of assignments of equal cost, the
+    one that changes the less sure verdicts wins.
     """
     nodes = sorted(ranked)
     fixed = fixed or {}
@@ -461,9 +463,10 @@ def connect_pairings(graph: MedialGraph, ranked: dict, costs: dict, *, fixed: di
     def assign(ranks: tuple[int, ...]) -> dict:
         return {**fixed, **{n: ranked[n][r] for n, r in zip(nodes, ranks)}}
 
-    # Ties of cost (junctions read as sure as `costs` allows) go by the evidence uncapped.
-    fine = {n: (evidence or {}).get(n, costs[n]) for n in nodes}
-    fine = {n: fine[n] if len(fine[n]) == len(costs[n]) else costs[n] for n in nodes}
+    # Ties of cost (junctions read as sure as `costs` allows) go by the evidence uncapped;
+    # a node whose pairings were cut down since (a user's pairing edit) by its costs.
+    evidence = evidence or {}
+    fine = {n: evidence[n] if len(evidence.get(n, ())) == len(costs[n]) else costs[n] for n in nodes}
     start = tuple(0 for _ in nodes)
     pieces = PieceCount(graph, fixed, nodes)  # counts under the ranked nodes' pairings (fixed ones stay)
     best_key, best_ranks = (pieces(assign(start)), 0.0, 0.0), start
