@@ -4,7 +4,6 @@ B-splines with `scipy.interpolate.splprep`, and convert them to Bézier segments
 from __future__ import annotations
 
 import bisect
-from dataclasses import dataclass
 
 import numpy as np
 from scipy.interpolate import splev, splprep
@@ -20,6 +19,7 @@ from vectorize.fit.retraces import (
     valid_twins,
 )
 from vectorize.fit.tips import corner_tip, pruned_cusps, with_fork_tips
+from vectorize.fit.traced import POINT, TracedPoints, point_records
 from vectorize.stroke import Stroke, arc_lengths, edge_lengths
 
 
@@ -32,32 +32,6 @@ THIN_MAX = 1.5
 # Only pieces of more points than this are thinned: FITPACK's time is in the long ones.
 THIN_FROM = 2000
 DENSE = 3.0
-
-
-@dataclass(frozen=True, kw_only=True)
-class TracedPoints:
-    """The points of a traversed stroke with what the filter needs to know about each, as
-    arrays (a stroke has thousands of points: one object per point cost more than the fit).
-
-    xy: (N, 2) px; keep: (N,) bool, keep the point for the fit; split: (N,) bool, split the
-    fit there; corner: (N,) bool or None (none), a corner (split, and the joint goes where
-    the two sides' tangents meet); radius: (N,) px, the medial axis's distance to the
-    outline at each point (half the ink width), or None (unknown); junction: (N,) bool or
-    None (none), the point is a node of the axis where three or more branches meet; held:
-    (N,) how many points each weighs in the fit (a crossing node kept alone in its uncertain
-    zone stands for the points dropped there), or None (one each).
-    """
-
-    xy: np.ndarray
-    keep: np.ndarray
-    split: np.ndarray
-    corner: np.ndarray | None = None
-    radius: np.ndarray | None = None
-    junction: np.ndarray | None = None
-    held: np.ndarray | None = None
-
-    def __len__(self) -> int:
-        return len(self.xy)
 
 
 def _distinct(points: np.ndarray, min_step: float) -> np.ndarray:
@@ -319,18 +293,39 @@ def _settle(pieces: list[np.ndarray], cuts: list[int], xy: np.ndarray, twins: li
         pieces[k] = keep_in_ink(whole, _open_fit(whole, sigma), guard, _open_fit, sigma)
 
 
+def _opened(points: np.ndarray, twins: list[Twin]) -> tuple[np.ndarray, list[Twin]]:
+    """A closed line's (N,) `POINT` records (its first point repeated last or not), split
+    somewhere, as an open line that starts and ends at its top-left split: (N', ) records
+    whose last repeats the first, and the twins moved along.
+
+    Where a closed line starts cannot be read from the ink; a pen usually starts at its
+    top-left sharp feature: then the line is a chain of open pieces.
+    """
+    if np.allclose(points["xy"][0], points["xy"][-1]):
+        last_corner = bool(points["corner"][-1])
+        points = points[:-1]
+        if not points["split"].any():  # the only split was the repeated point: it is the first
+            points["split"][0] = True
+            points["corner"][0] |= last_corner
+    split_at = np.flatnonzero(points["split"])
+    shift = int(split_at[np.argmin(points["xy"][split_at].sum(axis=1))])
+    points = np.roll(points, -shift)
+    twins = rolled(twins, shift, len(points))
+    points = np.concatenate([points, points[:1]])
+    return points, valid_twins(points["xy"], twins)
+
+
 def fit_stroke(traced: TracedPoints, *, closed: bool, sigma: float, stroke_width: float,
                guard: InkGuard | None = None, twins: tuple[Twin, ...] = ()) -> Stroke:
     """Filter, split at sharp features (Y-feet tips, cusps, corners) and fit one traversed
     stroke; with `guard`, every piece is brought back inside the ink where it strays
     (`vectorize.fit.ink_guard`). twins: stretches the stroke draws twice (`vectorize.fit.retraces`):
     fitted once, the later pass repeats the earlier one's curve."""
-    xy = np.array(traced.xy, dtype=float).reshape(-1, 2)
-    keep = np.array(traced.keep, dtype=bool)
-    split = np.array(traced.split, dtype=bool)
-    corner = np.zeros(len(xy), dtype=bool)
-    junction = np.zeros(len(xy), dtype=bool) if traced.junction is None else np.array(traced.junction, dtype=bool)
-    held = np.ones(len(xy)) if traced.held is None else np.array(traced.held, dtype=float)
+    # One record per traced point (`traced.POINT`); the names below are views of its fields,
+    # so marking one marks the points. Corners are found here (the traced ones join after).
+    points = point_records(traced.xy, keep=traced.keep, split=traced.split, junction=traced.junction,
+                           held=traced.held)
+    xy, keep, split, corner = (points[name] for name in ("xy", "keep", "split", "corner"))
     arc = arc_lengths(xy)
     wide = _turn(xy, arc, 1.5 * stroke_width, closed) if len(xy) >= 5 else None
     found = _sharp_corners(xy, arc, wide, stroke_width, closed) if wide is not None else np.zeros(0, dtype=int)
@@ -341,38 +336,20 @@ def fit_stroke(traced: TracedPoints, *, closed: bool, sigma: float, stroke_width
     corner[found] = True
     if guard is not None and wide is not None:
         # A cusp whose pruned spur left the axis's turn too round for a corner (`tips.pruned_cusps`).
-        free = keep & ~split & ~junction & (along_distance(arc, corner) > 2.0 * stroke_width)
+        free = keep & ~split & ~points["junction"] & (along_distance(arc, corner) > 2.0 * stroke_width)
         corner[pruned_cusps(xy, arc, wide, free, guard, stroke_width, closed)] = True
     if traced.corner is not None:
         corner |= np.asarray(traced.corner, dtype=bool)
     split |= corner
     twins = valid_twins(xy, twins)
     mirror_flags(twins, split, corner)
-    split_at = np.flatnonzero(split)
-    if closed and split_at.size and len(xy) > 3:
-        # Where a closed line starts cannot be read from the ink; start at its top-left
-        # sharp feature, as a pen usually does: then it is a chain of open pieces.
-        if np.allclose(xy[0], xy[-1]):
-            last_corner = bool(corner[-1])
-            xy, keep, split, corner, junction, held = (xy[:-1], keep[:-1], split[:-1], corner[:-1], junction[:-1],
-                                                       held[:-1])
-            split_at = np.flatnonzero(split)
-            if not split_at.size:  # the only split was the repeated point: it is the first
-                split[0], corner[0] = True, corner[0] or last_corner
-                split_at = np.zeros(1, dtype=np.int64)
-        shift = int(split_at[np.argmin(xy[split_at].sum(axis=1))])
-        xy, keep, split, corner, junction, held = (np.roll(a, -shift, axis=0)
-                                                   for a in (xy, keep, split, corner, junction, held))
-        twins = rolled(twins, shift, len(xy))
-        xy = np.vstack([xy, xy[:1]])
-        keep, split, corner = np.append(keep, keep[0]), np.append(split, split[0]), np.append(corner, corner[0])
-        junction, held = np.append(junction, junction[0]), np.append(held, held[0])
+    if closed and split.any() and len(points) > 3:
+        points, twins = _opened(points, twins)
         closed = False
-        twins = valid_twins(xy, twins)
     if guard is not None:
-        xy, keep, split, corner, junction, held, twins = with_fork_tips(xy, keep, split, corner, junction, held,
-                                                                          twins, guard, stroke_width, closed)
-        twins = valid_twins(xy, twins)
+        points, twins = with_fork_tips(points, twins, guard, stroke_width, closed)
+        twins = valid_twins(points["xy"], twins)
+    xy, keep, split, corner, junction, held = (points[name] for name in POINT.names)
     # Around a corner the axis is off the centre line for about a stroke width: leave it out.
     # (The corner joints below read the tip along this arc too.)
     arc = arc_lengths(xy)

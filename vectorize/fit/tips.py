@@ -8,6 +8,7 @@ import numpy as np
 
 from vectorize.fit.ink_guard import STEP, InkGuard
 from vectorize.fit.retraces import Twin
+from vectorize.fit.traced import point_records
 from vectorize.stroke import arc_lengths
 
 
@@ -160,28 +161,25 @@ def pruned_cusps(xy: np.ndarray, arc: np.ndarray, wide: np.ndarray, free: np.nda
     return np.array(found, dtype=int)
 
 
-def with_fork_tips(xy, keep, split, corner, junction, held, twins, guard: InkGuard, stroke_width: float,
-                   closed: bool):
-    """The traced arrays with a spike out to each fork's tip (`_fork_tip`) and back: the
-    points [tip, fork] inserted after the fork where the pen turns (a split there, or a
-    corner), split at both (the spike is fitted straight and retraced, as the route retraces
-    a spike). Returns (xy, keep, split, corner, junction, held, twins), the first six (N', ...)
-    arrays as `fitting.fit_stroke` holds them."""
+def with_fork_tips(points: np.ndarray, twins: list[Twin], guard: InkGuard, stroke_width: float,
+                   closed: bool) -> tuple[np.ndarray, list[Twin]]:
+    """The traced points ((N,) `traced.POINT` records, as `fitting.fit_stroke` holds them)
+    with a spike out to each fork's tip (`_fork_tip`) and back: the points [tip, fork]
+    inserted after the fork where the pen turns (a split there, or a corner), split at both
+    (the spike is fitted straight and retraced, as the route retraces a spike). Returns the
+    (N',) records and the twins moved along."""
+    xy = points["xy"]
     arc = arc_lengths(xy)
 
-    turns = [int(i) for i in np.flatnonzero(split & junction)
+    turns = [int(i) for i in np.flatnonzero(points["split"] & points["junction"])
              if 0 < i < len(xy) - 1 and _reverses(xy, arc, int(i), stroke_width, closed)]
     tips = {i: tip for i in turns if (tip := _fork_tip(xy, arc, i, guard, stroke_width, closed)) is not None}
     if tips:
-        corner = corner.copy()
+        points = points.copy()
     for i in sorted(tips, reverse=True):
-        corner[i] = False  # the pen turns at the tip; the fork is where the spike leaves
-        xy = np.insert(xy, i + 1, [tips[i], xy[i]], axis=0)
-        keep = np.insert(keep, i + 1, [True, True])
-        split = np.insert(split, i + 1, [True, True])
-        corner = np.insert(corner, i + 1, [False, False])
-        junction = np.insert(junction, i + 1, [False, False])
-        held = np.insert(held, i + 1, [1.0, 1.0])
+        points["corner"][i] = False  # the pen turns at the tip; the fork is where the spike leaves
+        spike = point_records([tips[i], points["xy"][i]], keep=True, split=True)
+        points = np.insert(points, i + 1, spike)
         # Ranges after the fork move on by the two points (one across it no longer matches
         # its partner and is dropped by `valid_twins`).
         def moved(span: tuple[int, int], i: int = i) -> tuple[int, int]:
@@ -189,4 +187,4 @@ def with_fork_tips(xy, keep, split, corner, junction, held, twins, guard: InkGua
             return (lo + 2 if lo >= i and hi > i else lo, hi + 2 if hi > i else hi)
 
         twins = [Twin(moved(t.first), moved(t.second), t.reverse) for t in twins]
-    return xy, keep, split, corner, junction, held, twins
+    return points, twins
