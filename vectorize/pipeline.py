@@ -132,10 +132,10 @@ def _raster(path: str, options: VectorizeOptions, cache=None):
 
 def threshold_mask_file(path: str | os.PathLike, options: VectorizeOptions = VectorizeOptions(), *,
                         cache=None) -> tuple[np.ndarray, float]:
-    """`vectorizer.threshold_mask` of a raster file: (H, W) bool working px (the whole
+    """`front_stages.threshold_mask` of a raster file: (H, W) bool working px (the whole
     image, downscaled to `options.max_size`) and the threshold level. An SVG has no
     threshold: `InputError`."""
-    from vectorize.vectorizer import threshold_mask
+    from vectorize.front_stages import threshold_mask
 
     path = str(path)
     if os.path.splitext(path)[1].lower() in (".svg", ".svgz"):

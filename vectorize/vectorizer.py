@@ -2,40 +2,32 @@
 
 from __future__ import annotations
 
-import sys
-import time
 from dataclasses import replace
-from functools import partial
-from importlib import import_module
 from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
 
-from onestroke.cores import idle_cores
-from onestroke.errors import InputError
 from vectorize.axis.clusters import merge_triple_points, straightest_pairs
-from vectorize.axis.gaps import bridge_gaps, keep_largest_piece
 from vectorize.axis.graph import MedialGraph
-from vectorize.axis.medial_axis import medial_axis
-from vectorize.axis.pruning import prune, trim_free_ends
 from vectorize.axis.simplify import Simplified, directions, simplify, slots
 from vectorize.axis.stem_clusters import merge_stem_clusters, stem_passes
 from vectorize.drawing import Drawing
 from vectorize.fit.ink_guard import InkGuard, guard_margin
 from vectorize.fit.ink_width import edge_offset, ink_widths
 from vectorize.fit.retraces import Twin, foot_is_retraced, trimmed_twins, twin_spans
+from vectorize.front_stages import front_stages, output_matrix, pixel_frame, refuse_ragged
 from vectorize.junctions.classifiers import make_classifier, shipped_pass_scorer
 from vectorize.junctions.crossing_point import crossing_point, passes_crossing
 from vectorize.junctions.intersections import (Junction, JunctionVerdict, along_line, lone_junctions, ranked_pairings,
                                               sharp_touch)
 from vectorize.junctions.junction_ink import own_ink, own_ink_reach
 from vectorize.options import InputFrame, VectorizeOptions, VectorizeReport, VectorizeResult
-from vectorize.raster.binarize import InkImage, downscaled_gray, ink_image, ink_threshold, paper_gray
-from vectorize.raster.outline import outline_rings
+from vectorize.raster.binarize import InkImage
 from vectorize.route.retrace_paths import turn_prices, turns_at
 from vectorize.route.route_ends import end_costs
 from vectorize.route.route_inspection import connect_pairings, cuts_off, plan_routes, shared_bands
 from vectorize.route.traversal import Ordering, half_turns, order_strokes, turn_backs
+from vectorize.stage_clock import StageClock
 from vectorize.stroke import Stroke, lengths
 
 if TYPE_CHECKING:  # the studio's refinement is imported where edits or a session ask for it
@@ -45,51 +37,11 @@ if TYPE_CHECKING:  # the studio's refinement is imported where edits or a sessio
     from vectorize.refine.edits import Edits
     from vectorize.refine.refine import Refinement, StageCache
 
-# Vanishing-angle thresholds (notes: 0.95 single-line, 0.90 multi-line).
-PRUNE_SINGLE, PRUNE_MULTI = 0.95, 0.90
-# No line drawing in a working image of <= max_size px has this many closed outlines or
-# medial-axis branch points (a dense 2000 px scribble: ~500 crossings); noise has tens of
-# thousands, and simplifying those takes hours.
-MAX_OUTLINES, MAX_BRANCH_POINTS = 5000, 4000
-# Outline samples bound the Voronoi diagram's work: the example drawings have 4,500-18,000;
-# a 400 px square of noise has 367,000 in 2,400 outlines, which qhull takes minutes over.
-# One long line is not noise: TSP art (a closed line 40,000-50,000 px long, 2-3 px wide,
-# outlined every 0.3 px) has 300,000 samples in a handful of outlines, and its medial axis
-# takes about 4 s. So past MAX_OUTLINE_SAMPLES the ink is refused only when it is also
-# broken into more than LONG_LINE_OUTLINES outlines, and always past MAX_LONG_LINE_SAMPLES.
-MAX_OUTLINE_SAMPLES = 150_000
-LONG_LINE_OUTLINES = 500
-MAX_LONG_LINE_SAMPLES = 600_000
-# Outline samples up to which the crossing CNN is started beside qhull (`_cnn_beside`): qhull
-# takes ~2.5 us a sample, so up to ~50 ms in one thread against ~25-30 ms in two tiles, while
-# onnxruntime's import and the session take ~30 ms of this thread.
-CNN_BESIDE_SAMPLES = 20_000
 # Share of plausibility of the smoother touching pairing when the classifier says "touch".
 SMOOTHER_TOUCH = 0.85
 # How sure a verdict may be taken where pairings of equal capped cost are told apart
 # (`route_inspection.connect_pairings`): the classifiers' own bound (`_with_geometry`).
 EVIDENCE_SURE = 1.0 - 1e-6
-
-
-class _Clock:
-    """Wall and CPU seconds per stage (CPU: on a shared machine the wall time includes
-    waiting for a core); `checkpoint` (optional) is called at every stage boundary and may
-    raise to stop the run there (`StageCache.checkpoint`)."""
-
-    def __init__(self, checkpoint=None) -> None:
-        self.checkpoint = checkpoint
-        self.seconds: dict[str, float] = {}
-        self.cpu_seconds: dict[str, float] = {}
-        self._last = time.perf_counter()
-        self._last_cpu = time.process_time()
-
-    def lap(self, stage: str) -> None:
-        now, cpu = time.perf_counter(), time.process_time()
-        self.seconds[stage] = self.seconds.get(stage, 0.0) + now - self._last
-        self.cpu_seconds[stage] = self.cpu_seconds.get(stage, 0.0) + cpu - self._last_cpu
-        self._last, self._last_cpu = now, cpu
-        if self.checkpoint is not None:
-            self.checkpoint()
 
 
 def _junctions(graph: MedialGraph, nodes, stroke_width: float) -> list[Junction]:
@@ -339,7 +291,7 @@ class _Solution(NamedTuple):
     tried: int
 
 
-def _order(graph: MedialGraph, ink, options: VectorizeOptions, ends: int, clock: _Clock,
+def _order(graph: MedialGraph, ink, options: VectorizeOptions, ends: int, clock: StageClock,
            refine: Refinement | None = None) -> _Solution:
     """Simplify (in place), classify the crossings and traverse, for one count of free ends.
 
@@ -371,7 +323,7 @@ def _order(graph: MedialGraph, ink, options: VectorizeOptions, ends: int, clock:
         clock.lap("simplification")
         if options.max_odd_nodes is not None:  # before the crossings' crops and the route
             odd = sum(1 for n, incident in graph.incident.items() if len(incident) % 2 and n not in simple.through)
-            _refuse_ragged(odd, "loose ends and forks", options, ink.threshold)
+            refuse_ragged(odd, "loose ends and forks", options, ink.threshold)
         junction_list = _junctions(graph, simple.crossings, w)
         junctions = dict(zip(simple.crossings, junction_list))
         # The whole image is read too only for a confidence that something shows (the studio).
@@ -421,178 +373,6 @@ def _single_route(graph: MedialGraph, simple: Simplified, ranked: dict, costs: d
                     sum(r.odd_nodes for r in routes), tuple(n for n in simple.crossings if n not in pairing)), tried
 
 
-def _refuse_noise(count: int, what: str, limit: int, threshold: float, given: bool) -> None:
-    """Raise `InputError` when the ink has more `what` than any line drawing has: the
-    threshold cut through paper texture or noise (and the search would take hours).
-    A threshold the user already chose is not suggested again (lowering it step by step
-    rarely helps); blur is what removes grain."""
-    if count > limit:
-        hint = ("try --blur 2 (more for coarse grain) with that threshold, or clean the scan" if given
-                else f"try --blur 2 (more for coarse grain), or a --threshold well below {threshold:.2f}")
-        raise InputError(f"the ink has {count} {what}: that is paper texture or noise, not a line "
-                         f"drawing; {hint}")
-
-
-def _refuse_ragged(count: int, what: str, options: VectorizeOptions, threshold: float) -> None:
-    """Raise `InputError` when the graph has more odd-degree nodes (`what`: its loose ends, or
-    its loose ends and forks once simplified) than `options.max_odd_nodes`. A single line
-    pairs them by route inspection's matching (its work grows as their cube); in multi-stroke
-    mode each pair is a stroke to classify, order and fit. A ragged or grainy edge gives
-    hundreds of them (spurs), a line drawing tens."""
-    if count > options.max_odd_nodes:
-        hint = ("try another --threshold (or the automatic one) or --blur 1, or clean the scan"
-                if options.threshold is not None else "try --blur 1, or clean the scan")
-        work = "strokes to end there" if options.multi else "for the line to pair up"
-        raise InputError(f"the ink has {count} {what} {work} at threshold {threshold:.2f}, more than the "
-                         f"{options.max_odd_nodes} an interactive run takes: that is a ragged edge or noise, "
-                         f"not a line drawing; {hint}")
-
-
-def working_paper(image: np.ndarray, options: VectorizeOptions, cache: StageCache | None = None):
-    """(gray, scale) of `binarize.paper_gray` at the options' blur and size: the working image
-    the threshold cuts, from the cache when one is given (and stored there)."""
-    def paper():
-        if cache is None:
-            return paper_gray(image, max_size=options.max_size, blur=options.blur)
-        # The downscaled gray is the same at every blur: a blur change starts from it.
-        scaled = cache.stage("gray", (options.max_size,), lambda: downscaled_gray(image, max_size=options.max_size))
-        return paper_gray(image, max_size=options.max_size, blur=options.blur, downscaled=scaled)
-
-    return paper() if cache is None else cache.stage("paper", (options.blur, options.max_size), paper)
-
-
-def threshold_mask(image: np.ndarray, options: VectorizeOptions, cache: StageCache | None = None):
-    """(mask, level): (H, W) bool of the working pixels darker than the threshold (the options'
-    or Li's level), what the threshold catches before specks, a frame and pinholes are
-    cleaned; the studio shows it while a threshold or blur slider moves."""
-    gray, _ = working_paper(image, options, cache)
-    level = ink_threshold(gray, options.threshold)
-    return gray < level, level
-
-
-def _axis(image: np.ndarray, options: VectorizeOptions, clock: _Clock, cache: StageCache | None = None,
-          binarized: Callable[[], InkImage] | None = None):
-    """Binarize, outline and medial axis: the stages that threshold and blur change, and the
-    mode does not. Returns (ink, rings, graph before pruning). binarized: gives the binarize
-    stage's result for this image and options, computed elsewhere (`pipeline.binarize_beside`)."""
-    # Every piece of ink is kept here; in single-line mode the pieces of a line broken by
-    # pen gaps are bridged later, and only then is the largest kept.
-    if binarized is not None:
-        ink = binarized()
-    else:
-        gray, scale = working_paper(image, options, cache)
-        ink = ink_image(gray, scale, threshold=options.threshold)
-    clock.lap("binarize")
-    w = ink.stroke_width
-    spacing = float(np.clip(w / 8.0, 0.3, 1.0))
-    # Straight sides sampled every half width: the axis between them zigzags by <= w / 32.
-    rings = outline_rings(ink.gray, ink.threshold, spacing, sparse=w / 2.0)
-    clock.lap("outline")
-    _refuse_noise(len(rings), "outlines (pieces and holes)", MAX_OUTLINES, ink.threshold,
-                  options.threshold is not None)
-    samples = sum(len(ring) for ring in rings)
-    _refuse_noise(samples, "outline samples", MAX_OUTLINE_SAMPLES if len(rings) > LONG_LINE_OUTLINES
-                  else MAX_LONG_LINE_SAMPLES, ink.threshold, options.threshold is not None)
-    # A process's first call imports the fitting stage's libraries (scipy.interpolate and
-    # scipy.optimize, ~0.1 s, holding the GIL) while qhull triangulates in another thread,
-    # and starts the crossing CNN there where the line likely crosses itself.
-    later = [] if "vectorize.fit.fitting" in sys.modules else [partial(import_module, "vectorize.fit.fitting")]
-    if _cnn_beside(len(rings), samples, options.classifier, idle_cores()):
-        later.append(_start_cnn)
-    graph = medial_axis(rings, ink.gray, ink.threshold, beside=partial(_each, later) if later else None)
-    clock.lap("medial axis")
-    return ink, rings, graph
-
-
-def _cnn_beside(rings: int, samples: int, classifier, cores: int) -> bool:
-    """Whether to start the crossing CNN (onnxruntime's import and the model's session,
-    ~30 ms of CPU holding the GIL, otherwise paid in the classification stage) in this
-    thread while qhull triangulates in another: where a core is spare (`cores`), the
-    `classifier` is the CNN and onnxruntime is not loaded yet, and the ink's outline of
-    `samples` points has three `rings` or more. A line that closes two loops or more meets
-    itself somewhere (the two loops' centre lines form a graph with a node of degree 3 or
-    more), and those junctions are classified by the ONNX networks; one hole (an O) needs
-    none. Up to `CNN_BESIDE_SAMPLES`: beyond that, qhull in two tiles saves more than the
-    overlap (`medial_axis` makes one tile per spare core while this thread works).
-    A guess of what the classification stage will ask for: the output is the same either way."""
-    return (classifier == "cnn" and rings >= 3 and samples <= CNN_BESIDE_SAMPLES and cores > 1
-            and "onnxruntime" not in sys.modules)
-
-
-def _start_cnn() -> None:
-    """Import onnxruntime and start the crossing CNN's session (`make_classifier`'s cached
-    one). A failure (the model missing or damaged, onnxruntime not loading) is left to the
-    classification stage, which meets it again only if the drawing needs the CNN."""
-    try:
-        make_classifier("cnn").session  # noqa: B018 - started for its side effect
-    except Exception:  # noqa: BLE001 - a guess must not fail a drawing that needs no CNN
-        pass
-
-
-def _each(steps: list[Callable[[], object]]) -> None:
-    """Run `steps` in order."""
-    for step in steps:
-        step()
-
-
-def output_matrix(ink_scale: float, frame: InputFrame) -> np.ndarray:
-    """2x3 working px -> output units, for the working image's `ink_scale` (working px per
-    input px) and the input's `frame`."""
-    scale = ink_scale * frame.scale  # working px per output unit
-    # Working pixel centres sit at integers (scikit-image); in SVG and in the input's pixel
-    # frame pixel i covers [i, i + 1), so its centre is at i + 0.5.
-    return np.array([[1 / scale, 0, frame.offset[0] + 0.5 / scale],
-                     [0, 1 / scale, frame.offset[1] + 0.5 / scale]])
-
-
-def _front(image: np.ndarray, options: VectorizeOptions, clock: _Clock, cache: StageCache | None = None,
-           frame: InputFrame | None = None, edits: Edits | None = None,
-           binarized: Callable[[], InkImage] | None = None):
-    """Binarize, outline, medial axis, pruning and (single-line) gap bridging: the stages
-    that only threshold, blur and mode change (and the edits' "unbridge" positions, in
-    `frame`). Returns (ink, rings, graph, bridges, dropped, unbridged), bridges: the pen
-    gaps bridged, each as its two ends (working px); unbridged: the bridges the edits
-    refused (`vectorize.refine.refine.Unbridging.refused`).
-
-    With `cache`, the stages before pruning are shared between the modes (a copy of the
-    cached graph is pruned) and the paper-flattened gray between thresholds."""
-    if cache is None:
-        ink, rings, graph = _axis(image, options, clock, binarized=binarized)
-    else:
-        key = (options.threshold, options.blur, options.max_size)
-        ink, rings, graph = cache.stage("axis", key, lambda: _axis(image, options, clock, cache))
-        graph = graph.copy()
-    w = ink.stroke_width
-    prune(graph, threshold=PRUNE_MULTI if options.multi else PRUNE_SINGLE, stroke_width=w)
-    trim_free_ends(graph, stroke_width=w)
-    clock.lap("pruning")
-    branch_points = sum(1 for incident in graph.incident.values() if len(incident) >= 3)
-    _refuse_noise(branch_points, "branch points", MAX_BRANCH_POINTS, ink.threshold,
-                  options.threshold is not None)
-    bridges: list = []
-    dropped = 0
-    refuse = None
-    if not options.multi:
-        if edits is not None and edits.of("unbridge"):
-            from vectorize.refine.refine import Unbridging
-
-            refuse = Unbridging(edits, output_matrix(ink.scale, frame or _pixel_frame(image)))
-        bridge_gaps(graph, stroke_width=w, made=bridges, refuse=refuse)
-        dropped = keep_largest_piece(graph)
-    if options.max_odd_nodes is not None:
-        # Simplification merges forks into crossings but keeps every loose end: a graph
-        # with too many of them is refused before that work.
-        ends = sum(1 for incident in graph.incident.values() if len(incident) == 1)
-        _refuse_ragged(ends, "loose ends", options, ink.threshold)
-    return ink, rings, graph, tuple(bridges), dropped, tuple(refuse.refused) if refuse is not None else ()
-
-
-def _pixel_frame(image: np.ndarray) -> InputFrame:
-    """The input's own pixels as the output frame."""
-    shape = np.asarray(image).shape
-    return InputFrame(1.0, (0.0, 0.0), float(shape[1]), float(shape[0]))
-
-
 def run_pipeline(image: np.ndarray, options: VectorizeOptions, *,
                  frame: InputFrame | None = None, edits: Edits | None = None,
                  cache: StageCache | None = None, binarized: Callable[[], InkImage] | None = None) -> VectorizeResult:
@@ -603,10 +383,10 @@ def run_pipeline(image: np.ndarray, options: VectorizeOptions, *,
     gives the binarize stage's `InkImage` of this image at these options, computed elsewhere
     (`pipeline.binarize_beside`); not with edits or a cache.
     """
-    clock = _Clock(cache.checkpoint if cache is not None else None)
+    clock = StageClock(cache.checkpoint if cache is not None else None)
     shape = np.asarray(image).shape
     if frame is None:
-        frame = _pixel_frame(image)
+        frame = pixel_frame(image)
     refining = edits is not None or cache is not None
     if refining and binarized is not None:
         raise ValueError("a binarize stage computed elsewhere cannot be refined (edits or a cache)")
@@ -618,10 +398,10 @@ def run_pipeline(image: np.ndarray, options: VectorizeOptions, *,
         edits = edits if edits is not None else Edits()
         options = edits.applied_to(options)
         cache = cache if cache is not None else StageCache()
-        front = cache.front_for(image, options, lambda stages: _front(image, options, clock, stages, frame, edits),
+        front = cache.front_for(image, options, lambda stages: front_stages(image, options, clock, stages, frame, edits),
                                 edits)
     else:
-        front = _front(image, options, clock, binarized=binarized)
+        front = front_stages(image, options, clock, binarized=binarized)
     ink, rings, graph, bridges, dropped, unbridged = front
     w = ink.stroke_width
     scale = ink.scale * frame.scale  # working px per output unit

@@ -11,7 +11,7 @@ import sys
 from pathlib import Path
 
 from tests.children import child_env
-from vectorize.vectorizer import CNN_BESIDE_SAMPLES, _cnn_beside
+from vectorize.front_stages import CNN_BESIDE_SAMPLES, _cnn_beside
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -21,9 +21,10 @@ ROOT = Path(__file__).resolve().parents[2]
 CHILD = r"""
 import json, sys
 import vectorize.axis.medial_axis as medial
+import vectorize.front_stages as front
 import vectorize.vectorizer as vectorizer
 out, drawing, cores = sys.argv[1], sys.argv[2], int(sys.argv[3])
-vectorizer.idle_cores = medial.idle_cores = lambda: cores
+front.idle_cores = medial.idle_cores = lambda: cores
 loaded, simplify = [], vectorizer.simplify
 
 def recorded(*args, **kwargs):

@@ -10,17 +10,18 @@ import numpy as np
 import pytest
 
 from vectorize.axis.graph import Branch, MedialGraph, measure_short
+from vectorize.front_stages import axis_stages
 from vectorize.options import VectorizeOptions
 from vectorize.raster.image_io import load_image
+from vectorize.stage_clock import StageClock
 from vectorize.stroke import edge_lengths, lengths
-from vectorize.vectorizer import _axis as axis_stages, _Clock
 
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
 
 
 def _axis(name: str) -> tuple[MedialGraph, float]:
     """The unpruned medial-axis graph of an example drawing, and its stroke width."""
-    ink, _, graph = axis_stages(load_image(EXAMPLES / name)[0], VectorizeOptions(), _Clock())
+    ink, _, graph = axis_stages(load_image(EXAMPLES / name)[0], VectorizeOptions(), StageClock())
     return graph, ink.stroke_width
 
 

@@ -14,13 +14,14 @@ import pytest
 
 from vectorize.axis.clusters import merge_triple_points, straightest_pairs
 from vectorize.axis.simplify import directions
+from vectorize.front_stages import front_stages
 from vectorize.junctions.pass_scorer import DEFAULT_MODEL, PAIRS, PassScorer, pair_feet
 from vectorize.options import VectorizeOptions
 from vectorize.pipeline import vectorize_image
+from vectorize.stage_clock import StageClock
 from vectorize.stroke import Stroke
 from vectorize.training.pass_eval import node_truth, same_pairing
 from vectorize.training.triple_synth import render_scene
-from vectorize.vectorizer import _Clock, _front
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -28,7 +29,7 @@ ROOT = Path(__file__).resolve().parents[2]
 def _nodes(scene):
     """The vectorizer's own stages on a scene: (ink, graph, triple-point nodes)."""
     image = np.round(scene.gray * 255.0).astype(np.uint8)
-    ink, _, graph, *_ = _front(image, VectorizeOptions(), _Clock())
+    ink, _, graph, *_ = front_stages(image, VectorizeOptions(), StageClock())
     return ink, graph, list(merge_triple_points(graph, stroke_width=ink.stroke_width))
 
 

@@ -78,8 +78,9 @@ def same_pairing(a: Pairs, b: Pairs) -> bool:
 def _pipeline_chunk(args: tuple[str, int, int, int]) -> list[tuple[bool, bool, bool]]:
     """Run the vectorizer's stages on scenes start..stop-1; per labelled node: right or
     wrong for each method."""
+    from vectorize.front_stages import front_stages
     from vectorize.options import VectorizeOptions
-    from vectorize.vectorizer import _Clock, _front
+    from vectorize.stage_clock import StageClock
 
     model_path, seed, start, stop = args
     scorer = PassScorer(model_path, check_hash=False)
@@ -87,7 +88,7 @@ def _pipeline_chunk(args: tuple[str, int, int, int]) -> list[tuple[bool, bool, b
     for index in range(start, stop):
         scene = render_scene(np.random.default_rng([seed, index]))
         image = np.round(scene.gray * 255.0).astype(np.uint8)
-        ink, _, graph, *_ = _front(image, VectorizeOptions(), _Clock())
+        ink, _, graph, *_ = front_stages(image, VectorizeOptions(), StageClock())
         w = ink.stroke_width
         for node in merge_triple_points(graph, stroke_width=w):
             feet = directions(graph, node, 2.5 * w)
