@@ -8,6 +8,10 @@ packages hold what they share.
   satin columns, stitch checks, an independent GRBL simulation) and the result tables;
 - `benchmarks.common`: rendering, processes and installs, running another checkout's code.
 
-Run a script from the repository root as a module: `python -m benchmarks.vectorize_bench`.
-The tests import the packages the same way (`from benchmarks.sets.hershey import hershey_set`).
+Run a script from the repository root as a module, `python -m benchmarks.vectorize_bench`, or
+as a file from anywhere, `python benchmarks/vectorize_bench.py`. As a file the script's own
+folder heads the import path; each script's first lines put the repository root in its place,
+as `-m` from the root has it, so that `benchmarks` imports (a child that another checkout's
+code runs, `common.checkout.rerun_on`, starts with -P and keeps its path). The tests import
+the packages as modules (`from benchmarks.sets.hershey import hershey_set`).
 """

@@ -20,6 +20,9 @@ from collections import defaultdict
 from dataclasses import dataclass
 from pathlib import Path
 
+if __name__ == "__main__" and Path(sys.path[0]).resolve() == Path(__file__).resolve().parent:
+    sys.path[0] = str(Path(__file__).resolve().parents[1])  # run as a file: see benchmarks/__init__.py
+
 from benchmarks.metrics.route_figures import ROUTE_SLACK
 
 

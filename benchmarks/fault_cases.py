@@ -30,6 +30,9 @@ import time
 from collections.abc import Iterator
 from pathlib import Path
 
+if __name__ == "__main__" and Path(sys.path[0]).resolve() == Path(__file__).resolve().parent:
+    sys.path[0] = str(Path(__file__).resolve().parents[1])  # run as a file: see benchmarks/__init__.py
+
 from benchmarks.common.processes import alive, children, cpu_ticks, rss_mb, workers_of
 
 ROOT = Path(__file__).resolve().parents[1]

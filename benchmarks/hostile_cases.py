@@ -21,6 +21,9 @@ import tempfile
 import time
 from pathlib import Path
 
+if __name__ == "__main__" and Path(sys.path[0]).resolve() == Path(__file__).resolve().parent:
+    sys.path[0] = str(Path(__file__).resolve().parents[1])  # run as a file: see benchmarks/__init__.py
+
 PATH = ('<path d="M 10 10 L 90 90" stroke="black" fill="none"/>')
 SVG_HEAD = '<svg xmlns="http://www.w3.org/2000/svg" xmlns:xlink="http://www.w3.org/1999/xlink" width="100" height="100">'
 WAVE = (SVG_HEAD + '<path d="M 10 50 C 30 10, 50 90, 90 50" stroke="black" fill="none"/></svg>')

@@ -25,7 +25,12 @@ import argparse
 import multiprocessing as mp
 import os
 import statistics
+import sys
 import time
+from pathlib import Path
+
+if __name__ == "__main__" and Path(sys.path[0]).resolve() == Path(__file__).resolve().parent:
+    sys.path[0] = str(Path(__file__).resolve().parents[1])  # run as a file: see benchmarks/__init__.py
 
 from benchmarks.laser_time import PROFILE, jobs
 from machines.emulator import EmulatorOptions, GrblEmulator

@@ -8,10 +8,14 @@ write, and the time estimate (reported separately: it is not part of writing).
 
 from __future__ import annotations
 
+import sys
 import tempfile
 import time
 from pathlib import Path
 from statistics import median
+
+if __name__ == "__main__" and Path(sys.path[0]).resolve() == Path(__file__).resolve().parent:
+    sys.path[0] = str(Path(__file__).resolve().parents[1])  # run as a file: see benchmarks/__init__.py
 
 import numpy as np
 

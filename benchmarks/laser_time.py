@@ -13,10 +13,14 @@ drawing on the same machine model.
 
 from __future__ import annotations
 
+import sys
 import tempfile
 import time
 from pathlib import Path
 from statistics import median
+
+if __name__ == "__main__" and Path(sys.path[0]).resolve() == Path(__file__).resolve().parent:
+    sys.path[0] = str(Path(__file__).resolve().parents[1])  # run as a file: see benchmarks/__init__.py
 
 from fabrication.laser.gcode_write import GcodeOptions, gcode_lines
 from machines.job_time import estimate_job_time as estimate_gcode_time

@@ -13,6 +13,9 @@ import argparse
 import sys
 from pathlib import Path
 
+if __name__ == "__main__" and Path(sys.path[0]).resolve() == Path(__file__).resolve().parent:
+    sys.path[0] = str(Path(__file__).resolve().parents[1])  # run as a file: see benchmarks/__init__.py
+
 from PIL import Image
 
 from benchmarks.sets.drawings import generate_drawing

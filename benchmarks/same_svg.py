@@ -35,6 +35,9 @@ import sys
 import time
 from pathlib import Path
 
+if __name__ == "__main__" and Path(sys.path[0]).resolve() == Path(__file__).resolve().parent:
+    sys.path[0] = str(Path(__file__).resolve().parents[1])  # run as a file: see benchmarks/__init__.py
+
 from benchmarks.common.checkout import needs_rerun, rerun_on
 
 HERE = Path(__file__).resolve().parents[1]

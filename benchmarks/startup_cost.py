@@ -234,6 +234,11 @@ def _parts(picks: list, command: list[str], python: str, env: dict, note: str, r
 
 if __name__ == "__main__":
     if len(sys.argv) == 4 and sys.argv[1] == CHILD_FLAG:
+        # The project as installed in the measured environment: the path stays as it is.
         _parts_child(sys.argv[2], sys.argv[3])
     else:
+        import os
+
+        if os.path.realpath(sys.path[0]) == os.path.dirname(os.path.realpath(__file__)):
+            sys.path[0] = os.path.dirname(sys.path[0])  # run as a file: see benchmarks/__init__.py
         sys.exit(main())

@@ -30,6 +30,9 @@ import warnings
 from pathlib import Path
 from statistics import median
 
+if __name__ == "__main__" and Path(sys.path[0]).resolve() == Path(__file__).resolve().parent:
+    sys.path[0] = str(Path(__file__).resolve().parents[1])  # run as a file: see benchmarks/__init__.py
+
 from benchmarks.common.checkout import needs_rerun, rerun_on
 
 ROOT = Path(__file__).resolve().parents[1]
