@@ -17,7 +17,7 @@ from vectorize.fit.ink_width import edge_offset, ink_widths
 from vectorize.fit.retraces import Twin, foot_is_retraced, trimmed_twins, twin_spans
 from vectorize.front_stages import front_stages, output_matrix, pixel_frame, refuse_ragged
 from vectorize.junctions.classifiers import make_classifier, shipped_pass_scorer
-from vectorize.junctions.crossing_point import crossing_point, passes_crossing
+from vectorize.junctions.crossing_point import BAND_WINDOW, crossing_point, passes_crossing
 from vectorize.junctions.intersections import (Junction, JunctionVerdict, along_line, lone_junctions, ranked_pairings,
                                               sharp_touch)
 from vectorize.junctions.junction_ink import own_ink, own_ink_reach
@@ -250,15 +250,16 @@ def _trace(graph: MedialGraph, simple: Simplified, ordering: Ordering, junctions
             turning = [i for i, at in turned.items() if at == node]
             near = (dist < reach) & ~np.isin(owner, turning + [i + 1 for i in turning])
             keep[near] &= crossing & (dist[near] < 1e-6)
-            if node in simple.narrowest:
-                # The ink shows where the passes cross: where the band they share is
-                # narrowest. Each pass keeps the node alone in a gap of its zone's length:
-                # it stands for the points dropped about it, or the smoothing spends its
-                # residual there, and where two passes cross at a shallow angle a pixel
-                # beside the node moves their crossing 1 / sin(a) px along the band. Not a
-                # node at the middle of its band or at an estimate from the passes' courses:
-                # there the fit bridging the zone guesses as well (held, EMSTech-R's crossing
-                # went 2.4 -> 5.3 px off and mechanically-1-4's 2.8 -> 6.9, measured).
+            if node in simple.held:
+                # The geometry shows where the passes cross: where the band they share is
+                # narrowest, or beside a band three passes share, where their courses on
+                # either side meet (`stem_clusters`). Each pass keeps the node alone in a gap
+                # of its zone's length: it stands for the points dropped about it, or the
+                # smoothing spends its residual there, and where two passes cross at a
+                # shallow angle a pixel beside the node moves their crossing 1 / sin(a) px
+                # along the band. Not a node at the middle of its band: there the fit
+                # bridging the zone guesses as well (held, EMSTech-R's crossing went 2.4 ->
+                # 5.3 px off, measured).
                 for i in np.flatnonzero(near & keep):
                     held[i] = max(held[i], _run(near & ~keep, i))
         result.append((TracedPoints(xy=xy, keep=keep, split=split, radius=np.concatenate(radii),
@@ -308,10 +309,10 @@ def _order(graph: MedialGraph, ink, options: VectorizeOptions, ends: int, clock:
         may_cluster = hooks.pop("may_cluster", None)
         through = merge_triple_points(graph, stroke_width=w, may_merge=may_cluster)
         # A stem drawn down and back up through a crossing (an h's base): read as one node too.
-        narrowest: set[int] = set()
+        held: set[int] = set()
         stems = {} if options.multi else merge_stem_clusters(
-            graph, stroke_width=w, ends=ends, through=through, may_merge=may_cluster, narrowest=narrowest,
-            place=lambda trial, node, passes: passes_crossing(trial, node, passes, w))
+            graph, stroke_width=w, ends=ends, through=through, may_merge=may_cluster, held=held,
+            place=lambda trial, node, passes: passes_crossing(trial, node, passes, w, window=BAND_WINDOW))
         simple = simplify(graph, stroke_width=w, multi=options.multi, ends=ends,
                           through={**through, **dict.fromkeys(stems, ())}, **hooks)
         # Paired after simplification: merging crossings next to a triple point renumbers its slots.
@@ -319,7 +320,7 @@ def _order(graph: MedialGraph, ink, options: VectorizeOptions, ends: int, clock:
         through.update({n: stem_passes(graph, n, w, tip)[0] for n, tip in stems.items()})
         simple = replace(simple, through=through, through_posterior=posterior,
                          crossings=tuple(n for n in simple.crossings if n not in stems),
-                         y_tips=simple.y_tips | set(stems.values()), narrowest=frozenset(narrowest))
+                         y_tips=simple.y_tips | set(stems.values()), held=frozenset(held))
         clock.lap("simplification")
         if options.max_odd_nodes is not None:  # before the crossings' crops and the route
             odd = sum(1 for n, incident in graph.incident.items() if len(incident) % 2 and n not in simple.through)

@@ -113,8 +113,9 @@ class Simplified:
     through: dict = field(default_factory=dict)  # node where three passes cross -> slot pairs
     # such a node -> (15,) posterior of the pass scorer over `pass_scorer.PAIRINGS` (slots)
     through_posterior: dict = field(default_factory=dict)
-    # crossing nodes placed where the band their passes share is narrowest (`stem_clusters`)
-    narrowest: frozenset = frozenset()
+    # crossing nodes placed where the geometry says their passes cross, which the fit holds
+    # (`stem_clusters`: a band's narrowest ink, or the passes' courses beside a band of three)
+    held: frozenset = frozenset()
 
 
 def line_radius(graph: MedialGraph) -> float:

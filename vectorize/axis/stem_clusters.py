@@ -42,7 +42,7 @@ HOLE_BRANCH_WIDTHS = 1.0 / np.sin(np.radians(15.0 / 2.0))
 
 
 def merge_stem_clusters(graph: MedialGraph, *, stroke_width: float, ends: int, place, through: dict | None = None,
-                        may_merge=None, narrowest: set | None = None) -> dict[int, int]:
+                        may_merge=None, held: set | None = None) -> dict[int, int]:
     """Find the clusters of junctions where a stem drawn down and back up meets a crossing
     (module doc) and read each as one crossing and one branch beside it, in place.
 
@@ -53,9 +53,10 @@ def merge_stem_clusters(graph: MedialGraph, *, stroke_width: float, ends: int, p
     in and the loop's way down (`passes`, two slot pairs at `node` merged in `graph`) cross
     (`vectorize.junctions.crossing_point.passes_crossing`, passed in: the junctions' stage
     comes after this one); the node's place where three passes share the band, and which
-    band where a hole's way in does not border its loop's junction. narrowest (if given)
-    gets the nodes placed where the band the two crossing passes share is narrowest: their
-    crossing read from the ink. Returns crossing node ->
+    band where a hole's way in does not border its loop's junction. held (if given) gets
+    the nodes placed where the two crossing passes cross by the geometry: where the band
+    they share is narrowest (their crossing read from the ink), or at a tree whose band
+    three passes share, at their estimated crossing; the fit holds those. Returns crossing node ->
     its stem's tip, where the fit splits; the tip's other branch is the stem drawn back up
     into the way on. Pair each node's slots with `stem_passes` once simplification is done.
     """
@@ -177,8 +178,8 @@ def merge_stem_clusters(graph: MedialGraph, *, stroke_width: float, ends: int, p
             graph.spans[node] = float(max(np.hypot(*(end - centre)) for end in band_ends))
         graph.add_branch(up)
         tips[node] = up.a
-        if read and narrowest is not None:
-            narrowest.add(node)
+        if (read or tree) and held is not None:
+            held.add(node)
     return tips
 
 
