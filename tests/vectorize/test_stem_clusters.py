@@ -134,6 +134,32 @@ def test_a_wide_h_base_crosses_at_its_narrowest_ink(seed, index):
     assert scores.undetected == 0, f"{scores.matched} of {scores.gt_intersections} crossings found"
 
 
+@pytest.mark.parametrize("seed, index", [
+    (4, 2),  # acetaldehyde, 5.75 px: the output crossed 8.5 px from the true crossing before
+    (5, 12),  # technically, 5.75 px: 8.0 px off before
+    (5, 20),  # unmechanical, 5.0 px: 7.1 px off before
+    (6, 17),  # phenylalanine, 5.0 px: 5.5 px off before
+    (35, 21),  # acetaldehyde, 5.75 px: 7.8 px off before
+])
+def test_a_wide_h_base_whose_band_three_passes_share_crosses_where_their_courses_meet(seed, index):
+    """At these h bases the medial axis is a tree whose band the stem drawn back up runs too:
+    its width tells nothing of where two of the three passes cross, and the node goes to where
+    the two passes' courses on either side of the band meet. Fitted 1-4 widths beyond the band,
+    those courses met 1.5-4.6 px from the true crossing, and the fit, not holding the node,
+    crossed 5.5-8.5 px off; fitted 0.5-2.5 widths beyond it, they meet nearer, and the fit holds
+    the node (`TracedPoints.held`). The page as the benchmark gives it: 8 bits."""
+    from benchmarks.common.render import render, to_uint8
+    from benchmarks.metrics.table1 import evaluate
+    from benchmarks.sets.cursive import cursive_drawing
+
+    gt = cursive_drawing(seed, index)
+    gray = render(gt.drawing)
+    result = vectorize_image(to_uint8(gray), VectorizeOptions(classifier="cnn"))
+    scores = evaluate(gt, result.drawing, gray)
+    assert result.report.strokes == 1
+    assert scores.undetected == 0, f"{scores.matched} of {scores.gt_intersections} crossings found"
+
+
 @pytest.mark.parametrize("index", [0, 2, 4, 7, 8, 9])
 def test_every_h_of_a_new_line_keeps_its_crossing(index):
     """A line of h's the benchmark does not draw ("the hen hath a hat", seed 7): before, 2 of
