@@ -29,8 +29,9 @@ from vectorize.junctions.intersections import crossing_pairing
 WINDOW = (1.0, 4.0)
 # Where three passes share a long band (an h's base read as one node, `stem_clusters`), the
 # crossing is extrapolated across the band: a window nearer its ends follows each pass's own
-# course. Node to true crossing over the 29 such nodes at cursive seeds 0-13 and 30-37: median
-# 1.04 px, 3 over 3 px (1.0-4.0 widths: 2.22 px, 9 over 3; 0.5-3.0: 1.20, 3; 0.5-2.0: 1.27, 5).
+# course. Estimate to true crossing over the 68 such nodes of cursive seeds 0-13 and 30-35:
+# median 1.15 px, 6 over 3 px (1.0-4.0 widths: 1.85 px, 20 over 3; 0.5-3.0: 1.14, 7; 0.5-2.0:
+# 1.41, 8; 0.75-2.5: 1.45, 13).
 BAND_WINDOW = (0.5, 2.5)
 # The fit's samples along each branch, in stroke widths (the outline's densest spacing).
 FIT_STEP = 1.0 / 8.0
