@@ -17,7 +17,7 @@ from vectorize.fit.ink_width import edge_offset, ink_widths
 from vectorize.fit.retraces import Twin, foot_is_retraced, trimmed_twins, twin_spans
 from vectorize.front_stages import front_stages, output_matrix, pixel_frame, refuse_ragged
 from vectorize.junctions.classifiers import make_classifier, shipped_pass_scorer
-from vectorize.junctions.crossing_point import BAND_WINDOW, crossing_point, passes_crossing
+from vectorize.junctions.crossing_point import crossing_point, passes_crossing
 from vectorize.junctions.intersections import (Junction, JunctionVerdict, along_line, lone_junctions, ranked_pairings,
                                               sharp_touch)
 from vectorize.junctions.junction_ink import own_ink, own_ink_reach
@@ -251,15 +251,16 @@ def _trace(graph: MedialGraph, simple: Simplified, ordering: Ordering, junctions
             near = (dist < reach) & ~np.isin(owner, turning + [i + 1 for i in turning])
             keep[near] &= crossing & (dist[near] < 1e-6)
             if node in simple.held:
-                # The geometry shows where the passes cross: where the band they share is
-                # narrowest, or beside a band three passes share, where their courses on
-                # either side meet (`stem_clusters`). Each pass keeps the node alone in a gap
-                # of its zone's length: it stands for the points dropped about it, or the
-                # smoothing spends its residual there, and where two passes cross at a
-                # shallow angle a pixel beside the node moves their crossing 1 / sin(a) px
-                # along the band. Not a node at the middle of its band: there the fit
-                # bridging the zone guesses as well (held, EMSTech-R's crossing went 2.4 ->
-                # 5.3 px off, measured).
+                # A stem cluster's node is placed where its two crossing passes cross (the
+                # band they share at its narrowest ink, at its middle, or where their courses
+                # either side meet: `stem_clusters`), and its zone is the band's length (20 px
+                # and more each way on wide lines). Each pass keeps the node alone in that
+                # gap: it stands for the points dropped about it, or the smoothing spends its
+                # residual there, and where two passes cross at a shallow angle a pixel beside
+                # the node moves their crossing 1 / sin(a) px along the band. Not a crossing
+                # `simplify` merged at the middle of the branch between its halves: there the
+                # fit bridging a short zone does better (held, EMSTech-R's crossing went 2.4
+                # -> 5.3 px off, measured).
                 for i in np.flatnonzero(near & keep):
                     held[i] = max(held[i], _run(near & ~keep, i))
         result.append((TracedPoints(xy=xy, keep=keep, split=split, radius=np.concatenate(radii),
@@ -309,10 +310,9 @@ def _order(graph: MedialGraph, ink, options: VectorizeOptions, ends: int, clock:
         may_cluster = hooks.pop("may_cluster", None)
         through = merge_triple_points(graph, stroke_width=w, may_merge=may_cluster)
         # A stem drawn down and back up through a crossing (an h's base): read as one node too.
-        held: set[int] = set()
         stems = {} if options.multi else merge_stem_clusters(
-            graph, stroke_width=w, ends=ends, through=through, may_merge=may_cluster, held=held,
-            place=lambda trial, node, passes: passes_crossing(trial, node, passes, w, window=BAND_WINDOW))
+            graph, stroke_width=w, ends=ends, through=through, may_merge=may_cluster,
+            place=lambda trial, node, passes, window=None: passes_crossing(trial, node, passes, w, window))
         simple = simplify(graph, stroke_width=w, multi=options.multi, ends=ends,
                           through={**through, **dict.fromkeys(stems, ())}, **hooks)
         # Paired after simplification: merging crossings next to a triple point renumbers its slots.
@@ -320,7 +320,7 @@ def _order(graph: MedialGraph, ink, options: VectorizeOptions, ends: int, clock:
         through.update({n: stem_passes(graph, n, w, tip)[0] for n, tip in stems.items()})
         simple = replace(simple, through=through, through_posterior=posterior,
                          crossings=tuple(n for n in simple.crossings if n not in stems),
-                         y_tips=simple.y_tips | set(stems.values()), held=frozenset(held))
+                         y_tips=simple.y_tips | set(stems.values()), held=frozenset(stems))
         clock.lap("simplification")
         if options.max_odd_nodes is not None:  # before the crossings' crops and the route
             odd = sum(1 for n, incident in graph.incident.items() if len(incident) % 2 and n not in simple.through)

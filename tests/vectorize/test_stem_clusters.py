@@ -160,6 +160,28 @@ def test_a_wide_h_base_whose_band_three_passes_share_crosses_where_their_courses
     assert scores.undetected == 0, f"{scores.matched} of {scores.gt_intersections} crossings found"
 
 
+@pytest.mark.parametrize("seed, index", [
+    (36, 31),  # technically, 6.25 px: the node 0.7 px from the true crossing, the output's 5.6 px
+    (36, 39),  # unmechanical, 4.5 px: 5.7 px off before
+])
+def test_a_wide_h_base_round_a_hole_crosses_at_its_node(seed, index):
+    """At these h bases the medial axis is junctions round a hole, and the node goes to the
+    middle of the band the way in and the way down share. Its zone is the band's length, so
+    each pass kept one point there, the node, and the smoothing spline ran 2-4 px beside it and
+    crossed the other pass 5.6-5.7 px along the band; held (`TracedPoints.held`), it crosses
+    within the match distance. The page as the benchmark gives it: 8 bits."""
+    from benchmarks.common.render import render, to_uint8
+    from benchmarks.metrics.table1 import evaluate
+    from benchmarks.sets.cursive import cursive_drawing
+
+    gt = cursive_drawing(seed, index)
+    gray = render(gt.drawing)
+    result = vectorize_image(to_uint8(gray), VectorizeOptions(classifier="cnn"))
+    scores = evaluate(gt, result.drawing, gray)
+    assert result.report.strokes == 1
+    assert scores.undetected == 0, f"{scores.matched} of {scores.gt_intersections} crossings found"
+
+
 @pytest.mark.parametrize("index", [0, 2, 4, 7, 8, 9])
 def test_every_h_of_a_new_line_keeps_its_crossing(index):
     """A line of h's the benchmark does not draw ("the hen hath a hat", seed 7): before, 2 of

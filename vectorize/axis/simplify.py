@@ -113,8 +113,7 @@ class Simplified:
     through: dict = field(default_factory=dict)  # node where three passes cross -> slot pairs
     # such a node -> (15,) posterior of the pass scorer over `pass_scorer.PAIRINGS` (slots)
     through_posterior: dict = field(default_factory=dict)
-    # crossing nodes placed where the geometry says their passes cross, which the fit holds
-    # (`stem_clusters`: a band's narrowest ink, or the passes' courses beside a band of three)
+    # crossing nodes the fit holds: where a stem cluster's passes cross (`stem_clusters`)
     held: frozenset = frozenset()
 
 

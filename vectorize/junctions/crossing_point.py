@@ -27,12 +27,6 @@ from vectorize.junctions.intersections import crossing_pairing
 # span): past the first width, where the medial axis bends into the junction, and short
 # enough that a quadratic follows a curving stroke.
 WINDOW = (1.0, 4.0)
-# Where three passes share a long band (an h's base read as one node, `stem_clusters`), the
-# crossing is extrapolated across the band: a window nearer its ends follows each pass's own
-# course. Estimate to true crossing over the 68 such nodes of cursive seeds 0-13 and 30-35:
-# median 1.15 px, 6 over 3 px (1.0-4.0 widths: 1.85 px, 20 over 3; 0.5-3.0: 1.14, 7; 0.5-2.0:
-# 1.41, 8; 0.75-2.5: 1.45, 13).
-BAND_WINDOW = (0.5, 2.5)
 # The fit's samples along each branch, in stroke widths (the outline's densest spacing).
 FIT_STEP = 1.0 / 8.0
 # Samples of the second pass (the crossing is interpolated between two of them).
@@ -85,15 +79,15 @@ def crossing_point(graph: MedialGraph, node: int, dirs: np.ndarray, stroke_width
 
 
 def passes_crossing(graph: MedialGraph, node: int, passes, stroke_width: float,
-                    window: tuple[float, float] = WINDOW) -> np.ndarray:
+                    window: tuple[float, float] | None = None) -> np.ndarray:
     """Estimated point (2,) px where two passes through `node` cross (passes: two slot
     pairs, indices into `slots`), fitted as in `crossing_point` on each branch between
-    `window` stroke widths beyond the node's span; the node's position where a branch is
-    too short to fit or the fit is degenerate."""
+    `window` stroke widths beyond the node's span (None: `WINDOW`); the node's position
+    where a branch is too short to fit or the fit is degenerate."""
     centre = np.asarray(graph.positions[node], dtype=float)
     span = graph.spans.get(node, 0.0)
     node_slots = slots(graph, node)
-    lo, hi = span + window[0] * stroke_width, span + window[1] * stroke_width
+    lo, hi = (span + f * stroke_width for f in (WINDOW if window is None else window))
     windows = {i: _window(graph, node_slots[i], lo, hi, FIT_STEP * stroke_width) for pair in passes for i in pair}
     if min(len(p) for p in windows.values()) < 3:
         return centre
