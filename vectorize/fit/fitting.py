@@ -242,6 +242,37 @@ def _corner_point(before: np.ndarray, after: np.ndarray, fallback: np.ndarray, l
     return apex
 
 
+def _refit_dragged(pieces: list[np.ndarray], cuts: list[int], xy: np.ndarray, keep: np.ndarray,
+                   corner: np.ndarray, twins: list[Twin], sigma: float, stroke_width: float) -> None:
+    """In place: a piece that a corner's joint dragged off its own points is refitted on them.
+
+    A piece is fitted on its kept points, those a width or more from a corner, and its end
+    is then moved to the corner point (where the sides' tangents meet, up to two widths out,
+    or the tip the ink shows) with its inner handle kept. Moved that far, the end's first
+    stretch swings off the points it was fitted on: up a band three passes share, where the
+    way in's tangent at the band's foot points across it, the curve ran along the band's far
+    edge, 2.5 px from its own centre line (a 2 px line). A piece whose curve passes farther
+    than `DRAGGED` widths from one of its kept points is refitted on them between its final
+    ends (pieces (K, 4, 2) px; cuts: the traced-point index each piece starts at, and the last).
+    """
+    for k, (lo, hi) in enumerate(zip(cuts[:-1], cuts[1:])):
+        if not (corner[lo] or corner[hi]) or twin_piece(twins, lo, hi) is not None:
+            continue
+        inner = xy[lo + 1:hi][keep[lo + 1:hi]]
+        if not len(inner):
+            continue
+        curve = Stroke(pieces[k]).sample_evenly(STEP)
+        off = np.sqrt(((inner[:, None, :] - curve[None, :, :]) ** 2).sum(axis=2).min(axis=1))
+        if off.max() <= DRAGGED * stroke_width:
+            continue
+        pieces[k] = _open_fit(np.vstack([pieces[k][0, 0], inner, pieces[k][-1, 3]]), sigma)
+
+
+# A fitted piece passes within the smoothing's noise of its points; one farther than this many
+# stroke widths from one of them was moved there by a joint, not by the points.
+DRAGGED = 0.5
+
+
 def _reached_in_ink(guard: InkGuard, corner: np.ndarray, point: np.ndarray) -> bool:
     """Whether the straight way from the traced `corner` (2,) px to a corner point (2,) px
     lies in the ink: a spike out to the point and back is what the pen would draw.
@@ -437,6 +468,7 @@ def fit_stroke(traced: TracedPoints, *, closed: bool, sigma: float, stroke_width
             after[0, 1] += point - after[0, 0]
         before[-1, 3] = point
         after[0, 0] = point
+    _refit_dragged(pieces, cuts, xy, keep, corner, twins, sigma, stroke_width)
     share_pieces(twins, cuts, pieces)
     if guard is not None and not (closed and len(pieces) == 1):  # a closed piece was checked when fitted
         _settle(pieces, cuts, xy, twins, guard, sigma, inside)
