@@ -7,6 +7,7 @@ import bisect
 
 import numpy as np
 from scipy.interpolate import splev, splprep
+from scipy.spatial import cKDTree
 
 from vectorize.fit.ink_guard import MARGIN, STEP, InkGuard, curve_excess, keep_in_ink
 from vectorize.fit.retraces import (
@@ -261,8 +262,7 @@ def _refit_dragged(pieces: list[np.ndarray], cuts: list[int], xy: np.ndarray, ke
         inner = xy[lo + 1:hi][keep[lo + 1:hi]]
         if not len(inner):
             continue
-        curve = Stroke(pieces[k]).sample_evenly(STEP)
-        off = np.sqrt(((inner[:, None, :] - curve[None, :, :]) ** 2).sum(axis=2).min(axis=1))
+        off, _ = cKDTree(Stroke(pieces[k]).sample_evenly(STEP)).query(inner)
         if off.max() <= DRAGGED * stroke_width:
             continue
         pieces[k] = _open_fit(np.vstack([pieces[k][0, 0], inner, pieces[k][-1, 3]]), sigma)
