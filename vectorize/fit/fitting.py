@@ -243,7 +243,7 @@ def _corner_point(before: np.ndarray, after: np.ndarray, fallback: np.ndarray, l
     return apex
 
 
-def _refit_dragged(pieces: list[np.ndarray], cuts: list[int], xy: np.ndarray, keep: np.ndarray,
+def _refit_dragged(pieces: list[np.ndarray], cuts: list[int], xy: np.ndarray, keep: np.ndarray, held: np.ndarray,
                    corner: np.ndarray, twins: list[Twin], sigma: float, stroke_width: float) -> None:
     """In place: a piece that a corner's joint dragged off its own points is refitted on them.
 
@@ -254,18 +254,21 @@ def _refit_dragged(pieces: list[np.ndarray], cuts: list[int], xy: np.ndarray, ke
     way in's tangent at the band's foot points across it, the curve ran along the band's far
     edge, 2.5 px from its own centre line (a 2 px line). A piece whose curve passes farther
     than `DRAGGED` widths from one of its kept points is refitted on them between its final
-    ends (pieces (K, 4, 2) px; cuts: the traced-point index each piece starts at, and the last).
+    ends, each point weighing what it weighed in the first fit (`held`) (pieces (K, 4, 2) px; cuts:
+    the traced-point index each piece starts at, and the last).
     """
     for k, (lo, hi) in enumerate(zip(cuts[:-1], cuts[1:])):
         if not (corner[lo] or corner[hi]) or twin_piece(twins, lo, hi) is not None:
             continue
-        inner = xy[lo + 1:hi][keep[lo + 1:hi]]
+        kept = keep[lo + 1:hi]
+        inner = xy[lo + 1:hi][kept]
         if not len(inner):
             continue
         off, _ = cKDTree(Stroke(pieces[k]).sample_evenly(STEP)).query(inner)
         if off.max() <= DRAGGED * stroke_width:
             continue
-        pieces[k] = _open_fit(np.vstack([pieces[k][0, 0], inner, pieces[k][-1, 3]]), sigma)
+        pieces[k] = fit_piece(np.vstack([pieces[k][0, 0], inner, pieces[k][-1, 3]]), closed=False, sigma=sigma,
+                              held=np.concatenate([[1.0], held[lo + 1:hi][kept], [1.0]]))
 
 
 # A fitted piece passes within the smoothing's noise of its points; one farther than this many
@@ -468,7 +471,7 @@ def fit_stroke(traced: TracedPoints, *, closed: bool, sigma: float, stroke_width
             after[0, 1] += point - after[0, 0]
         before[-1, 3] = point
         after[0, 0] = point
-    _refit_dragged(pieces, cuts, xy, keep, corner, twins, sigma, stroke_width)
+    _refit_dragged(pieces, cuts, xy, keep, held, corner, twins, sigma, stroke_width)
     share_pieces(twins, cuts, pieces)
     if guard is not None and not (closed and len(pieces) == 1):  # a closed piece was checked when fitted
         _settle(pieces, cuts, xy, twins, guard, sigma, inside)
