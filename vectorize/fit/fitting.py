@@ -243,8 +243,9 @@ def _corner_point(before: np.ndarray, after: np.ndarray, fallback: np.ndarray, l
     return apex
 
 
-def _refit_dragged(pieces: list[np.ndarray], cuts: list[int], xy: np.ndarray, keep: np.ndarray, held: np.ndarray,
-                   corner: np.ndarray, twins: list[Twin], sigma: float, stroke_width: float) -> None:
+def _refit_dragged(pieces: list[np.ndarray], fitted: list[np.ndarray], cuts: list[int], xy: np.ndarray,
+                   keep: np.ndarray, held: np.ndarray, corner: np.ndarray, twins: list[Twin], sigma: float,
+                   stroke_width: float) -> None:
     """In place: a piece that a corner's joint dragged off its own points is refitted on them.
 
     A piece is fitted on its kept points, those a width or more from a corner, and its end
@@ -252,10 +253,13 @@ def _refit_dragged(pieces: list[np.ndarray], cuts: list[int], xy: np.ndarray, ke
     or the tip the ink shows) with its inner handle kept. Moved that far, the end's first
     stretch swings off the points it was fitted on: up a band three passes share, where the
     way in's tangent at the band's foot points across it, the curve ran along the band's far
-    edge, 2.5 px from its own centre line (a 2 px line). A piece whose curve passes farther
-    than `DRAGGED` widths from one of its kept points is refitted on them between its final
-    ends, each point weighing what it weighed in the first fit (`held`) (pieces (K, 4, 2) px; cuts:
-    the traced-point index each piece starts at, and the last).
+    edge, 2.5 px from its own centre line (a 2 px line). A piece that the joints moved more than
+    `DRAGGED` widths farther from one of its kept points than its fit (`fitted`, the pieces
+    before the joints) left it is refitted on them between its final ends, each point weighing
+    what it weighed in the first fit (`held`). The fit's own residual is not a drag: bridging a
+    shallow crossing's uncertain stretch, a long piece may pass half a width from the points
+    beside it, and refitted, its crossing moved (pieces (K, 4, 2) px; cuts: the traced-point
+    index each piece starts at, and the last).
     """
     for k, (lo, hi) in enumerate(zip(cuts[:-1], cuts[1:])):
         if not (corner[lo] or corner[hi]) or twin_piece(twins, lo, hi) is not None:
@@ -267,12 +271,16 @@ def _refit_dragged(pieces: list[np.ndarray], cuts: list[int], xy: np.ndarray, ke
         off, _ = cKDTree(Stroke(pieces[k]).sample_evenly(STEP)).query(inner)
         if off.max() <= DRAGGED * stroke_width:
             continue
+        before, _ = cKDTree(Stroke(fitted[k]).sample_evenly(STEP)).query(inner)
+        if (off - before).max() <= DRAGGED * stroke_width:
+            continue
         pieces[k] = fit_piece(np.vstack([pieces[k][0, 0], inner, pieces[k][-1, 3]]), closed=False, sigma=sigma,
                               held=np.concatenate([[1.0], held[lo + 1:hi][kept], [1.0]]))
 
 
-# A fitted piece passes within the smoothing's noise of its points; one farther than this many
-# stroke widths from one of them was moved there by a joint, not by the points.
+# A joint that moves a piece this many stroke widths farther from one of its points than its fit
+# left it (within 0.43 w of all of them as fitted, at the 222 corner pieces of three thin lines)
+# dragged it off its line.
 DRAGGED = 0.5
 
 
@@ -441,6 +449,7 @@ def fit_stroke(traced: TracedPoints, *, closed: bool, sigma: float, stroke_width
         fitted[(lo, hi)] = len(pieces)
         pieces.append(np.array(control))  # writable: the joints move its ends
         inside.append(checked)
+    as_fitted = [np.array(piece) for piece in pieces]
     # Join the pieces: at corners where their sides meet, elsewhere where they end.
     joints = list(zip(range(len(pieces) - 1), range(1, len(pieces)), cuts[1:-1]))
     if corner[0] and corner[-1] and len(pieces) > 1:
@@ -471,7 +480,7 @@ def fit_stroke(traced: TracedPoints, *, closed: bool, sigma: float, stroke_width
             after[0, 1] += point - after[0, 0]
         before[-1, 3] = point
         after[0, 0] = point
-    _refit_dragged(pieces, cuts, xy, keep, held, corner, twins, sigma, stroke_width)
+    _refit_dragged(pieces, as_fitted, cuts, xy, keep, held, corner, twins, sigma, stroke_width)
     share_pieces(twins, cuts, pieces)
     if guard is not None and not (closed and len(pieces) == 1):  # a closed piece was checked when fitted
         _settle(pieces, cuts, xy, twins, guard, sigma, inside)
