@@ -145,3 +145,18 @@ def test_a_piece_a_corner_joint_dragged_off_its_points_is_refitted(seed, index):
     assert len(result.drawing.strokes) == 1
     assert uncovered(gt.drawing, result.drawing) <= order_tolerance(gt.width)
     assert excursion(gt.drawing, result.drawing) <= excursion_bound(gt.width)
+
+
+def test_a_refitted_piece_can_still_be_moved_by_the_joints_after_it():
+    """uncle_hank-40-5 (2.25 px line): a dragged piece with under four kept points was refitted
+    as a frozen Stroke's control points, and the retraced stretch's joints after it could not
+    move its end (`ValueError: output array is read-only`, the whole drawing lost)."""
+    from benchmarks.common.render import render_truth
+    from benchmarks.metrics.ink import excursion, excursion_bound
+    from benchmarks.sets.cursive import cursive_drawing
+    from vectorize import VectorizeOptions, vectorize_image
+
+    gt = cursive_drawing(40, 5)
+    result = vectorize_image(render_truth(gt), VectorizeOptions(multi=False, classifier="cnn", seed=0))
+    assert len(result.drawing.strokes) == 1
+    assert excursion(gt.drawing, result.drawing) <= excursion_bound(gt.width)

@@ -274,8 +274,10 @@ def _refit_dragged(pieces: list[np.ndarray], fitted: list[np.ndarray], cuts: lis
         before, _ = cKDTree(Stroke(fitted[k]).sample_evenly(STEP)).query(inner)
         if (off - before).max() <= DRAGGED * stroke_width:
             continue
-        pieces[k] = fit_piece(np.vstack([pieces[k][0, 0], inner, pieces[k][-1, 3]]), closed=False, sigma=sigma,
-                              held=np.concatenate([[1.0], held[lo + 1:hi][kept], [1.0]]))
+        # Writable, as every piece is: a retraced stretch's joints (`share_pieces`) and `_settle`
+        # move its ends later (a piece of under four points comes back as a frozen Stroke's).
+        pieces[k] = np.array(fit_piece(np.vstack([pieces[k][0, 0], inner, pieces[k][-1, 3]]), closed=False,
+                                       sigma=sigma, held=np.concatenate([[1.0], held[lo + 1:hi][kept], [1.0]])))
 
 
 # A joint that moves a piece this many stroke widths farther from one of its points than its fit
