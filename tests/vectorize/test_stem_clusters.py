@@ -110,6 +110,21 @@ def test_a_thin_h_base_whose_band_is_many_measured_widths_long():
     assert scores.undetected == 0, f"{scores.matched} of {scores.gt_intersections} crossings found"
 
 
+def _every_crossing_found_on_the_8bit_page(seed: int, index: int) -> None:
+    """Cursive line `index` of `seed`, rendered and stored in 8 bits as a PNG holds it (the page
+    the benchmark gives), comes out as one stroke with every true crossing matched."""
+    from benchmarks.common.render import render, to_uint8
+    from benchmarks.metrics.table1 import evaluate
+    from benchmarks.sets.cursive import cursive_drawing
+
+    gt = cursive_drawing(seed, index)
+    gray = render(gt.drawing)
+    result = vectorize_image(to_uint8(gray), VectorizeOptions(classifier="cnn"))
+    scores = evaluate(gt, result.drawing, gray)
+    assert result.report.strokes == 1
+    assert scores.undetected == 0, f"{scores.matched} of {scores.gt_intersections} crossings found"
+
+
 @pytest.mark.parametrize("seed, index", [
     (32, 14),  # acetaldehyde, 5.5 px: the output crossed 6.7 px from the true crossing before
     (33, 0),  # phenylalanine, 4.25 px: 6.0 px off before
@@ -122,16 +137,7 @@ def test_a_wide_h_base_crosses_at_its_narrowest_ink(seed, index):
     the band, beyond the benchmark's match distance. The node now stands for the points its
     zone dropped (`TracedPoints.held`). The page as the benchmark gives it: 8 bits, as a PNG
     holds it (from the float render both came out right before, by chance)."""
-    from benchmarks.common.render import render, to_uint8
-    from benchmarks.metrics.table1 import evaluate
-    from benchmarks.sets.cursive import cursive_drawing
-
-    gt = cursive_drawing(seed, index)
-    gray = render(gt.drawing)
-    result = vectorize_image(to_uint8(gray), VectorizeOptions(classifier="cnn"))
-    scores = evaluate(gt, result.drawing, gray)
-    assert result.report.strokes == 1
-    assert scores.undetected == 0, f"{scores.matched} of {scores.gt_intersections} crossings found"
+    _every_crossing_found_on_the_8bit_page(seed, index)
 
 
 @pytest.mark.parametrize("seed, index", [
@@ -148,16 +154,7 @@ def test_a_wide_h_base_whose_band_three_passes_share_crosses_where_their_courses
     those courses met 1.5-4.6 px from the true crossing, and the fit, not holding the node,
     crossed 5.5-8.5 px off; fitted 0.5-2.5 widths beyond it, they meet nearer, and the fit holds
     the node (`TracedPoints.held`). The page as the benchmark gives it: 8 bits."""
-    from benchmarks.common.render import render, to_uint8
-    from benchmarks.metrics.table1 import evaluate
-    from benchmarks.sets.cursive import cursive_drawing
-
-    gt = cursive_drawing(seed, index)
-    gray = render(gt.drawing)
-    result = vectorize_image(to_uint8(gray), VectorizeOptions(classifier="cnn"))
-    scores = evaluate(gt, result.drawing, gray)
-    assert result.report.strokes == 1
-    assert scores.undetected == 0, f"{scores.matched} of {scores.gt_intersections} crossings found"
+    _every_crossing_found_on_the_8bit_page(seed, index)
 
 
 @pytest.mark.parametrize("seed, index", [
@@ -170,16 +167,7 @@ def test_a_wide_h_base_round_a_hole_crosses_at_its_node(seed, index):
     each pass kept one point there, the node, and the smoothing spline ran 2-4 px beside it and
     crossed the other pass 5.6-5.7 px along the band; held (`TracedPoints.held`), it crosses
     within the match distance. The page as the benchmark gives it: 8 bits."""
-    from benchmarks.common.render import render, to_uint8
-    from benchmarks.metrics.table1 import evaluate
-    from benchmarks.sets.cursive import cursive_drawing
-
-    gt = cursive_drawing(seed, index)
-    gray = render(gt.drawing)
-    result = vectorize_image(to_uint8(gray), VectorizeOptions(classifier="cnn"))
-    scores = evaluate(gt, result.drawing, gray)
-    assert result.report.strokes == 1
-    assert scores.undetected == 0, f"{scores.matched} of {scores.gt_intersections} crossings found"
+    _every_crossing_found_on_the_8bit_page(seed, index)
 
 
 @pytest.mark.parametrize("index", [0, 2, 4, 7, 8, 9])
