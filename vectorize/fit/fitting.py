@@ -33,6 +33,10 @@ THIN_MAX = 1.5
 # Only pieces of more points than this are thinned: FITPACK's time is in the long ones.
 THIN_FROM = 2000
 DENSE = 3.0
+# A joint that moves a piece this many stroke widths farther from one of its points than its fit
+# left it (within 0.43 w of all of them as fitted, at the 222 corner pieces of three thin lines)
+# dragged it off its line (`_refit_dragged`).
+DRAGGED = 0.5
 
 
 def _distinct(points: np.ndarray, min_step: float) -> np.ndarray:
@@ -243,6 +247,12 @@ def _corner_point(before: np.ndarray, after: np.ndarray, fallback: np.ndarray, l
     return apex
 
 
+def _distance_to_curve(piece: np.ndarray, points: np.ndarray) -> np.ndarray:
+    """(N,) px from each of `points` (N, 2) px to the curve of `piece` (K, 4, 2) px, sampled
+    every `ink_guard.STEP` px."""
+    return cKDTree(Stroke(piece).sample_evenly(STEP)).query(points)[0]
+
+
 def _refit_dragged(pieces: list[np.ndarray], fitted: list[np.ndarray], cuts: list[int], xy: np.ndarray,
                    keep: np.ndarray, held: np.ndarray, corner: np.ndarray, twins: list[Twin], sigma: float,
                    stroke_width: float) -> None:
@@ -268,22 +278,15 @@ def _refit_dragged(pieces: list[np.ndarray], fitted: list[np.ndarray], cuts: lis
         inner = xy[lo + 1:hi][kept]
         if not len(inner):
             continue
-        off, _ = cKDTree(Stroke(pieces[k]).sample_evenly(STEP)).query(inner)
+        off = _distance_to_curve(pieces[k], inner)
         if off.max() <= DRAGGED * stroke_width:
             continue
-        before, _ = cKDTree(Stroke(fitted[k]).sample_evenly(STEP)).query(inner)
-        if (off - before).max() <= DRAGGED * stroke_width:
+        if (off - _distance_to_curve(fitted[k], inner)).max() <= DRAGGED * stroke_width:
             continue
         # Writable, as every piece is: a retraced stretch's joints (`share_pieces`) and `_settle`
         # move its ends later (a piece of under four points comes back as a frozen Stroke's).
         pieces[k] = np.array(fit_piece(np.vstack([pieces[k][0, 0], inner, pieces[k][-1, 3]]), closed=False,
                                        sigma=sigma, held=np.concatenate([[1.0], held[lo + 1:hi][kept], [1.0]])))
-
-
-# A joint that moves a piece this many stroke widths farther from one of its points than its fit
-# left it (within 0.43 w of all of them as fitted, at the 222 corner pieces of three thin lines)
-# dragged it off its line.
-DRAGGED = 0.5
 
 
 def _reached_in_ink(guard: InkGuard, corner: np.ndarray, point: np.ndarray) -> bool:
